@@ -1,0 +1,188 @@
+//! The exemplar analysis (design note §1.2): everything synthesis needs, computed once per
+//! texture — the Gaussian stack, per-level runtime projections and the k = 2 candidate sets with
+//! their features stored next to them. See [`crate::analysis_file`] for how it is stored.
+
+use serde::{Deserialize, Serialize};
+
+use crate::candidates::{candidate_sets, CandidateRules};
+use crate::exemplar::{Exemplar, Preparation};
+use crate::features::{
+    principal_directions, project_runtime, project_search, quantise_projection, LevelColours, RUNTIME_DIMS,
+    SEARCH_DIMS,
+};
+use crate::stack::{build_stack, to_u8};
+
+/// Version of the synthesis algorithm (hash, tags, filters, schedules). Part of every ETag:
+/// bump it whenever any output pixel could change.
+pub const ALGORITHM_VERSION: u32 = 1;
+/// First pyramid level that is corrected (LH05: levels 0–2 are not).
+pub const FIRST_CORRECTED_LEVEL: u32 = 3;
+
+/// Receives progress from long computations (analysis), so front ends can show it.
+pub trait Progress: Sync {
+    /// `done` of `total` steps are finished; `what` names the current step.
+    fn step(&self, done: u32, total: u32, what: &str);
+}
+
+/// A [`Progress`] that ignores everything.
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn step(&self, _: u32, _: u32, _: &str) {}
+}
+
+/// One candidate: an exemplar coordinate and its runtime feature vector.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Candidate {
+    /// Packed exemplar coordinate `x | y << 16`.
+    pub coord: u32,
+    /// Runtime feature `Ñ_E(coord)` (quantised PCA projection of its 5×5 neighbourhood).
+    pub feat: [i16; RUNTIME_DIMS],
+}
+
+/// Analysis data of one corrected level.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CorrectionLevel {
+    /// Quantised projection, `[tap][channel][dim]`, i16 (unit vectors × 2^12).
+    pub proj: Vec<i16>,
+    /// `[C_1(u), C_2(u)]` for every texel `u = y·m + x`.
+    pub cands: Vec<[Candidate; 2]>,
+}
+
+/// Descriptive header of an analysis (stored as JSON in the file).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AnalysisHeader {
+    /// Content hash of exemplar pixels, flags and algorithm version (hex): the analysis id.
+    pub id: String,
+    /// Algorithm version the analysis was made for.
+    pub algorithm_version: u32,
+    /// Exemplar side `m`.
+    pub side: u32,
+    /// `L = log2 m`: the finest level index.
+    pub levels: u32,
+    /// Wrap-around synthesis.
+    pub toroidal: bool,
+    /// How the input image was prepared.
+    pub preparation: Preparation,
+}
+
+/// A complete exemplar analysis.
+#[derive(Debug, Clone)]
+pub struct Analysis {
+    /// Header data.
+    pub header: AnalysisHeader,
+    /// The prepared exemplar, RGB8, row-major.
+    pub exemplar: Vec<[u8; 3]>,
+    /// Gaussian stack, `levels + 1` images, value·256.
+    pub stack: Vec<Vec<[u16; 3]>>,
+    /// Levels `FIRST_CORRECTED_LEVEL..=levels`.
+    pub corrected: Vec<CorrectionLevel>,
+    /// Derived: 8-bit stack colours (not stored).
+    pub(crate) stack8: Vec<Vec<[u8; 3]>>,
+}
+
+impl Analysis {
+    /// Analyse a prepared exemplar. Deterministic: the same exemplar always gives the same
+    /// analysis, whatever the thread count.
+    pub fn build(ex: &Exemplar, progress: &dyn Progress) -> Analysis {
+        let m = ex.side as usize;
+        let levels = ex.side.trailing_zeros();
+        let total = levels - FIRST_CORRECTED_LEVEL + 2;
+        progress.step(0, total, "gaussian stack");
+        let stack = build_stack(&ex.pixels, m, ex.toroidal);
+        let stack8 = derive_stack8(&stack);
+        let mut corrected = Vec::new();
+        for l in FIRST_CORRECTED_LEVEL..=levels {
+            progress.step(l - FIRST_CORRECTED_LEVEL + 1, total, "neighbourhoods and candidates");
+            corrected.push(analyse_level(&stack8[l as usize], m, ex.toroidal, 1 << (levels - l)));
+        }
+        progress.step(total, total, "done");
+        let header = AnalysisHeader {
+            id: analysis_id(ex),
+            algorithm_version: ALGORITHM_VERSION,
+            side: ex.side,
+            levels,
+            toroidal: ex.toroidal,
+            preparation: ex.preparation.clone(),
+        };
+        Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8 }
+    }
+
+    /// Exemplar side `m`.
+    pub fn side(&self) -> u32 {
+        self.header.side
+    }
+
+    /// Finest level index `L`.
+    pub fn levels(&self) -> u32 {
+        self.header.levels
+    }
+
+    /// The analysis of corrected level `l`, if `l` is corrected.
+    pub fn correction_level(&self, l: u32) -> Option<&CorrectionLevel> {
+        l.checked_sub(FIRST_CORRECTED_LEVEL).and_then(|i| self.corrected.get(i as usize))
+    }
+
+    /// 8-bit stack colours of level `l`.
+    pub fn colours8(&self, l: u32) -> &[[u8; 3]] {
+        &self.stack8[l as usize]
+    }
+
+    /// Mean colour of the exemplar (8-bit).
+    pub fn mean_colour(&self) -> [u8; 3] {
+        self.stack8[0][0]
+    }
+
+    /// Rebuild derived tables after loading.
+    pub(crate) fn from_parts(
+        header: AnalysisHeader,
+        exemplar: Vec<[u8; 3]>,
+        stack: Vec<Vec<[u16; 3]>>,
+        corrected: Vec<CorrectionLevel>,
+    ) -> Analysis {
+        let stack8 = derive_stack8(&stack);
+        Analysis { header, exemplar, stack, corrected, stack8 }
+    }
+}
+
+fn derive_stack8(stack: &[Vec<[u16; 3]>]) -> Vec<Vec<[u8; 3]>> {
+    stack.iter().map(|lv| lv.iter().map(|p| p.map(to_u8)).collect()).collect()
+}
+
+/// Content hash of what determines an analysis: algorithm version, side, toroidal flag, pixels.
+fn analysis_id(ex: &Exemplar) -> String {
+    let mut h = blake3::Hasher::new();
+    h.update(b"textile-analysis");
+    h.update(&ALGORITHM_VERSION.to_le_bytes());
+    h.update(&ex.side.to_le_bytes());
+    h.update(&[ex.toroidal as u8]);
+    for p in &ex.pixels {
+        h.update(p);
+    }
+    h.finalize().to_hex()[..16].to_string()
+}
+
+fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize) -> CorrectionLevel {
+    use rayon::prelude::*;
+    let cols = LevelColours { px, m: m as i64, toroidal, h: h as i64 };
+    let dirs5 = principal_directions(&cols, 2, RUNTIME_DIMS);
+    let proj = quantise_projection(&dirs5);
+    let dirs7 = principal_directions(&cols, 3, SEARCH_DIMS);
+    let (runtime, search): (Vec<[i16; RUNTIME_DIMS]>, Vec<[f64; SEARCH_DIMS]>) = (0..m * m)
+        .into_par_iter()
+        .map_init(Vec::new, |buf, i| {
+            let (x, y) = ((i % m) as i64, (i / m) as i64);
+            cols.neighbourhood(x, y, 2, buf);
+            let r = project_runtime(&proj, buf);
+            cols.neighbourhood(x, y, 3, buf);
+            (r, project_search(&dirs7, buf))
+        })
+        .unzip();
+    let sets = candidate_sets(&search, &CandidateRules::for_level(m, toroidal, h));
+    let cand = |i: u32| {
+        let i = i as usize;
+        Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }
+    };
+    let cands = sets.iter().map(|&[a, b]| [cand(a), cand(b)]).collect();
+    CorrectionLevel { proj, cands }
+}

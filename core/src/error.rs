@@ -1,0 +1,92 @@
+//! Typed errors of the core library: every way an exemplar, an analysis file or a synthesis
+//! request can be wrong. The server maps each variant to one HTTP status in one place.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in `textile-core`.
+#[derive(Debug, thiserror::Error)]
+pub enum CoreError {
+    /// The exemplar bytes are not an image format we can decode, or the image data is corrupt.
+    #[error("exemplar is not a decodable image: {0}")]
+    ExemplarUndecodable(String),
+    /// The exemplar decodes but its size is outside the accepted range.
+    #[error("exemplar is {width}x{height} pixels; allowed is {min}x{min} to {max}x{max}")]
+    ExemplarSize {
+        /// Width of the offending image.
+        width: u32,
+        /// Height of the offending image.
+        height: u32,
+        /// Smallest accepted side.
+        min: u32,
+        /// Largest accepted side.
+        max: u32,
+    },
+    /// An analysis file could not be read or written.
+    #[error("analysis file {path}: {source}")]
+    Io {
+        /// The file concerned.
+        path: PathBuf,
+        /// The underlying I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// An analysis file is not usable; `problem` says why (truncated, wrong magic, …).
+    #[error("analysis file {path}: {problem}")]
+    AnalysisFile {
+        /// The file concerned (empty when parsing from memory).
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: AnalysisFileProblem,
+    },
+    /// A synthesis parameter is outside its allowed range.
+    #[error("parameter '{name}': {message}")]
+    Param {
+        /// Parameter name as the API spells it.
+        name: &'static str,
+        /// What was wrong and what is allowed.
+        message: String,
+    },
+    /// A requested window is empty or too large.
+    #[error("window {width}x{height} is not allowed: {message}")]
+    Window {
+        /// Requested width.
+        width: i64,
+        /// Requested height.
+        height: i64,
+        /// What is allowed.
+        message: String,
+    },
+}
+
+/// Why an analysis file was refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum AnalysisFileProblem {
+    /// The file does not start with the textile analysis magic bytes.
+    #[error("not a textile analysis file (wrong magic bytes)")]
+    BadMagic,
+    /// The file was written by an incompatible format or algorithm version.
+    #[error("unsupported version {found} (this build reads {expected})")]
+    UnsupportedVersion {
+        /// Version found in the file.
+        found: u32,
+        /// Version this build understands.
+        expected: u32,
+    },
+    /// The file is shorter than its header says.
+    #[error("truncated: {actual} bytes, header declares {declared}")]
+    Truncated {
+        /// Size on disk.
+        actual: u64,
+        /// Size the header declares.
+        declared: u64,
+    },
+    /// The trailing checksum does not match the content.
+    #[error("checksum mismatch (file corrupted)")]
+    ChecksumMismatch,
+    /// The content is structurally invalid.
+    #[error("corrupt content: {0}")]
+    Corrupt(String),
+}
+
+/// Result alias used throughout the crate.
+pub type Result<T, E = CoreError> = std::result::Result<T, E>;

@@ -1,0 +1,273 @@
+//! Exemplar preparation (design note §1.1): decode with bounded resources, composite alpha,
+//! crop to the centred square, bring the side to a power of two with an exact integer area
+//! filter, and decide whether the exemplar wraps around seamlessly (toroidal).
+
+use std::io::Cursor;
+
+use image::{ImageReader, Limits};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{CoreError, Result};
+
+/// Smallest exemplar side accepted on input.
+pub const MIN_INPUT_SIDE: u32 = 16;
+/// Smallest and largest prepared exemplar side (a power of two).
+pub const MIN_SIDE: u32 = 32;
+/// Largest prepared exemplar side.
+pub const MAX_SIDE: u32 = 512;
+
+/// How an input image is accepted and prepared.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ExemplarOptions {
+    /// Largest accepted input side in pixels (default 1024); larger images are refused before
+    /// their pixels are decoded.
+    pub max_input_side: u32,
+    /// Force the toroidal flag; `None` detects it from the wrap-around seam.
+    pub toroidal: Option<bool>,
+}
+
+impl Default for ExemplarOptions {
+    fn default() -> Self {
+        ExemplarOptions { max_input_side: 1024, toroidal: None }
+    }
+}
+
+/// What was done to the input to make it a power-of-two square.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Preparation {
+    /// Input width.
+    pub input_width: u32,
+    /// Input height.
+    pub input_height: u32,
+    /// Side of the centred square crop.
+    pub crop_side: u32,
+    /// Prepared side `m` (area-resampled from `crop_side` when they differ).
+    pub side: u32,
+    /// Whether the toroidal flag was detected (false) or forced by the caller (true).
+    pub toroidal_forced: bool,
+    /// Seam energy ÷ interior gradient energy (≤ 1.5 means toroidal when detected).
+    pub seam_ratio: f64,
+}
+
+/// A prepared exemplar: `side × side` RGB8 pixels, `side` a power of two.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Exemplar {
+    /// Side `m` in pixels.
+    pub side: u32,
+    /// Row-major RGB pixels.
+    pub pixels: Vec<[u8; 3]>,
+    /// Whether synthesis may wrap around the exemplar edges.
+    pub toroidal: bool,
+    /// What preparation did.
+    pub preparation: Preparation,
+}
+
+impl Exemplar {
+    /// Decode and prepare an exemplar from encoded image bytes (PNG, JPEG, WebP, TGA, BMP).
+    pub fn from_bytes(bytes: &[u8], opts: &ExemplarOptions) -> Result<Exemplar> {
+        let reader = ImageReader::new(Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        if reader.format().is_none() {
+            return Err(CoreError::ExemplarUndecodable(
+                "unrecognised image format (expected PNG, JPEG, WebP, TGA or BMP)".into(),
+            ));
+        }
+        let (w, h) = reader
+            .into_dimensions()
+            .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        check_size(w, h, opts.max_input_side)?;
+        let mut reader = ImageReader::new(Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        let mut limits = Limits::default();
+        limits.max_image_width = Some(opts.max_input_side);
+        limits.max_image_height = Some(opts.max_input_side);
+        limits.max_alloc = Some(256 << 20);
+        reader.limits(limits);
+        let img = reader.decode().map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        let rgba = img.to_rgba8();
+        let (w, h) = rgba.dimensions();
+        let px: Vec<[u8; 4]> = rgba.pixels().map(|p| p.0).collect();
+        Ok(Self::from_rgba(w, h, &px, opts))
+    }
+
+    /// Prepare an exemplar from raw RGBA pixels (row-major, `w × h`). The size must already be
+    /// valid (see [`Exemplar::from_bytes`]).
+    pub fn from_rgba(w: u32, h: u32, px: &[[u8; 4]], opts: &ExemplarOptions) -> Exemplar {
+        let rgb = composite_over_mean(px);
+        let crop_side = w.min(h);
+        let ox = ((w - crop_side) / 2) as usize;
+        let oy = ((h - crop_side) / 2) as usize;
+        let s = crop_side as usize;
+        let mut square = Vec::with_capacity(s * s);
+        for y in 0..s {
+            let row = (oy + y) * w as usize + ox;
+            square.extend_from_slice(&rgb[row..row + s]);
+        }
+        let side = target_side(crop_side);
+        let pixels = if side == crop_side { square } else { area_resample(&square, s, side as usize) };
+        let seam_ratio = seam_ratio(&pixels, side as usize);
+        let toroidal = opts.toroidal.unwrap_or(seam_ratio <= 1.5);
+        Exemplar {
+            side,
+            pixels,
+            toroidal,
+            preparation: Preparation {
+                input_width: w,
+                input_height: h,
+                crop_side,
+                side,
+                toroidal_forced: opts.toroidal.is_some(),
+                seam_ratio,
+            },
+        }
+    }
+}
+
+fn check_size(w: u32, h: u32, max: u32) -> Result<()> {
+    if w < MIN_INPUT_SIDE || h < MIN_INPUT_SIDE || w > max || h > max {
+        return Err(CoreError::ExemplarSize { width: w, height: h, min: MIN_INPUT_SIDE, max });
+    }
+    Ok(())
+}
+
+/// The prepared side for a crop of side `s`: the largest power of two ≤ `s`, clamped to
+/// `[MIN_SIDE, MAX_SIDE]`.
+pub fn target_side(s: u32) -> u32 {
+    let p = if s == 0 { 1 } else { 1u32 << (31 - s.leading_zeros()) };
+    p.clamp(MIN_SIDE, MAX_SIDE)
+}
+
+/// Composite RGBA over the alpha-weighted mean colour of the image, with integer rounding.
+fn composite_over_mean(px: &[[u8; 4]]) -> Vec<[u8; 3]> {
+    let (mut sum, mut wsum) = ([0u64; 3], 0u64);
+    for p in px {
+        for c in 0..3 {
+            sum[c] += p[c] as u64 * p[3] as u64;
+        }
+        wsum += p[3] as u64;
+    }
+    let mean: [u64; 3] = if wsum == 0 {
+        [0; 3]
+    } else {
+        [0, 1, 2].map(|c| (sum[c] + wsum / 2) / wsum)
+    };
+    px.iter()
+        .map(|p| {
+            let a = p[3] as u64;
+            [0, 1, 2].map(|c| ((p[c] as u64 * a + mean[c] * (255 - a) + 127) / 255) as u8)
+        })
+        .collect()
+}
+
+/// Exact area resampling of an `s × s` image to `t × t` with integer weights (works both ways).
+/// Output pixel `i` covers source interval `[i·s/t, (i+1)·s/t)`; weights are overlap lengths in
+/// units of `1/t` source pixels, so every sum is an exact integer.
+fn area_resample(src: &[[u8; 3]], s: usize, t: usize) -> Vec<[u8; 3]> {
+    let weights: Vec<Vec<(usize, u64)>> = (0..t)
+        .map(|i| {
+            let (a, b) = (i * s, (i + 1) * s); // in units of 1/t source pixels
+            let mut w = Vec::new();
+            for j in a / t..b.div_ceil(t) {
+                let lo = a.max(j * t);
+                let hi = b.min((j + 1) * t);
+                if hi > lo {
+                    w.push((j, (hi - lo) as u64));
+                }
+            }
+            w
+        })
+        .collect();
+    // Horizontal pass (sums of weight·value, total weight s per output pixel).
+    let mut tmp = vec![[0u64; 3]; s * t];
+    for y in 0..s {
+        for (x, w) in weights.iter().enumerate() {
+            let mut acc = [0u64; 3];
+            for &(j, wt) in w {
+                let p = src[y * s + j];
+                for c in 0..3 {
+                    acc[c] += wt * p[c] as u64;
+                }
+            }
+            tmp[y * t + x] = acc;
+        }
+    }
+    let total = (s * s) as u64;
+    let mut out = vec![[0u8; 3]; t * t];
+    for (y, w) in weights.iter().enumerate() {
+        for x in 0..t {
+            let mut acc = [0u64; 3];
+            for &(j, wt) in w {
+                let p = tmp[j * t + x];
+                for c in 0..3 {
+                    acc[c] += wt * p[c];
+                }
+            }
+            out[y * t + x] = acc.map(|v| ((v + total / 2) / total).min(255) as u8);
+        }
+    }
+    out
+}
+
+/// Mean absolute gradient across the wrap-around edges divided by the interior mean.
+fn seam_ratio(px: &[[u8; 3]], m: usize) -> f64 {
+    let diff = |a: [u8; 3], b: [u8; 3]| -> u64 { (0..3).map(|c| a[c].abs_diff(b[c]) as u64).sum() };
+    let (mut inner, mut n_inner) = (0u64, 0u64);
+    let (mut seam, mut n_seam) = (0u64, 0u64);
+    for y in 0..m {
+        for x in 0..m {
+            let p = px[y * m + x];
+            let right = px[y * m + (x + 1) % m];
+            let down = px[((y + 1) % m) * m + x];
+            if x + 1 < m {
+                inner += diff(p, right);
+                n_inner += 1;
+            } else {
+                seam += diff(p, right);
+                n_seam += 1;
+            }
+            if y + 1 < m {
+                inner += diff(p, down);
+                n_inner += 1;
+            } else {
+                seam += diff(p, down);
+                n_seam += 1;
+            }
+        }
+    }
+    let inner = inner as f64 / n_inner.max(1) as f64;
+    let seam = seam as f64 / n_seam.max(1) as f64;
+    if inner == 0.0 {
+        if seam == 0.0 {
+            1.0
+        } else {
+            f64::INFINITY
+        }
+    } else {
+        seam / inner
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn target_sides() {
+        assert_eq!(target_side(16), 32);
+        assert_eq!(target_side(100), 64);
+        assert_eq!(target_side(128), 128);
+        assert_eq!(target_side(1024), 512);
+    }
+
+    #[test]
+    fn area_resample_preserves_flat_images_and_means() {
+        let src = vec![[10u8, 20, 30]; 100 * 100];
+        let out = area_resample(&src, 100, 64);
+        assert!(out.iter().all(|p| *p == [10, 20, 30]));
+        let src: Vec<[u8; 3]> = (0..16 * 16).map(|i| [(i % 2 * 255) as u8; 3]).collect();
+        let out = area_resample(&src, 16, 32);
+        assert_eq!(out.len(), 32 * 32);
+    }
+}

@@ -1,0 +1,136 @@
+//! Neighbourhood vectors and their PCA projections (design note §1.2b–c): the 5×5 runtime
+//! neighbourhood projected to [`RUNTIME_DIMS`] integer dimensions, and the 7×7 similarity
+//! neighbourhood projected to [`SEARCH_DIMS`] for the candidate search.
+
+use nalgebra::{DMatrix, SymmetricEigen};
+
+use crate::stack::addr;
+
+/// Dimensions of the runtime (correction) feature vectors.
+pub const RUNTIME_DIMS: usize = 8;
+/// Dimensions of the candidate-search feature vectors.
+pub const SEARCH_DIMS: usize = 8;
+/// Fixed-point scale of projection matrices (unit vectors × 2^12).
+pub const PROJ_ONE: f64 = 4096.0;
+/// Right shift from `P · N` to a stored feature: features are in quarter colour units and
+/// fit i16; squared 8-D distances fit u32.
+pub const FEAT_SHIFT: u32 = 10;
+/// Number of texels in the 5×5 runtime neighbourhood.
+pub const TAPS5: usize = 25;
+
+/// The 8-bit stack colours of one level, for neighbourhood gathering.
+pub struct LevelColours<'a> {
+    /// Row-major `m × m` colours.
+    pub px: &'a [[u8; 3]],
+    /// Exemplar side.
+    pub m: i64,
+    /// Wrap (true) or mirror (false) addressing.
+    pub toroidal: bool,
+    /// Sampling stride `h_l`.
+    pub h: i64,
+}
+
+impl LevelColours<'_> {
+    /// The `(2r+1)²` neighbourhood of texel `(x, y)` at stride `h`, raster order, RGB.
+    pub fn neighbourhood(&self, x: i64, y: i64, r: i64, out: &mut Vec<i32>) {
+        out.clear();
+        for dy in -r..=r {
+            let sy = addr(y + dy * self.h, self.m, self.toroidal);
+            for dx in -r..=r {
+                let sx = addr(x + dx * self.h, self.m, self.toroidal);
+                let p = self.px[sy * self.m as usize + sx];
+                out.extend(p.iter().map(|&v| v as i32));
+            }
+        }
+    }
+}
+
+/// The top `k` principal directions of the `(2r+1)²·3`-dimensional neighbourhoods of a level,
+/// estimated from a regular grid of at most 64×64 texels (exact integer sums, f64 eigen-solve).
+/// Each vector has its largest-magnitude component positive.
+pub fn principal_directions(cols: &LevelColours, r: i64, k: usize) -> Vec<Vec<f64>> {
+    let dim = ((2 * r + 1) * (2 * r + 1) * 3) as usize;
+    let step = (cols.m / 64).max(1);
+    let mut sum = vec![0i64; dim];
+    let mut cross = vec![0i64; dim * dim];
+    let mut n = 0i64;
+    let mut v = Vec::with_capacity(dim);
+    for y in (0..cols.m).step_by(step as usize) {
+        for x in (0..cols.m).step_by(step as usize) {
+            cols.neighbourhood(x, y, r, &mut v);
+            for i in 0..dim {
+                let vi = v[i] as i64;
+                sum[i] += vi;
+                let row = &mut cross[i * dim..i * dim + i + 1];
+                for (j, c) in row.iter_mut().enumerate() {
+                    *c += vi * v[j] as i64;
+                }
+            }
+            n += 1;
+        }
+    }
+    let nf = n as f64;
+    let cov = DMatrix::from_fn(dim, dim, |i, j| {
+        let (a, b) = if j <= i { (i, j) } else { (j, i) };
+        (cross[a * dim + b] as f64 - sum[a] as f64 * sum[b] as f64 / nf) / nf
+    });
+    let eig = SymmetricEigen::new(cov);
+    let mut order: Vec<usize> = (0..dim).collect();
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]).then(a.cmp(&b)));
+    order
+        .into_iter()
+        .take(k)
+        .map(|i| {
+            let mut e: Vec<f64> = eig.eigenvectors.column(i).iter().copied().collect();
+            let mut big = 0;
+            for (j, x) in e.iter().enumerate() {
+                if x.abs() > e[big].abs() {
+                    big = j;
+                }
+            }
+            if e[big] < 0.0 {
+                e.iter_mut().for_each(|x| *x = -*x);
+            }
+            e
+        })
+        .collect()
+}
+
+/// Quantise runtime projection directions to the fixed-point layout used by correction:
+/// `[tap (25)][channel (3)][dim (RUNTIME_DIMS)]` as i16 (unit vectors × 2^12).
+pub fn quantise_projection(dirs: &[Vec<f64>]) -> Vec<i16> {
+    let mut p = vec![0i16; TAPS5 * 3 * RUNTIME_DIMS];
+    for (d, dir) in dirs.iter().enumerate().take(RUNTIME_DIMS) {
+        for (i, &x) in dir.iter().enumerate() {
+            let (tap, c) = (i / 3, i % 3);
+            p[(tap * 3 + c) * RUNTIME_DIMS + d] = (x * PROJ_ONE).round() as i16;
+        }
+    }
+    p
+}
+
+/// Project a 5×5 RGB neighbourhood with a quantised projection to a stored feature vector.
+#[inline]
+pub fn project_runtime(proj: &[i16], n: &[i32]) -> [i16; RUNTIME_DIMS] {
+    let mut acc = [0i32; RUNTIME_DIMS];
+    for (i, &v) in n.iter().enumerate() {
+        let row = &proj[i * RUNTIME_DIMS..(i + 1) * RUNTIME_DIMS];
+        for d in 0..RUNTIME_DIMS {
+            acc[d] += row[d] as i32 * v;
+        }
+    }
+    acc.map(|a| (a >> FEAT_SHIFT) as i16)
+}
+
+/// Project a neighbourhood onto f64 directions (candidate search features).
+pub fn project_search(dirs: &[Vec<f64>], n: &[i32]) -> [f64; SEARCH_DIMS] {
+    let mut out = [0.0; SEARCH_DIMS];
+    for (d, dir) in dirs.iter().enumerate().take(SEARCH_DIMS) {
+        let mut s = 0.0;
+        for (a, &b) in dir.iter().zip(n) {
+            s += a * b as f64;
+        }
+        out[d] = s;
+    }
+    out
+}

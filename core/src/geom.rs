@@ -1,0 +1,111 @@
+//! Integer plane geometry: half-open rectangles with `i64` coordinates and the floor/parity
+//! helpers that stay correct for negative coordinates (design note §0).
+
+/// `floor(x / 2)` for any sign (arithmetic shift).
+#[inline]
+pub fn fl2(x: i64) -> i64 {
+    x >> 1
+}
+
+/// Parity `x mod 2` in `{0, 1}` for any sign.
+#[inline]
+pub fn par(x: i64) -> i64 {
+    x & 1
+}
+
+/// A half-open rectangle `[x0, x1) × [y0, y1)` of pixels at some pyramid level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Rect {
+    /// First column.
+    pub x0: i64,
+    /// First row.
+    pub y0: i64,
+    /// One past the last column.
+    pub x1: i64,
+    /// One past the last row.
+    pub y1: i64,
+}
+
+impl Rect {
+    /// The rectangle with origin `(x, y)` and size `w × h`.
+    pub fn new(x: i64, y: i64, w: i64, h: i64) -> Self {
+        Rect { x0: x, y0: y, x1: x + w, y1: y + h }
+    }
+
+    /// Width in pixels (0 if empty).
+    pub fn width(&self) -> i64 {
+        (self.x1 - self.x0).max(0)
+    }
+
+    /// Height in pixels (0 if empty).
+    pub fn height(&self) -> i64 {
+        (self.y1 - self.y0).max(0)
+    }
+
+    /// Number of pixels.
+    pub fn area(&self) -> i64 {
+        self.width() * self.height()
+    }
+
+    /// True when the rectangle holds no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.x1 <= self.x0 || self.y1 <= self.y0
+    }
+
+    /// The rectangle grown by `n` pixels on every side.
+    pub fn grow(&self, n: i64) -> Self {
+        Rect { x0: self.x0 - n, y0: self.y0 - n, x1: self.x1 + n, y1: self.y1 + n }
+    }
+
+    /// Smallest rectangle containing both (an empty operand is ignored).
+    pub fn union(&self, o: &Rect) -> Self {
+        if self.is_empty() {
+            return *o;
+        }
+        if o.is_empty() {
+            return *self;
+        }
+        Rect {
+            x0: self.x0.min(o.x0),
+            y0: self.y0.min(o.y0),
+            x1: self.x1.max(o.x1),
+            y1: self.y1.max(o.y1),
+        }
+    }
+
+    /// True when `o` lies inside `self`.
+    pub fn contains_rect(&self, o: &Rect) -> bool {
+        o.x0 >= self.x0 && o.y0 >= self.y0 && o.x1 <= self.x1 && o.y1 <= self.y1
+    }
+
+    /// The parents (one level coarser) of every pixel: `[a, b) → [a >> 1, (b + 1) >> 1)`.
+    pub fn parents(&self) -> Self {
+        Rect { x0: fl2(self.x0), y0: fl2(self.y0), x1: fl2(self.x1 + 1), y1: fl2(self.y1 + 1) }
+    }
+
+    /// The children (one level finer) of every pixel: `[2a, 2b)`.
+    pub fn children(&self) -> Self {
+        Rect { x0: self.x0 * 2, y0: self.y0 * 2, x1: self.x1 * 2, y1: self.y1 * 2 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parents_of_negative_rect_keep_the_edge_parent() {
+        let r = Rect { x0: -11, y0: -11, x1: 267, y1: 267 };
+        let p = r.parents();
+        assert_eq!((p.x0, p.x1), (-6, 134));
+    }
+
+    #[test]
+    fn floor_and_parity_for_negatives() {
+        assert_eq!(fl2(-1), -1);
+        assert_eq!(fl2(-2), -1);
+        assert_eq!(fl2(-3), -2);
+        assert_eq!(par(-1), 1);
+        assert_eq!(par(-2), 0);
+    }
+}

@@ -1,0 +1,201 @@
+//! Validated synthesis parameters (design note §1.9–1.10). Everything is parsed once into
+//! canonical fixed point, so "0.5" and "0.50" are the same request, and the engine trusts it.
+
+use crate::analysis::Analysis;
+use crate::error::{CoreError, Result};
+
+/// Fixed-point one for randomness and κ (2^16).
+pub const ONE_Q16: u32 = 1 << 16;
+/// Largest number of correction passes accepted.
+pub const MAX_PASSES: u32 = 4;
+/// Largest period accepted, in texels (2^40).
+pub const MAX_PERIOD: i64 = 1 << 40;
+
+/// Per-level randomness: one value for every level, or an explicit list (coarse to fine).
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum Randomness {
+    /// The default schedule (see [`default_randomness`]).
+    Default,
+    /// The same value at every level (fixed point, `[0, 65536]`).
+    Uniform(u32),
+    /// One value per level `0..=L` (fixed point).
+    PerLevel(Vec<u32>),
+}
+
+/// The default schedule, coarse to fine: 1.0 at levels 0–1, 0.8 at 2, 0.6 at 3, then a
+/// linear decrease to 0.1 at the finest level `L` (fixed point).
+pub fn default_randomness(levels: u32) -> Vec<u32> {
+    (0..=levels)
+        .map(|l| {
+            let r = match l {
+                0 | 1 => 1.0,
+                2 => 0.8,
+                _ => {
+                    let span = (levels as f64 - 3.0).max(1.0);
+                    0.6 - 0.5 * (l as f64 - 3.0) / span
+                }
+            };
+            (r * ONE_Q16 as f64).round() as u32
+        })
+        .collect()
+}
+
+/// Parse one randomness value in `[0, 1]` to fixed point.
+fn parse_unit(name: &'static str, s: &str) -> Result<u32> {
+    let v: f64 = s.trim().parse().map_err(|_| CoreError::Param {
+        name,
+        message: format!("'{s}' is not a number; expected a value in [0, 1]"),
+    })?;
+    if !v.is_finite() || !(0.0..=1.0).contains(&v) {
+        return Err(CoreError::Param { name, message: format!("{s} is outside [0, 1]") });
+    }
+    Ok((v * ONE_Q16 as f64).round() as u32)
+}
+
+impl Randomness {
+    /// Parse `"0.5"` (every level) or `"1,0.8,…"` (one value per level, coarse to fine).
+    pub fn parse(s: &str) -> Result<Randomness> {
+        let parts: Vec<&str> = s.split(',').collect();
+        if parts.len() == 1 {
+            return Ok(Randomness::Uniform(parse_unit("randomness", parts[0])?));
+        }
+        Ok(Randomness::PerLevel(parts.iter().map(|p| parse_unit("randomness", p)).collect::<Result<_>>()?))
+    }
+
+    /// The fixed-point value at every level `0..=levels`.
+    pub fn resolve(&self, levels: u32) -> Vec<u32> {
+        match self {
+            Randomness::Default => default_randomness(levels),
+            Randomness::Uniform(r) => vec![*r; levels as usize + 1],
+            Randomness::PerLevel(v) => v.clone(),
+        }
+    }
+
+    /// Canonical text form (fixed-point values), for cache keys and ETags.
+    pub fn canonical(&self) -> String {
+        match self {
+            Randomness::Default => "default".into(),
+            Randomness::Uniform(r) => r.to_string(),
+            Randomness::PerLevel(v) => v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(","),
+        }
+    }
+}
+
+/// Everything besides the analysis that determines synthesized pixels.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SynthParams {
+    /// Selects another, equally good texture.
+    pub seed: u64,
+    /// Per-level jitter strength.
+    pub randomness: Randomness,
+    /// Correction passes per corrected level (0 switches correction off).
+    pub passes: u32,
+    /// Subpasses per pass: 4 (parity classes, the paper's order) or 1 (all pixels at once).
+    pub subpasses: u32,
+    /// κ in fixed point (`[0, 65536]`): penalty on jumps to the second candidate.
+    pub kappa: u32,
+    /// Optional period in texels (a power of two ≥ the exemplar side): periodic output.
+    pub period: Option<i64>,
+}
+
+impl Default for SynthParams {
+    fn default() -> Self {
+        SynthParams {
+            seed: 0,
+            randomness: Randomness::Default,
+            passes: 2,
+            subpasses: 4,
+            kappa: (0.2 * ONE_Q16 as f64).round() as u32,
+            period: None,
+        }
+    }
+}
+
+impl SynthParams {
+    /// Parse κ from text (`[0, 1]`).
+    pub fn parse_kappa(s: &str) -> Result<u32> {
+        parse_unit("kappa", s)
+    }
+
+    /// Check the parameters against an analysis (list length, period, ranges).
+    pub fn validate_for(&self, an: &Analysis) -> Result<()> {
+        let levels = an.levels();
+        if let Randomness::PerLevel(v) = &self.randomness {
+            if v.len() != levels as usize + 1 {
+                return Err(CoreError::Param {
+                    name: "randomness",
+                    message: format!(
+                        "a list needs exactly {} values (one per level, coarse to fine), got {}",
+                        levels + 1,
+                        v.len()
+                    ),
+                });
+            }
+        }
+        let in_unit = |v: u32| v <= ONE_Q16;
+        if !self.randomness.resolve(levels).into_iter().all(in_unit) {
+            return Err(CoreError::Param { name: "randomness", message: "values must be in [0, 1]".into() });
+        }
+        if self.passes > MAX_PASSES {
+            return Err(CoreError::Param { name: "passes", message: format!("must be 0 to {MAX_PASSES}") });
+        }
+        if self.subpasses != 1 && self.subpasses != 4 {
+            return Err(CoreError::Param { name: "subpasses", message: "must be 1 or 4".into() });
+        }
+        if !in_unit(self.kappa) {
+            return Err(CoreError::Param { name: "kappa", message: "must be in [0, 1]".into() });
+        }
+        if let Some(n) = self.period {
+            let m = an.side() as i64;
+            if n < m || n > MAX_PERIOD || n.count_ones() != 1 {
+                return Err(CoreError::Param {
+                    name: "period",
+                    message: format!("must be a power of two from {m} (the exemplar side) to 2^40 texels, got {n}"),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Canonical text form of every field, for cache keys and ETags.
+    pub fn canonical(&self) -> String {
+        format!(
+            "seed={};r={};passes={};sub={};kappa={};period={}",
+            self.seed,
+            self.randomness.canonical(),
+            self.passes,
+            self.subpasses,
+            self.kappa,
+            self.period.map(|p| p.to_string()).unwrap_or_else(|| "none".into())
+        )
+    }
+
+    /// Candidate weights `φ_1 = 2^16`, `φ_2 = (1+κ)²·2^16`, in integer arithmetic.
+    pub(crate) fn phi(&self) -> [u64; 2] {
+        let one = ONE_Q16 as u64;
+        let k = one + self.kappa as u64;
+        [one, (k * k + one / 2) >> 16]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn randomness_parsing_is_canonical() {
+        assert_eq!(Randomness::parse("0.5").unwrap(), Randomness::parse("0.50").unwrap());
+        assert!(Randomness::parse("1.5").is_err());
+        assert!(Randomness::parse("NaN").is_err());
+        assert!(Randomness::parse("x").is_err());
+        assert_eq!(Randomness::parse("0,1").unwrap(), Randomness::PerLevel(vec![0, 65536]));
+    }
+
+    #[test]
+    fn default_schedule_shape() {
+        let r = default_randomness(7);
+        assert_eq!(r.len(), 8);
+        assert_eq!(r[0], 65536);
+        assert_eq!(r[7], (0.1f64 * 65536.0).round() as u32);
+    }
+}

@@ -1,0 +1,134 @@
+//! Window pyramid arithmetic (design note §1.5–1.6): which rectangle each level must compute so
+//! that a requested window comes out exact. The padding is derived by propagating the needed
+//! rectangles backwards through the correction subpasses, per parity class.
+
+use crate::analysis::FIRST_CORRECTED_LEVEL;
+use crate::geom::Rect;
+
+/// Which pixels a correction subpass updates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Class {
+    /// Every pixel (one subpass per pass).
+    All,
+    /// Pixels with `(x mod 2, y mod 2) = (px, py)`.
+    Parity(i64, i64),
+}
+
+/// The subpass sequence for `passes` passes of `subpasses` (1 or 4) subpasses each. With 4,
+/// passes alternate LH05's orders `(0,0) (1,1) (1,0) (0,1)` and `(1,1) (0,0) (1,0) (0,1)`.
+pub fn schedule(passes: u32, subpasses: u32) -> Vec<Class> {
+    const A: [(i64, i64); 4] = [(0, 0), (1, 1), (1, 0), (0, 1)];
+    const B: [(i64, i64); 4] = [(1, 1), (0, 0), (1, 0), (0, 1)];
+    let mut out = Vec::new();
+    for p in 0..passes {
+        if subpasses == 1 {
+            out.push(Class::All);
+        } else {
+            let order = if p % 2 == 0 { A } else { B };
+            out.extend(order.iter().map(|&(x, y)| Class::Parity(x, y)));
+        }
+    }
+    out
+}
+
+/// What to compute at one level.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LevelPlan {
+    /// Pyramid level.
+    pub level: u32,
+    /// Pixels that must come out exact (the window, or the parents the next level reads).
+    pub need: Rect,
+    /// Pixels to upsample and jitter (⊇ `need`), so that correction of `need` is exact.
+    pub padded: Rect,
+    /// For each subpass, its class and the rectangle of class pixels it corrects.
+    pub subpasses: Vec<(Class, Rect)>,
+}
+
+/// Snap a rect inward to the pixels of one parity class (empty if none).
+fn snap(r: Rect, cx: i64, cy: i64) -> Rect {
+    let x0 = r.x0 + (cx - r.x0).rem_euclid(2);
+    let y0 = r.y0 + (cy - r.y0).rem_euclid(2);
+    let x1 = (r.x1 - 1) - ((r.x1 - 1) - cx).rem_euclid(2) + 1;
+    let y1 = (r.y1 - 1) - ((r.y1 - 1) - cy).rem_euclid(2) + 1;
+    Rect { x0, y0, x1: x1.max(x0), y1: y1.max(y0) }
+}
+
+/// The exact padding of `w` for a subpass schedule (§1.5): returns the padded rect and each
+/// subpass's rect.
+pub fn pad_for_correction(w: Rect, sched: &[Class]) -> (Rect, Vec<(Class, Rect)>) {
+    // need[c]: pixels of parity class c (index px + 2·py) whose value is still needed.
+    let mut need = [w; 4];
+    let mut plan = vec![(Class::All, Rect::new(0, 0, 0, 0)); sched.len()];
+    for (k, &class) in sched.iter().enumerate().rev() {
+        let r = match class {
+            Class::All => need.iter().fold(Rect::new(0, 0, 0, 0), |a, b| a.union(b)),
+            Class::Parity(px, py) => snap(need[(px + 2 * py) as usize], px, py),
+        };
+        plan[k] = (class, r);
+        if !r.is_empty() {
+            let g = r.grow(2);
+            for n in need.iter_mut() {
+                *n = n.union(&g);
+            }
+        }
+    }
+    let padded = need.iter().fold(w, |a, b| a.union(b));
+    (padded, plan)
+}
+
+/// Plan the synthesis of `rect` at `target` level: one entry per level `0..=target`, coarse first.
+pub fn plan_window(target: u32, rect: Rect, sched: &[Class]) -> Vec<LevelPlan> {
+    let mut plans = Vec::with_capacity(target as usize + 1);
+    let mut need = rect;
+    for l in (0..=target).rev() {
+        let corrected = l >= FIRST_CORRECTED_LEVEL && !sched.is_empty();
+        let (padded, subpasses) = if corrected { pad_for_correction(need, sched) } else { (need, Vec::new()) };
+        plans.push(LevelPlan { level: l, need, padded, subpasses });
+        need = padded.parents();
+    }
+    plans.reverse();
+    plans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sizes(r: Rect) -> (i64, i64) {
+        (r.width(), r.height())
+    }
+
+    /// The worked example of design note §1.6 (m = 128, L = 7, tile [0,256)²).
+    #[test]
+    fn plan_matches_design_table_for_tile_at_origin() {
+        let plans = plan_window(7, Rect::new(0, 0, 256, 256), &schedule(2, 4));
+        let expect = [
+            (7, (0, 256, 0, 256), (275, 277)),
+            (6, (-5, 133, -5, 134), (157, 161)),
+            (5, (-7, 72, -8, 73), (97, 101)),
+            (4, (-8, 41, -9, 42), (69, 73)),
+            (3, (-9, 26, -10, 27), (53, 57)),
+            (2, (-9, 18, -10, 19), (27, 29)),
+            (1, (-5, 9, -5, 10), (14, 15)),
+            (0, (-3, 5, -3, 5), (8, 8)),
+        ];
+        for (l, (x0, x1, y0, y1), size) in expect {
+            let p = &plans[l];
+            assert_eq!(p.level, l as u32);
+            assert_eq!((p.need.x0, p.need.x1, p.need.y0, p.need.y1), (x0, x1, y0, y1), "need at level {l}");
+            assert_eq!(sizes(p.padded), size, "padded at level {l}");
+        }
+        let top = &plans[7];
+        assert_eq!((top.padded.x0, top.padded.x1, top.padded.y0, top.padded.y1), (-10, 265, -10, 267));
+    }
+
+    #[test]
+    fn plan_for_negative_tile_has_the_same_sizes() {
+        let a = plan_window(7, Rect::new(0, 0, 256, 256), &schedule(2, 4));
+        let b = plan_window(7, Rect::new(-256, -256, 256, 256), &schedule(2, 4));
+        for (p, q) in a.iter().zip(&b) {
+            assert_eq!(sizes(p.padded), sizes(q.padded), "level {}", p.level);
+        }
+        assert_eq!((b[6].need.x0, b[6].need.x1, b[6].need.y0, b[6].need.y1), (-133, 5, -133, 6));
+    }
+}

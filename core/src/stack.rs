@@ -1,0 +1,92 @@
+//! The Gaussian stack (design note §1.2a): one full `m × m` image per synthesis level, blurred
+//! more at coarser levels with an à-trous binomial filter, in exact u16 fixed point (value·256).
+//! Edges are handled by an addressing rule: wrap for toroidal exemplars, mirror otherwise.
+
+/// Exemplar texel address for a possibly out-of-range index `i` (wrap or mirror, §1.2a).
+#[inline]
+pub fn addr(i: i64, m: i64, toroidal: bool) -> usize {
+    if toroidal {
+        i.rem_euclid(m) as usize
+    } else {
+        let j = i.rem_euclid(2 * m);
+        (if j < m { j } else { 2 * m - 1 - j }) as usize
+    }
+}
+
+const TAPS: [u32; 5] = [1, 4, 6, 4, 1];
+
+/// Build the stack for an `m × m` exemplar (`m = 2^L`): `L + 1` levels, index `l` = level `l`
+/// (0 = coarsest, the exact mean colour; `L` = the exemplar itself).
+pub fn build_stack(pixels: &[[u8; 3]], m: usize, toroidal: bool) -> Vec<Vec<[u16; 3]>> {
+    let levels = m.trailing_zeros() as usize;
+    let mut stack = vec![Vec::new(); levels + 1];
+    stack[levels] = pixels.iter().map(|p| p.map(|v| (v as u16) << 8)).collect();
+    for l in (1..=levels).rev() {
+        let h = 1i64 << (levels - l);
+        let src = &stack[l];
+        let pass = |src: &[[u16; 3]], horizontal: bool| -> Vec<[u16; 3]> {
+            let mut out = vec![[0u16; 3]; m * m];
+            for y in 0..m {
+                for x in 0..m {
+                    let mut acc = [0u32; 3];
+                    for (k, &t) in TAPS.iter().enumerate() {
+                        let off = (k as i64 - 2) * h;
+                        let (sx, sy) = if horizontal {
+                            (addr(x as i64 + off, m as i64, toroidal), y)
+                        } else {
+                            (x, addr(y as i64 + off, m as i64, toroidal))
+                        };
+                        let p = src[sy * m + sx];
+                        for c in 0..3 {
+                            acc[c] += t * p[c] as u32;
+                        }
+                    }
+                    out[y * m + x] = acc.map(|s| ((s + 8) >> 4) as u16);
+                }
+            }
+            out
+        };
+        let blurred = pass(&pass(src, true), false);
+        stack[l - 1] = blurred;
+    }
+    // Level 0 is the exact mean colour (LH05).
+    let n = (m * m) as u64;
+    let mut sum = [0u64; 3];
+    for p in pixels {
+        for c in 0..3 {
+            sum[c] += p[c] as u64;
+        }
+    }
+    let mean = sum.map(|s| (((s << 8) + n / 2) / n) as u16);
+    stack[0] = vec![mean; m * m];
+    stack
+}
+
+/// Round a stack value (value·256) to 8 bits.
+#[inline]
+pub fn to_u8(v: u16) -> u8 {
+    ((v as u32 + 128) >> 8).min(255) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn addressing_wraps_or_mirrors() {
+        assert_eq!(addr(-1, 8, true), 7);
+        assert_eq!(addr(-1, 8, false), 0);
+        assert_eq!(addr(8, 8, false), 7);
+        assert_eq!(addr(17, 8, false), 1);
+    }
+
+    #[test]
+    fn flat_exemplar_gives_flat_stack() {
+        let px = vec![[7u8, 8, 9]; 32 * 32];
+        let s = build_stack(&px, 32, false);
+        assert_eq!(s.len(), 6);
+        for level in &s {
+            assert!(level.iter().all(|p| *p == [7 << 8, 8 << 8, 9 << 8]));
+        }
+    }
+}
