@@ -10,7 +10,13 @@ fn main() {
     let t = Instant::now();
     let ex = Exemplar::from_bytes(&bytes, &ExemplarOptions::default()).unwrap();
     let an = Analysis::build(&ex, &NoProgress);
-    eprintln!("analysis {:?} m={} toroidal={} seam={:.2}", t.elapsed(), an.side(), an.header.toroidal, ex.preparation.seam_ratio);
+    eprintln!(
+        "analysis {:?} m={} toroidal={} seam={:.2}",
+        t.elapsed(),
+        an.side(),
+        an.header.toroidal,
+        ex.preparation.seam_ratio
+    );
     let mut p = SynthParams::default();
     for kv in args.iter().skip(4) {
         let (k, v) = kv.split_once('=').unwrap();
@@ -30,5 +36,12 @@ fn main() {
         let _ = render(&an, &p, 0, Rect::new(0, 0, 256, 256)).unwrap();
         eprintln!("256 tile {:?}", t.elapsed());
     }
-    image::save_buffer(&args[2], &img.pixels, img.width, img.height, image::ExtendedColorType::Rgb8).unwrap();
+    image::save_buffer(
+        &args[2],
+        &img.pixels,
+        img.width,
+        img.height,
+        image::ExtendedColorType::Rgb8,
+    )
+    .unwrap();
 }

@@ -28,7 +28,10 @@ pub struct ExemplarOptions {
 
 impl Default for ExemplarOptions {
     fn default() -> Self {
-        ExemplarOptions { max_input_side: 1024, toroidal: None }
+        ExemplarOptions {
+            max_input_side: 1024,
+            toroidal: None,
+        }
     }
 }
 
@@ -85,7 +88,9 @@ impl Exemplar {
         limits.max_image_height = Some(opts.max_input_side);
         limits.max_alloc = Some(256 << 20);
         reader.limits(limits);
-        let img = reader.decode().map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        let img = reader
+            .decode()
+            .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
         let rgba = img.to_rgba8();
         let (w, h) = rgba.dimensions();
         let px: Vec<[u8; 4]> = rgba.pixels().map(|p| p.0).collect();
@@ -106,7 +111,11 @@ impl Exemplar {
             square.extend_from_slice(&rgb[row..row + s]);
         }
         let side = target_side(crop_side);
-        let pixels = if side == crop_side { square } else { area_resample(&square, s, side as usize) };
+        let pixels = if side == crop_side {
+            square
+        } else {
+            area_resample(&square, s, side as usize)
+        };
         let seam_ratio = seam_ratio(&pixels, side as usize);
         let toroidal = opts.toroidal.unwrap_or(seam_ratio <= 1.5);
         Exemplar {
@@ -127,7 +136,12 @@ impl Exemplar {
 
 fn check_size(w: u32, h: u32, max: u32) -> Result<()> {
     if w < MIN_INPUT_SIDE || h < MIN_INPUT_SIDE || w > max || h > max {
-        return Err(CoreError::ExemplarSize { width: w, height: h, min: MIN_INPUT_SIDE, max });
+        return Err(CoreError::ExemplarSize {
+            width: w,
+            height: h,
+            min: MIN_INPUT_SIDE,
+            max,
+        });
     }
     Ok(())
 }
@@ -135,7 +149,11 @@ fn check_size(w: u32, h: u32, max: u32) -> Result<()> {
 /// The prepared side for a crop of side `s`: the largest power of two ≤ `s`, clamped to
 /// `[MIN_SIDE, MAX_SIDE]`.
 pub fn target_side(s: u32) -> u32 {
-    let p = if s == 0 { 1 } else { 1u32 << (31 - s.leading_zeros()) };
+    let p = if s == 0 {
+        1
+    } else {
+        1u32 << (31 - s.leading_zeros())
+    };
     p.clamp(MIN_SIDE, MAX_SIDE)
 }
 

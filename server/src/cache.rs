@@ -1,0 +1,153 @@
+//! The encoded-tile cache: an LRU (the `lru` crate) bounded by bytes, with single-flight so that
+//! concurrent requests for one key cause one synthesis and all receive its result.
+
+use std::collections::HashMap;
+use std::future::Future;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use axum::body::Bytes;
+use lru::LruCache;
+use tokio::sync::OnceCell;
+
+use crate::http::error::ApiError;
+
+type Flight = Arc<OnceCell<Result<Bytes, ApiError>>>;
+
+struct Lru {
+    map: LruCache<String, Bytes>,
+    bytes: u64,
+}
+
+/// Counters of the cache.
+#[derive(Default)]
+pub struct CacheStats {
+    /// Answers served from the cache.
+    pub hits: AtomicU64,
+    /// Answers not in the cache.
+    pub misses: AtomicU64,
+    /// Entries evicted to stay under the byte limit.
+    pub evictions: AtomicU64,
+}
+
+/// Byte-bounded LRU of encoded images with request coalescing.
+pub struct TileCache {
+    lru: Mutex<Lru>,
+    limit: u64,
+    inflight: Mutex<HashMap<String, Flight>>,
+    /// Counters.
+    pub stats: CacheStats,
+}
+
+impl TileCache {
+    /// A cache holding at most `limit` bytes of values (keys are small and not counted).
+    pub fn new(limit: u64) -> Self {
+        TileCache {
+            lru: Mutex::new(Lru {
+                map: LruCache::unbounded(),
+                bytes: 0,
+            }),
+            limit,
+            inflight: Mutex::new(HashMap::new()),
+            stats: CacheStats::default(),
+        }
+    }
+
+    /// Entries and bytes held.
+    pub fn usage(&self) -> (usize, u64) {
+        let l = self.lru.lock().unwrap_or_else(|e| e.into_inner());
+        (l.map.len(), l.bytes)
+    }
+
+    fn get(&self, key: &str) -> Option<Bytes> {
+        self.lru
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .map
+            .get(key)
+            .cloned()
+    }
+
+    fn insert(&self, key: &str, value: Bytes) {
+        let size = value.len() as u64;
+        if size > self.limit {
+            return;
+        }
+        let mut l = self.lru.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(old) = l.map.put(key.to_string(), value) {
+            l.bytes -= old.len() as u64;
+        }
+        l.bytes += size;
+        while l.bytes > self.limit {
+            match l.map.pop_lru() {
+                Some((_, v)) => {
+                    l.bytes -= v.len() as u64;
+                    self.stats.evictions.fetch_add(1, Ordering::Relaxed);
+                }
+                None => break,
+            }
+        }
+    }
+
+    /// The cached value for `key`, or the result of `compute` — run once for all concurrent
+    /// callers with the same key. Returns whether it was a cache hit. Errors are not cached.
+    pub async fn get_or_compute<F, Fut>(
+        &self,
+        key: &str,
+        compute: F,
+    ) -> (Result<Bytes, ApiError>, bool)
+    where
+        F: FnOnce() -> Fut,
+        Fut: Future<Output = Result<Bytes, ApiError>>,
+    {
+        if let Some(v) = self.get(key) {
+            self.stats.hits.fetch_add(1, Ordering::Relaxed);
+            return (Ok(v), true);
+        }
+        self.stats.misses.fetch_add(1, Ordering::Relaxed);
+        let cell = {
+            let mut m = self.inflight.lock().unwrap_or_else(|e| e.into_inner());
+            m.entry(key.to_string()).or_default().clone()
+        };
+        let result = cell
+            .get_or_init(|| async {
+                let r = compute().await;
+                if let Ok(b) = &r {
+                    self.insert(key, b.clone());
+                }
+                r
+            })
+            .await
+            .clone();
+        {
+            let mut m = self.inflight.lock().unwrap_or_else(|e| e.into_inner());
+            if m.get(key).is_some_and(|c| Arc::ptr_eq(c, &cell)) {
+                m.remove(key);
+            }
+        }
+        (result, false)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[tokio::test]
+    async fn evicts_by_bytes_and_coalesces() {
+        let c = TileCache::new(10);
+        let (r, hit) = c
+            .get_or_compute("a", || async { Ok(Bytes::from_static(b"123456")) })
+            .await;
+        assert_eq!((r.unwrap().len(), hit), (6, false));
+        let (_, hit) = c
+            .get_or_compute("a", || async { Err(ApiError::internal("not called")) })
+            .await;
+        assert!(hit);
+        let _ = c
+            .get_or_compute("b", || async { Ok(Bytes::from_static(b"123456")) })
+            .await;
+        assert_eq!(c.usage(), (1, 6));
+        assert_eq!(c.stats.evictions.load(Ordering::Relaxed), 1);
+    }
+}

@@ -1,0 +1,139 @@
+//! Command-line interface: argument definitions (clap) for `serve` (the default), `analyze`,
+//! `render` and `info`.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand};
+
+/// textile — an infinite, deterministic, example-based texture as map tiles.
+#[derive(Debug, Parser)]
+#[command(name = "textile", version, about, long_about = None, args_conflicts_with_subcommands = true)]
+pub struct Cli {
+    /// Sub-command (default: serve).
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Options of `serve` when no sub-command is given.
+    #[command(flatten)]
+    pub serve: ServeArgs,
+}
+
+/// Sub-commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Serve tiles over HTTP (the default).
+    Serve(ServeArgs),
+    /// Analyse an exemplar image and store the analysis file.
+    Analyze(AnalyzeArgs),
+    /// Render a tile or any window of a texture to an image file.
+    Render(RenderArgs),
+    /// Print the header of an analysis file.
+    Info(InfoArgs),
+}
+
+/// Options shared by commands that read the configuration.
+#[derive(Debug, Args, Clone, Default)]
+pub struct ConfigArgs {
+    /// Configuration file (TOML), layered over the built-in defaults.
+    #[arg(long, value_name = "FILE", env = "TEXTILE_CONFIG")]
+    pub config: Option<PathBuf>,
+    /// Directory where analyses are stored [env TEXTILE_DATA_DIR].
+    #[arg(long, value_name = "DIR")]
+    pub data_dir: Option<String>,
+}
+
+/// `textile serve`.
+#[derive(Debug, Args, Clone, Default)]
+pub struct ServeArgs {
+    #[command(flatten)]
+    pub config: ConfigArgs,
+    /// Address to listen on, e.g. 127.0.0.1:8080 (port 0: any free port) [env TEXTILE_BIND].
+    #[arg(long, value_name = "ADDR")]
+    pub bind: Option<String>,
+    /// Tile cache size in MiB [env TEXTILE_CACHE_MIB].
+    #[arg(long, value_name = "MIB")]
+    pub cache_mib: Option<u64>,
+    /// Synthesis threads, 0 = one per core [env TEXTILE_WORKER_THREADS].
+    #[arg(long, value_name = "N")]
+    pub workers: Option<usize>,
+    /// Syntheses in flight before answering 503 [env TEXTILE_MAX_IN_FLIGHT].
+    #[arg(long, value_name = "N")]
+    pub max_in_flight: Option<usize>,
+    /// Print the effective configuration as TOML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+}
+
+/// `textile analyze`.
+#[derive(Debug, Args)]
+pub struct AnalyzeArgs {
+    /// Exemplar image (PNG, JPEG, WebP, TGA or BMP).
+    pub exemplar: PathBuf,
+    /// Output analysis file.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Toroidal (wrap-around) exemplar: auto, true or false.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "true", "false"])]
+    pub toroidal: String,
+    /// Largest accepted exemplar side.
+    #[arg(long, default_value_t = 1024)]
+    pub max_side: u32,
+}
+
+/// `textile render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub config: ConfigArgs,
+    /// A configured texture id.
+    #[arg(
+        long,
+        conflicts_with = "exemplar",
+        required_unless_present = "exemplar"
+    )]
+    pub texture: Option<String>,
+    /// An exemplar image, analysed on the fly.
+    #[arg(long, value_name = "IMAGE")]
+    pub exemplar: Option<PathBuf>,
+    /// Zoom (default: the texture's native zoom).
+    #[arg(long)]
+    pub z: Option<u32>,
+    /// Tile column (with --y); renders one 256 px tile.
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        requires = "y",
+        conflicts_with = "window"
+    )]
+    pub x: Option<i64>,
+    /// Tile row (with --x).
+    #[arg(long, allow_hyphen_values = true, requires = "x")]
+    pub y: Option<i64>,
+    /// A window instead of a tile: X,Y,W,H in pixels at zoom --z.
+    #[arg(long, value_name = "X,Y,W,H", allow_hyphen_values = true)]
+    pub window: Option<String>,
+    /// Seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Randomness: one value in [0,1] or a comma list, one per level (coarse to fine).
+    #[arg(long)]
+    pub randomness: Option<String>,
+    /// Period in native tiles (power of two): periodic, seamless output.
+    #[arg(long)]
+    pub world: Option<u64>,
+    /// Correction passes per level (0 switches correction off).
+    #[arg(long)]
+    pub passes: Option<u32>,
+    /// κ in [0,1]: penalty on jumps to the second candidate.
+    #[arg(long)]
+    pub kappa: Option<String>,
+    /// Output image (.png, .jpg, .webp).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+}
+
+/// `textile info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Analysis file.
+    pub file: PathBuf,
+}

@@ -1,0 +1,302 @@
+//! Configuration: the typed settings of the service, loaded in layers — the built-in
+//! `config/textile.toml` < `--config FILE` < `TEXTILE_*` environment < command-line flags —
+//! and validated, with messages that name the key and the allowed values.
+
+use std::path::{Path, PathBuf};
+
+use figment::providers::{Env, Format, Serialized, Toml};
+use figment::Figment;
+use serde::{Deserialize, Serialize};
+
+/// The default configuration, compiled in.
+pub const DEFAULT_CONFIG: &str = include_str!("../../config/textile.toml");
+
+/// Environment keys read (as `TEXTILE_<KEY>`).
+const ENV_KEYS: &[&str] = &[
+    "bind",
+    "data_dir",
+    "cache_mib",
+    "cache_control",
+    "worker_threads",
+    "request_timeout_secs",
+    "max_in_flight",
+    "max_exemplar_side",
+];
+
+/// Tri-state toroidal setting of a texture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Toroidal {
+    /// Detect from the wrap-around seam.
+    Auto,
+    /// The exemplar wraps seamlessly.
+    True,
+    /// The exemplar does not wrap.
+    False,
+}
+
+impl Toroidal {
+    /// As the core's option.
+    pub fn as_option(self) -> Option<bool> {
+        match self {
+            Toroidal::Auto => None,
+            Toroidal::True => Some(true),
+            Toroidal::False => Some(false),
+        }
+    }
+}
+
+/// One served texture.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureConfig {
+    /// URL id: 1–64 of `a-z 0-9 _ -`.
+    pub id: String,
+    /// Display name.
+    pub name: String,
+    /// Exemplar path (relative to the config file) or `embedded:NAME`.
+    pub exemplar: String,
+    /// Toroidal flag.
+    #[serde(default = "default_toroidal")]
+    pub toroidal: Toroidal,
+    /// Mode used when a request names none.
+    #[serde(default = "default_mode")]
+    pub default_mode: String,
+    /// Seed used when a request names none.
+    #[serde(default)]
+    pub default_seed: u64,
+    /// Randomness used when a request names none (`"0.5"` or a per-level list); empty = the
+    /// engine's default schedule.
+    #[serde(default)]
+    pub default_randomness: String,
+    /// Attribution shown in TileJSON.
+    #[serde(default)]
+    pub attribution: String,
+}
+
+fn default_toroidal() -> Toroidal {
+    Toroidal::Auto
+}
+
+fn default_mode() -> String {
+    "synth".into()
+}
+
+/// The whole service configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// Listen address.
+    pub bind: String,
+    /// Analysis directory (empty = platform default).
+    pub data_dir: String,
+    /// Tile cache size in MiB.
+    pub cache_mib: u64,
+    /// Cache-Control of tiles.
+    pub cache_control: String,
+    /// CORS origins (`*` = any).
+    pub cors_origins: Vec<String>,
+    /// Synthesis threads (0 = cores).
+    pub worker_threads: usize,
+    /// Request timeout in seconds.
+    pub request_timeout_secs: u64,
+    /// Syntheses in flight before shedding with 503.
+    pub max_in_flight: usize,
+    /// Largest exemplar side accepted.
+    pub max_exemplar_side: u32,
+    /// Served textures.
+    pub textures: Vec<TextureConfig>,
+    /// Directory relative exemplar paths are resolved against (set by the loader).
+    #[serde(skip)]
+    pub base_dir: PathBuf,
+}
+
+/// Values given on the command line (override everything else when present).
+#[derive(Debug, Default, Clone, Serialize)]
+pub struct Overrides {
+    /// `--bind`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bind: Option<String>,
+    /// `--data-dir`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub data_dir: Option<String>,
+    /// `--cache-mib`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cache_mib: Option<u64>,
+    /// `--workers`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worker_threads: Option<usize>,
+    /// `--max-in-flight`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_in_flight: Option<usize>,
+}
+
+/// A configuration problem, naming the key.
+#[derive(Debug, thiserror::Error)]
+#[error("invalid configuration: {0}")]
+pub struct ConfigError(pub String);
+
+impl Config {
+    /// Load the layered configuration and validate it.
+    pub fn load(file: Option<&Path>, overrides: &Overrides) -> Result<Config, ConfigError> {
+        let mut fig = Figment::from(Toml::string(DEFAULT_CONFIG));
+        let mut base_dir = std::env::current_dir().unwrap_or_default();
+        if let Some(path) = file {
+            if !path.is_file() {
+                return Err(ConfigError(format!(
+                    "config file {} does not exist",
+                    path.display()
+                )));
+            }
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| ConfigError(format!("config file {}: {e}", path.display())))?;
+            fig = fig.merge(Toml::string(&text));
+            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                base_dir = dir.to_path_buf();
+            }
+        }
+        fig = fig
+            .merge(Env::prefixed("TEXTILE_").only(ENV_KEYS))
+            .merge(Serialized::defaults(overrides));
+        let mut cfg: Config = fig.extract().map_err(|e| {
+            let msgs: Vec<String> = e.into_iter().map(|e| e.to_string()).collect();
+            ConfigError(msgs.join("; "))
+        })?;
+        cfg.base_dir = base_dir;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |key: &str, msg: String| Err(ConfigError(format!("key '{key}': {msg}")));
+        if self.bind.parse::<std::net::SocketAddr>().is_err() {
+            return bad(
+                "bind",
+                format!("'{}' is not an address like 127.0.0.1:8080", self.bind),
+            );
+        }
+        if !(1..=65536).contains(&self.cache_mib) {
+            return bad(
+                "cache_mib",
+                format!("{} is outside 1..=65536", self.cache_mib),
+            );
+        }
+        if self.worker_threads > 1024 {
+            return bad(
+                "worker_threads",
+                format!(
+                    "{} is outside 0..=1024 (0 = one per core)",
+                    self.worker_threads
+                ),
+            );
+        }
+        if !(1..=3600).contains(&self.request_timeout_secs) {
+            return bad(
+                "request_timeout_secs",
+                format!("{} is outside 1..=3600", self.request_timeout_secs),
+            );
+        }
+        if !(1..=100_000).contains(&self.max_in_flight) {
+            return bad(
+                "max_in_flight",
+                format!("{} is outside 1..=100000", self.max_in_flight),
+            );
+        }
+        if !(16..=8192).contains(&self.max_exemplar_side) {
+            return bad(
+                "max_exemplar_side",
+                format!("{} is outside 16..=8192", self.max_exemplar_side),
+            );
+        }
+        if axum::http::HeaderValue::from_str(&self.cache_control).is_err() {
+            return bad("cache_control", "must be a valid header value".into());
+        }
+        if self.textures.is_empty() {
+            return bad("textures", "at least one texture is needed".into());
+        }
+        let mut seen = std::collections::HashSet::new();
+        for (i, t) in self.textures.iter().enumerate() {
+            if !valid_id(&t.id) {
+                return bad(
+                    &format!("textures[{i}].id"),
+                    format!("'{}' must be 1-64 of a-z 0-9 _ -", t.id),
+                );
+            }
+            if !seen.insert(&t.id) {
+                return bad(
+                    &format!("textures[{i}].id"),
+                    format!("'{}' is used twice", t.id),
+                );
+            }
+            if !crate::tile_request::MODES.contains(&t.default_mode.as_str()) {
+                return bad(
+                    &format!("textures[{i}].default_mode"),
+                    format!(
+                        "'{}' is not one of {:?}",
+                        t.default_mode,
+                        crate::tile_request::MODES
+                    ),
+                );
+            }
+            if !t.default_randomness.is_empty() {
+                if let Err(e) = textile_core::Randomness::parse(&t.default_randomness) {
+                    return bad(&format!("textures[{i}].default_randomness"), e.to_string());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The analysis directory in effect.
+    pub fn data_dir(&self) -> PathBuf {
+        if !self.data_dir.is_empty() {
+            return PathBuf::from(&self.data_dir);
+        }
+        if let Some(x) = std::env::var_os("XDG_DATA_HOME").filter(|x| !x.is_empty()) {
+            return PathBuf::from(x).join("textile");
+        }
+        if let Some(h) = std::env::var_os("HOME").filter(|x| !x.is_empty()) {
+            return PathBuf::from(h).join(".local/share/textile");
+        }
+        PathBuf::from("textile-data")
+    }
+}
+
+/// Texture ids: 1–64 characters of `a-z 0-9 _ -`.
+pub fn valid_id(id: &str) -> bool {
+    !id.is_empty()
+        && id.len() <= 64
+        && id
+            .bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_' || b == b'-')
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn built_in_config_is_valid() {
+        let cfg = Config::load(None, &Overrides::default()).unwrap();
+        assert_eq!(cfg.textures.len(), 3);
+        assert_eq!(cfg.bind, "127.0.0.1:8080");
+    }
+
+    #[test]
+    fn overrides_win() {
+        let o = Overrides {
+            bind: Some("127.0.0.1:0".into()),
+            cache_mib: Some(5),
+            ..Default::default()
+        };
+        let cfg = Config::load(None, &o).unwrap();
+        assert_eq!((cfg.bind.as_str(), cfg.cache_mib), ("127.0.0.1:0", 5));
+    }
+
+    #[test]
+    fn ids_are_checked() {
+        assert!(valid_id("gravel_2"));
+        assert!(!valid_id("../etc"));
+        assert!(!valid_id(""));
+    }
+}

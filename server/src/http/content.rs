@@ -1,0 +1,69 @@
+//! HTTP semantics of image answers, in one place: strong ETags derived from everything that
+//! determines the bytes, `If-None-Match` → 304, Cache-Control, Content-Type and `X-Cache`.
+
+use axum::body::Bytes;
+use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
+use axum::response::{IntoResponse, Response};
+
+use crate::encode::Format;
+
+/// Version of everything besides the analysis that determines bytes.
+pub fn engine_version() -> String {
+    format!(
+        "textile/{}/algo{}/enc{}",
+        env!("CARGO_PKG_VERSION"),
+        textile_core::ALGORITHM_VERSION,
+        crate::encode::ENCODER_VERSION
+    )
+}
+
+/// The strong ETag (quoted) for a cache key.
+pub fn etag_for(key: &str) -> String {
+    format!("\"{}\"", &blake3::hash(key.as_bytes()).to_hex()[..32])
+}
+
+/// Does `If-None-Match` match this ETag? (Weak comparison, as RFC 9110 asks for this header.)
+pub fn if_none_match(headers: &HeaderMap, etag: &str) -> bool {
+    headers.get_all(header::IF_NONE_MATCH).iter().any(|v| {
+        v.to_str()
+            .map(|s| {
+                s.split(',').any(|t| {
+                    let t = t.trim();
+                    t == "*" || t.strip_prefix("W/").unwrap_or(t) == etag
+                })
+            })
+            .unwrap_or(false)
+    })
+}
+
+fn common(h: &mut HeaderMap, etag: &str, cache_control: &str) {
+    if let Ok(v) = HeaderValue::from_str(etag) {
+        h.insert(header::ETAG, v);
+    }
+    if let Ok(v) = HeaderValue::from_str(cache_control) {
+        h.insert(header::CACHE_CONTROL, v);
+    }
+}
+
+/// 304 Not Modified with the validators.
+pub fn not_modified(etag: &str, cache_control: &str) -> Response {
+    let mut r = StatusCode::NOT_MODIFIED.into_response();
+    common(r.headers_mut(), etag, cache_control);
+    r
+}
+
+/// 200 with an encoded image.
+pub fn image(bytes: Bytes, fmt: Format, etag: &str, cache_control: &str, hit: bool) -> Response {
+    let mut r = bytes.into_response();
+    let h = r.headers_mut();
+    h.insert(
+        header::CONTENT_TYPE,
+        HeaderValue::from_static(fmt.content_type()),
+    );
+    common(h, etag, cache_control);
+    h.insert(
+        "x-cache",
+        HeaderValue::from_static(if hit { "HIT" } else { "MISS" }),
+    );
+    r
+}

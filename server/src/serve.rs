@@ -1,0 +1,113 @@
+//! `textile serve`: load the configuration, start listening at once (answering `/health`, and
+//! 503 elsewhere while textures load), load or compute analyses, announce the viewer URL, and
+//! drain in-flight requests on SIGINT/SIGTERM.
+
+use std::sync::Arc;
+
+use tokio::net::TcpListener;
+use tracing::{info, warn};
+
+use crate::cli::ServeArgs;
+use crate::config::{Config, Overrides};
+use crate::http::state::AppState;
+use crate::textures::load_registry;
+
+/// Any error ending a command, as text for the user.
+pub type CliResult = Result<(), Box<dyn std::error::Error>>;
+
+struct LogProgress;
+
+impl textile_core::Progress for LogProgress {
+    fn step(&self, done: u32, total: u32, what: &str) {
+        info!("analysis {done}/{total}: {what}");
+    }
+}
+
+/// Run the server until a shutdown signal.
+pub fn run(args: ServeArgs) -> CliResult {
+    let overrides = Overrides {
+        bind: args.bind.clone(),
+        data_dir: args.config.data_dir.clone(),
+        cache_mib: args.cache_mib,
+        worker_threads: args.workers,
+        max_in_flight: args.max_in_flight,
+    };
+    let cfg = Config::load(args.config.config.as_deref(), &overrides)?;
+    if args.print_config {
+        print!("{}", toml::to_string_pretty(&cfg)?);
+        return Ok(());
+    }
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_env("TEXTILE_LOG")
+                .unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(cfg.worker_threads)
+        .thread_name(|i| format!("textile-synth-{i}"))
+        .build_global()?;
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()?;
+    rt.block_on(serve(cfg))
+}
+
+async fn serve(cfg: Config) -> CliResult {
+    let listener = TcpListener::bind(&cfg.bind)
+        .await
+        .map_err(|e| format!("cannot listen on {}: {e}", cfg.bind))?;
+    let addr = listener.local_addr()?;
+    let state = Arc::new(AppState::new(cfg));
+    let app = crate::http::router(state.clone());
+    info!("listening on http://{addr}/ (loading textures)");
+    let loader = {
+        let state = state.clone();
+        tokio::task::spawn_blocking(move || {
+            let log = |s: String| info!("{s}");
+            load_registry(&state.config, &log, &LogProgress).map(|reg| {
+                let _ = state.registry.set(Arc::new(reg));
+            })
+        })
+    };
+    let server = tokio::spawn(async move {
+        axum::serve(listener, app)
+            .with_graceful_shutdown(shutdown_signal())
+            .await
+    });
+    match loader.await? {
+        Ok(()) => {
+            let n = state.registry.get().map(|r| r.list.len()).unwrap_or(0);
+            println!("textile ready: viewer at http://{addr}/ ({n} textures)");
+            use std::io::Write;
+            let _ = std::io::stdout().flush();
+        }
+        Err(e) => {
+            warn!("{e}");
+            return Err(Box::new(e));
+        }
+    }
+    server.await??;
+    info!("shut down cleanly");
+    Ok(())
+}
+
+async fn shutdown_signal() {
+    let ctrl_c = async {
+        let _ = tokio::signal::ctrl_c().await;
+    };
+    #[cfg(unix)]
+    let term = async {
+        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
+            Ok(mut s) => {
+                s.recv().await;
+            }
+            Err(_) => std::future::pending::<()>().await,
+        }
+    };
+    #[cfg(not(unix))]
+    let term = std::future::pending::<()>();
+    tokio::select! { _ = ctrl_c => {}, _ = term => {} }
+    info!("shutdown signal: draining in-flight requests");
+}

@@ -1,0 +1,213 @@
+//! The texture registry: for each configured texture, its exemplar (embedded or from disk), its
+//! analysis (loaded from the data directory when current, recomputed and stored atomically when
+//! missing, stale or damaged) and the defaults requests fall back to.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use textile_core::{Analysis, Exemplar, ExemplarOptions, Progress, Randomness, SynthParams};
+
+use crate::config::{Config, TextureConfig};
+
+/// Exemplars compiled into the binary (`config/exemplars`, CC0; see LICENSE.md there).
+const EMBEDDED: &[(&str, &[u8])] = &[
+    (
+        "gravel.png",
+        include_bytes!("../../config/exemplars/gravel.png"),
+    ),
+    (
+        "grass.png",
+        include_bytes!("../../config/exemplars/grass.png"),
+    ),
+    (
+        "brick.png",
+        include_bytes!("../../config/exemplars/brick.png"),
+    ),
+];
+
+/// The bytes of an embedded exemplar.
+pub fn embedded(name: &str) -> Option<&'static [u8]> {
+    EMBEDDED.iter().find(|(n, _)| *n == name).map(|(_, b)| *b)
+}
+
+/// A texture ready to serve.
+pub struct Texture {
+    /// Its configuration.
+    pub config: TextureConfig,
+    /// The exemplar analysis.
+    pub analysis: Arc<Analysis>,
+    /// Hash of the stored analysis bytes (part of every ETag and the TileJSON version).
+    pub file_hash: String,
+    /// The prepared exemplar as PNG.
+    pub exemplar_png: Vec<u8>,
+    /// Parameters a request starts from.
+    pub defaults: SynthParams,
+}
+
+impl Texture {
+    /// Zoom at which one tile pixel is one texel.
+    pub fn native_zoom(&self) -> u32 {
+        self.analysis.levels()
+    }
+    /// Smallest zoom served.
+    pub fn min_zoom(&self) -> u32 {
+        0
+    }
+    /// Largest zoom served.
+    pub fn max_zoom(&self) -> u32 {
+        self.native_zoom()
+    }
+}
+
+/// All served textures, in configuration order.
+pub struct Registry {
+    /// Textures in configuration order.
+    pub list: Vec<Arc<Texture>>,
+    by_id: HashMap<String, Arc<Texture>>,
+}
+
+impl Registry {
+    /// The texture with this id.
+    pub fn get(&self, id: &str) -> Option<&Arc<Texture>> {
+        self.by_id.get(id)
+    }
+}
+
+/// A texture that could not be prepared.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    /// The exemplar file is missing or unreadable.
+    #[error("texture '{id}': cannot read exemplar {path}: {source}")]
+    Read {
+        /// Texture id.
+        id: String,
+        /// Exemplar path.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// `embedded:NAME` names no embedded exemplar.
+    #[error(
+        "texture '{id}': no embedded exemplar '{name}' (have: gravel.png, grass.png, brick.png)"
+    )]
+    NoEmbedded {
+        /// Texture id.
+        id: String,
+        /// The name asked for.
+        name: String,
+    },
+    /// The exemplar or its analysis is unusable.
+    #[error("texture '{id}': {source}")]
+    Core {
+        /// Texture id.
+        id: String,
+        /// Cause.
+        source: textile_core::CoreError,
+    },
+}
+
+/// Read the exemplar bytes a texture config names.
+pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadError> {
+    if let Some(name) = t.exemplar.strip_prefix("embedded:") {
+        return embedded(name)
+            .map(|b| b.to_vec())
+            .ok_or_else(|| LoadError::NoEmbedded {
+                id: t.id.clone(),
+                name: name.into(),
+            });
+    }
+    let path = cfg.base_dir.join(&t.exemplar);
+    std::fs::read(&path).map_err(|source| LoadError::Read {
+        id: t.id.clone(),
+        path,
+        source,
+    })
+}
+
+/// Load or compute the analysis of every configured texture. `log` receives one line per
+/// event; `progress` receives analysis progress.
+pub fn load_registry(
+    cfg: &Config,
+    log: &dyn Fn(String),
+    progress: &dyn Progress,
+) -> Result<Registry, LoadError> {
+    let data_dir = cfg.data_dir();
+    let mut list = Vec::new();
+    for t in &cfg.textures {
+        let core = |source| LoadError::Core {
+            id: t.id.clone(),
+            source,
+        };
+        let bytes = exemplar_bytes(cfg, t)?;
+        let opts = ExemplarOptions {
+            max_input_side: cfg.max_exemplar_side,
+            toroidal: t.toroidal.as_option(),
+        };
+        let ex = Exemplar::from_bytes(&bytes, &opts).map_err(core)?;
+        let path = data_dir.join(format!("{}.tex", t.id));
+        let expected = Analysis::id_for(&ex);
+        let analysis = match Analysis::load(&path) {
+            Ok(a) if a.header.id == expected => {
+                log(format!(
+                    "texture '{}': loaded analysis {} from {}",
+                    t.id,
+                    a.header.id,
+                    path.display()
+                ));
+                a
+            }
+            other => {
+                match other {
+                    Ok(_) => log(format!(
+                        "texture '{}': stored analysis is stale (exemplar changed); recomputing",
+                        t.id
+                    )),
+                    Err(textile_core::CoreError::Io { .. }) => {
+                        log(format!("texture '{}': no stored analysis; computing", t.id))
+                    }
+                    Err(e) => log(format!("texture '{}': {e}; recomputing", t.id)),
+                }
+                let started = std::time::Instant::now();
+                let a = Analysis::build(&ex, progress);
+                a.save(&path).map_err(core)?;
+                log(format!(
+                    "texture '{}': analysed {}x{} in {:.2}s, stored {}",
+                    t.id,
+                    a.side(),
+                    a.side(),
+                    started.elapsed().as_secs_f64(),
+                    path.display()
+                ));
+                a
+            }
+        };
+        let file_hash = analysis.file_hash();
+        let m = analysis.side();
+        let rgb: Vec<u8> = analysis.exemplar.iter().flatten().copied().collect();
+        let exemplar_png = crate::encode::png(&rgb, m, m).map_err(|e| LoadError::Core {
+            id: t.id.clone(),
+            source: textile_core::CoreError::ExemplarUndecodable(e.to_string()),
+        })?;
+        let mut defaults = SynthParams {
+            seed: t.default_seed,
+            ..SynthParams::default()
+        };
+        if !t.default_randomness.is_empty() {
+            defaults.randomness = Randomness::parse(&t.default_randomness).map_err(core)?;
+        }
+        defaults.validate_for(&analysis).map_err(core)?;
+        list.push(Arc::new(Texture {
+            config: t.clone(),
+            analysis: Arc::new(analysis),
+            file_hash,
+            exemplar_png,
+            defaults,
+        }));
+    }
+    let by_id = list
+        .iter()
+        .map(|t| (t.config.id.clone(), t.clone()))
+        .collect();
+    Ok(Registry { list, by_id })
+}

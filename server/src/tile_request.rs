@@ -1,0 +1,250 @@
+//! Validated tile and window requests: path segments and query strings parsed once, at the
+//! edge, into typed values with errors that name the parameter, the value and what is allowed.
+
+use std::collections::BTreeMap;
+
+use textile_core::{Randomness, SynthParams};
+
+use crate::encode::Format;
+use crate::http::error::ApiError;
+use crate::textures::Texture;
+
+/// Synthesis modes served.
+pub const MODES: &[&str] = &["synth"];
+/// Tile side in pixels (`@2x` tiles are twice that).
+pub const TILE_SIZE: i64 = 256;
+/// Smallest tile coordinate.
+pub const COORD_MIN: i64 = -(1 << 31);
+/// Largest tile coordinate.
+pub const COORD_MAX: i64 = (1 << 31) - 1;
+/// Largest window side.
+pub const MAX_WINDOW_SIDE: i64 = 4096;
+/// Largest window origin magnitude, in pixels at the requested zoom.
+pub const MAX_WINDOW_COORD: i64 = 1 << 40;
+/// Largest `world` (tiles at native zoom).
+pub const MAX_WORLD: i64 = 1 << 31;
+/// Query parameters every image endpoint accepts.
+pub const PARAM_KEYS: &[&str] = &["mode", "seed", "randomness", "world", "v"];
+
+/// Parsed, de-duplicated query parameters.
+pub type Query = BTreeMap<String, String>;
+
+/// Parse a raw query string; unknown or repeated keys are errors.
+pub fn parse_query(raw: Option<&str>, allowed: &[&str]) -> Result<Query, ApiError> {
+    let mut q = Query::new();
+    for (k, v) in form_urlencoded::parse(raw.unwrap_or("").as_bytes()) {
+        if !allowed.contains(&k.as_ref()) {
+            return Err(ApiError::bad_request(
+                "unknown_parameter",
+                format!(
+                    "unknown query parameter '{k}'; allowed: {}",
+                    allowed.join(", ")
+                ),
+            ));
+        }
+        if q.insert(k.to_string(), v.to_string()).is_some() {
+            return Err(ApiError::bad_request(
+                "invalid_parameter",
+                format!("parameter '{k}' is given more than once"),
+            ));
+        }
+    }
+    Ok(q)
+}
+
+/// Mode and synthesis parameters of a request.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RenderParams {
+    /// Synthesis mode.
+    pub mode: String,
+    /// Engine parameters.
+    pub synth: SynthParams,
+}
+
+impl RenderParams {
+    /// Canonical form for cache keys and ETags.
+    pub fn canonical(&self) -> String {
+        format!("mode={};{}", self.mode, self.synth.canonical())
+    }
+}
+
+/// Resolve a request's parameters against a texture's defaults.
+pub fn render_params(tex: &Texture, q: &Query) -> Result<RenderParams, ApiError> {
+    let mode = q
+        .get("mode")
+        .cloned()
+        .unwrap_or_else(|| tex.config.default_mode.clone());
+    if !MODES.contains(&mode.as_str()) {
+        return Err(ApiError::bad_request(
+            "invalid_parameter",
+            format!(
+                "parameter 'mode': '{mode}' is not available; allowed: {}",
+                MODES.join(", ")
+            ),
+        ));
+    }
+    let mut synth = tex.defaults.clone();
+    if let Some(s) = q.get("seed") {
+        synth.seed = s.parse().map_err(|_| {
+            ApiError::bad_request(
+                "invalid_parameter",
+                format!("parameter 'seed': '{s}' is not an integer in 0..=18446744073709551615"),
+            )
+        })?;
+    }
+    if let Some(s) = q.get("randomness") {
+        synth.randomness = Randomness::parse(s).map_err(ApiError::from)?;
+    }
+    if let Some(s) = q.get("world") {
+        let w: i64 = s.parse().ok().filter(|w: &i64| *w >= 1 && *w <= MAX_WORLD && w.count_ones() == 1).ok_or_else(|| {
+            ApiError::bad_request(
+                "invalid_parameter",
+                format!("parameter 'world': '{s}' is not a power of two from 1 to 2^31 (tiles at the native zoom)"),
+            )
+        })?;
+        synth.period = Some(w * TILE_SIZE);
+    }
+    if let Some(v) = q.get("v") {
+        if v.len() > 64 {
+            return Err(ApiError::bad_request(
+                "invalid_parameter",
+                "parameter 'v': at most 64 characters".into(),
+            ));
+        }
+    }
+    synth.validate_for(&tex.analysis).map_err(|e| match e {
+        textile_core::CoreError::Param { name: "period", .. } => ApiError::bad_request(
+            "invalid_parameter",
+            format!(
+                "parameter 'world': the period must be at least the exemplar side ({} texels), so world >= {}",
+                tex.analysis.side(),
+                (tex.analysis.side() as i64 / TILE_SIZE).max(1)
+            ),
+        ),
+        other => ApiError::from(other),
+    })?;
+    Ok(RenderParams { mode, synth })
+}
+
+/// A tile address.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TileSpec {
+    /// Zoom.
+    pub z: u32,
+    /// Column.
+    pub x: i64,
+    /// Row.
+    pub y: i64,
+    /// 1 (256 px) or 2 (`@2x`, 512 px).
+    pub scale: u32,
+    /// Encoding.
+    pub format: Format,
+}
+
+fn parse_int(name: &str, s: &str, lo: i64, hi: i64) -> Result<i64, ApiError> {
+    let v: i64 = s.parse().map_err(|_| {
+        ApiError::bad_request(
+            "invalid_coordinate",
+            format!("'{name}' = '{s}' is not an integer in [{lo}, {hi}]"),
+        )
+    })?;
+    if v < lo || v > hi {
+        return Err(ApiError::bad_request(
+            "invalid_coordinate",
+            format!("'{name}' = {v} is outside [{lo}, {hi}]"),
+        ));
+    }
+    Ok(v)
+}
+
+/// Split `NAME.EXT` and parse the format.
+pub fn split_format(s: &str) -> Result<(&str, Format), ApiError> {
+    let (stem, ext) = s.rsplit_once('.').ok_or_else(|| {
+        ApiError::bad_request(
+            "invalid_format",
+            format!("'{s}' has no format extension; use .png, .jpg, .jpeg or .webp"),
+        )
+    })?;
+    let fmt = Format::from_ext(ext).ok_or_else(|| {
+        ApiError::bad_request(
+            "invalid_format",
+            format!("format '{ext}' is not supported; use png, jpg, jpeg or webp"),
+        )
+    })?;
+    Ok((stem, fmt))
+}
+
+/// Parse `z`, `x` and `y[@2x].fmt` path segments for a texture.
+pub fn parse_tile(tex: &Texture, z: &str, x: &str, y_fmt: &str) -> Result<TileSpec, ApiError> {
+    let (y, format) = split_format(y_fmt)?;
+    let (y, scale) = match y.strip_suffix("@2x") {
+        Some(y) => (y, 2),
+        None => (y, 1),
+    };
+    let z = parse_int("z", z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32;
+    let x = parse_int("x", x, COORD_MIN, COORD_MAX)?;
+    let y = parse_int("y", y, COORD_MIN, COORD_MAX)?;
+    Ok(TileSpec {
+        z,
+        x,
+        y,
+        scale,
+        format,
+    })
+}
+
+/// A window request (`/windows/{id}.{fmt}`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WindowSpec {
+    /// Zoom.
+    pub z: u32,
+    /// Left pixel at that zoom.
+    pub x: i64,
+    /// Top pixel at that zoom.
+    pub y: i64,
+    /// Width.
+    pub w: i64,
+    /// Height.
+    pub h: i64,
+    /// Encoding.
+    pub format: Format,
+}
+
+/// Query keys of the window endpoint.
+pub const WINDOW_KEYS: &[&str] = &[
+    "mode",
+    "seed",
+    "randomness",
+    "world",
+    "v",
+    "x",
+    "y",
+    "w",
+    "h",
+    "z",
+];
+
+/// Parse a window request's geometry from its query.
+pub fn parse_window(tex: &Texture, q: &Query, format: Format) -> Result<WindowSpec, ApiError> {
+    let need = |k: &str| {
+        q.get(k).ok_or_else(|| {
+            ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required"))
+        })
+    };
+    let z = match q.get("z") {
+        Some(z) => parse_int("z", z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32,
+        None => tex.native_zoom(),
+    };
+    let x = parse_int("x", need("x")?, -MAX_WINDOW_COORD, MAX_WINDOW_COORD)?;
+    let y = parse_int("y", need("y")?, -MAX_WINDOW_COORD, MAX_WINDOW_COORD)?;
+    let w = parse_int("w", need("w")?, 1, MAX_WINDOW_SIDE)?;
+    let h = parse_int("h", need("h")?, 1, MAX_WINDOW_SIDE)?;
+    Ok(WindowSpec {
+        z,
+        x,
+        y,
+        w,
+        h,
+        format,
+    })
+}
