@@ -292,8 +292,8 @@ fn correct_pixel(
             let vy = ((v >> 16) + suby) & mask;
             let cand = &cl.cands[vy as usize * m + vx as usize][k];
             let mut d = 0u32;
-            for j in 0..RUNTIME_DIMS {
-                let e = ns[j] - cand.feat[j] as i32;
+            for (a, &b) in ns.iter().zip(&cand.feat) {
+                let e = a - b as i32;
                 d = d.wrapping_add((e * e) as u32);
             }
             let dd = d as u64 * phi_k;

@@ -1,0 +1,92 @@
+//! The command line: `analyze` (with its file), `info`, `render` (same bytes as the server's
+//! tile), and clear errors with nothing half-written.
+
+mod support;
+
+use std::process::Command;
+
+use support::{binary, shared_data_dir, Server};
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(binary()).args(args).output().expect("run textile");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn exemplar(name: &str) -> String {
+    format!("{}/../config/exemplars/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn analyze_then_info() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("grass.tex");
+    let (code, stdout, err) = run(&["analyze", &exemplar("grass.png"), "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("analysed"), "{stdout}");
+    let (code, info, err) = run(&["info", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(info.contains("128x128") && info.contains("analysis id"), "{info}");
+}
+
+#[test]
+fn bad_inputs_are_clear_errors_and_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = dir.path().join("notes.png");
+    std::fs::write(&text, "just text").unwrap();
+    let out = dir.path().join("out.tex");
+    let (code, _, err) = run(&["analyze", text.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("notes.png") && err.contains("not a decodable image"), "{err}");
+    assert!(std::fs::read_dir(dir.path()).unwrap().count() == 1, "nothing else was written");
+    let truncated = dir.path().join("short.tex");
+    std::fs::write(&truncated, b"TXTLANA\0\x01\0\0\0").unwrap();
+    let (code, _, err) = run(&["info", truncated.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("short.tex") && err.contains("truncated"), "{err}");
+    let (code, _, err) = run(&["render", "--texture", "nosuch", "-o", "/tmp/x.png"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("nosuch") && err.contains("gravel"), "{err}");
+    let (code, _, _) = run(&["render", "--texture", "gravel", "--z", "99", "-o", "/tmp/x.png"]);
+    assert_ne!(code, 0);
+    let (code, _, err) = run(&["render", "--exemplar", text.to_str().unwrap(), "-o", "/tmp/x.png"]);
+    assert_ne!(code, 0, "{err}");
+}
+
+#[tokio::test]
+async fn render_writes_the_same_bytes_as_the_server() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tile.png");
+    let data = shared_data_dir();
+    let (code, _, err) = run(&[
+        "render", "--texture", "gravel", "--data-dir", data.to_str().unwrap(), "--x", "-3", "--y", "4", "--seed", "8",
+        "-o", out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let s = Server::start(&[]);
+    let (status, body) = s.get_bytes("/tiles/gravel/7/-3/4.png?seed=8").await;
+    assert_eq!(status, 200);
+    assert_eq!(std::fs::read(&out).unwrap(), body);
+    let win = dir.path().join("win.png");
+    let (code, _, err) = run(&[
+        "render", "--exemplar", &exemplar("brick.png"), "--window=-100,-50,300,200", "-o", win.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let img = image::open(&win).unwrap();
+    assert_eq!((img.width(), img.height()), (300, 200));
+}
+
+#[test]
+fn help_describes_every_command() {
+    let (code, out, _) = run(&["--help"]);
+    assert_eq!(code, 0);
+    for c in ["serve", "analyze", "render", "info"] {
+        assert!(out.contains(c), "{out}");
+    }
+    let (code, out, _) = run(&["render", "--help"]);
+    assert_eq!(code, 0);
+    assert!(out.contains("--randomness") && out.contains("--window"), "{out}");
+}

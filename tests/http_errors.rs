@@ -1,0 +1,115 @@
+//! Bad input gets a clear JSON 4xx and never a 500, an HTML page, a panic or a hang; damaged
+//! analyses at start-up are recomputed; an invalid configuration stops start-up with a message
+//! naming the key; SIGTERM drains and exits 0.
+
+mod support;
+
+use std::process::Command;
+
+use support::{assert_error, binary, Server};
+
+#[tokio::test]
+async fn bad_requests_are_json_4xx() {
+    let s = Server::start(&[]);
+    let cases: &[(&str, u16, &str)] = &[
+        ("/tiles/gravel/7/abc/0.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/x/0/0.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/7/0/1.5.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/7/99999999999999999999999/0.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/7/2147483648/0.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/7/0/-2147483649.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/8/0/0.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/-1/0/0.png", 400, "invalid_coordinate"),
+        ("/tiles/gravel/7/0/0.gif", 400, "invalid_format"),
+        ("/tiles/gravel/7/0/0", 400, "invalid_format"),
+        ("/tiles/nosuch/7/0/0.png", 404, "unknown_texture"),
+        ("/tiles/..%2F..%2Fetc%2Fpasswd/7/0/0.png", 404, "unknown_texture"),
+        // The client resolves "%2e%2e" as "..": the request reaches no route.
+        ("/tiles/%2e%2e/7/0/0.png", 404, "not_found"),
+        ("/textures/..%2Fconfig", 404, "unknown_texture"),
+        ("/tiles/gravel/7/0/0.png?bogus=1", 400, "unknown_parameter"),
+        ("/tiles/gravel/7/0/0.png?seed=1&seed=2", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?seed=-1", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?seed=18446744073709551616", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?seed=abc", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?randomness=1.5", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?randomness=-0.1", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?randomness=NaN", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?randomness=0.1,0.2", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?mode=teleport", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?world=3", 400, "invalid_parameter"),
+        ("/tiles/gravel/7/0/0.png?world=0", 400, "invalid_parameter"),
+        ("/windows/gravel.png?x=0&y=0&w=4097&h=10", 400, "invalid_coordinate"),
+        ("/windows/gravel.png?x=0&y=0&w=0&h=10", 400, "invalid_coordinate"),
+        ("/windows/gravel.png?x=0&y=0&w=10", 400, "missing_parameter"),
+        ("/windows/gravel.tiff?x=0&y=0&w=10&h=10", 400, "invalid_format"),
+        ("/windows/nosuch.png?x=0&y=0&w=10&h=10", 404, "unknown_texture"),
+        ("/nowhere", 404, "not_found"),
+        ("/tiles/gravel/7/0/0/extra.png", 404, "not_found"),
+    ];
+    for &(path, status, code) in cases {
+        assert_error(&s, path, status, code).await;
+    }
+    for (method, path) in [("POST", "/tiles/gravel/7/0/0.png"), ("DELETE", "/catalog"), ("PUT", "/health")] {
+        let r = s.client.request(method.parse().unwrap(), s.url(path)).send().await.unwrap();
+        assert_eq!(r.status(), 405, "{method} {path}");
+        let body: serde_json::Value = r.json().await.unwrap();
+        assert_eq!(body["error"], "method_not_allowed");
+    }
+    // The server is still healthy after all of that.
+    assert_eq!(s.json("/health").await["status"], "ok");
+}
+
+#[tokio::test]
+async fn corrupt_analysis_at_start_up_is_recomputed() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = Server::start_in(dir.path(), &[], &[]);
+    let before = s.get_bytes("/tiles/gravel/7/2/3.png").await;
+    assert_eq!(s.terminate(), Some(0));
+    let file = dir.path().join("gravel.tex");
+    let mut bytes = std::fs::read(&file).unwrap();
+    let n = bytes.len();
+    bytes[n / 2] ^= 0xFF;
+    std::fs::write(&file, &bytes).unwrap();
+    std::fs::write(dir.path().join("grass.tex"), &bytes[..100]).unwrap();
+    let s = Server::start_in(dir.path(), &[], &[]);
+    assert_eq!(s.get_bytes("/tiles/gravel/7/2/3.png").await, before);
+    assert_eq!(s.get("/tiles/grass/7/0/0.png").await.status(), 200);
+    drop(s);
+    assert!(textile_core::Analysis::load(&file).is_ok(), "the damaged file was rewritten");
+}
+
+#[test]
+fn invalid_configuration_stops_start_up_naming_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("bad.toml");
+    let run = |args: &[&str], env: &[(&str, &str)]| {
+        let out = Command::new(binary()).args(args).envs(env.iter().copied()).output().unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    std::fs::write(&cfg, "cache_mib = 0\n").unwrap();
+    let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("cache_mib"), "{err}");
+    std::fs::write(&cfg, "cache_mb = 10\n").unwrap();
+    let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("cache_mb"), "{err}");
+    std::fs::write(&cfg, "[[textures]]\nid = \"x\"\nname = \"X\"\nexemplar = \"e.png\"\ndefault_mode = \"magic\"\n").unwrap();
+    let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("default_mode") && err.contains("synth"), "{err}");
+    let (code, err) = run(&["serve"], &[("TEXTILE_BIND", "not-an-address")]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("bind"), "{err}");
+    let (code, err) = run(&["serve", "--config", "/nonexistent/textile.toml"], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("does not exist"), "{err}");
+}
+
+#[tokio::test]
+async fn sigterm_exits_cleanly() {
+    let s = Server::start(&[]);
+    assert_eq!(s.get("/health").await.status(), 200);
+    assert_eq!(s.terminate(), Some(0));
+}

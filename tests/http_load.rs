@@ -1,0 +1,56 @@
+//! Caching under concurrency: one synthesis for 100 simultaneous requests of one uncached
+//! tile, all with identical bodies; beyond the in-flight limit only 200 or 503 + Retry-After.
+
+mod support;
+
+use support::Server;
+
+async fn synthesized(s: &Server) -> u64 {
+    s.json("/health").await["tiles_synthesized"].as_u64().unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn concurrent_requests_for_one_tile_cause_one_synthesis() {
+    let s = Server::start(&[]);
+    let before = synthesized(&s).await;
+    let path = "/tiles/brick/7/123/-456.png?seed=99";
+    let mut tasks = Vec::new();
+    for _ in 0..100 {
+        let c = s.client.clone();
+        let url = s.url(path);
+        tasks.push(tokio::spawn(async move {
+            let r = c.get(url).send().await.expect("request");
+            assert_eq!(r.status(), 200);
+            r.bytes().await.expect("body").to_vec()
+        }));
+    }
+    let mut bodies = Vec::new();
+    for t in tasks {
+        bodies.push(t.await.unwrap());
+    }
+    assert!(bodies.iter().all(|b| *b == bodies[0]));
+    assert_eq!(synthesized(&s).await - before, 1);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn overload_sheds_with_503_and_retry_after() {
+    let s = Server::start(&["--max-in-flight", "1", "--workers", "1"]);
+    let mut tasks = Vec::new();
+    for i in 0..24 {
+        let c = s.client.clone();
+        let url = s.url(&format!("/tiles/gravel/6/{i}/77@2x.png"));
+        tasks.push(tokio::spawn(async move {
+            let r = c.get(url).send().await.expect("request");
+            (r.status().as_u16(), r.headers().get("retry-after").is_some())
+        }));
+    }
+    let mut statuses = Vec::new();
+    for t in tasks {
+        statuses.push(t.await.unwrap());
+    }
+    assert!(statuses.iter().all(|(s, _)| *s == 200 || *s == 503), "{statuses:?}");
+    assert!(statuses.iter().any(|(s, _)| *s == 503), "expected some shedding: {statuses:?}");
+    assert!(statuses.iter().any(|(s, _)| *s == 200), "{statuses:?}");
+    assert!(statuses.iter().filter(|(s, _)| *s == 503).all(|(_, ra)| *ra));
+    assert!(s.json("/health").await["shed"].as_u64().unwrap() > 0);
+}

@@ -1,0 +1,139 @@
+//! Tiles, metadata and HTTP semantics of the real server: sizes and formats, TileJSON 3.0.0,
+//! catalog consistency, ETag/304, X-Cache, HEAD, CORS and the OpenAPI document.
+
+mod support;
+
+use support::Server;
+
+#[tokio::test]
+async fn tiles_decode_to_the_right_size_in_every_format() {
+    let s = Server::start(&[]);
+    for fmt in ["png", "jpg", "jpeg", "webp"] {
+        let img = s.image(&format!("/tiles/gravel/7/3/-2.{fmt}")).await;
+        assert_eq!(img.dimensions(), (256, 256), "{fmt}");
+    }
+    let big = s.image("/tiles/gravel/6/0/0@2x.png").await;
+    assert_eq!(big.dimensions(), (512, 512));
+    let native2x = s.image("/tiles/gravel/7/0/0@2x.png").await;
+    assert_eq!(native2x.dimensions(), (512, 512));
+    let r = s.get("/tiles/gravel/7/0/0.webp").await;
+    assert_eq!(r.headers()["content-type"], "image/webp");
+    let r = s.get("/tiles/gravel/7/0/0.jpg").await;
+    assert_eq!(r.headers()["content-type"], "image/jpeg");
+}
+
+#[tokio::test]
+async fn tilejson_is_valid_and_its_template_fetches_tiles() {
+    let s = Server::start(&[]);
+    let tj = s.json("/tiles/grass/tilejson.json?seed=5&randomness=0.4").await;
+    assert_eq!(tj["tilejson"], "3.0.0");
+    assert_eq!(tj["scheme"], "xyz");
+    let tiles = tj["tiles"].as_array().expect("tiles array");
+    assert!(!tiles.is_empty());
+    let (minz, maxz) = (tj["minzoom"].as_u64().unwrap(), tj["maxzoom"].as_u64().unwrap());
+    assert!(minz <= maxz && maxz <= 30);
+    assert!(tj["name"].is_string() && tj["attribution"].is_string());
+    let bounds = tj["bounds"].as_array().unwrap();
+    assert_eq!(bounds.len(), 4);
+    let center = tj["center"].as_array().unwrap();
+    assert_eq!(center.len(), 3);
+    let template = tiles[0].as_str().unwrap();
+    assert!(template.contains("seed=5") && template.contains("randomness=0.4") && template.contains("v="), "{template}");
+    let url = template.replace("{z}", &maxz.to_string()).replace("{x}", "-1").replace("{y}", "2");
+    let path = url.strip_prefix(&s.base).expect("template on this server");
+    let via_template = s.get_bytes(path).await;
+    assert_eq!(via_template.0, 200);
+    // The same tile without the cache-busting version has the same bytes.
+    let direct = s.get_bytes(&format!("/tiles/grass/{maxz}/-1/2.png?seed=5&randomness=0.40")).await;
+    assert_eq!(direct, via_template);
+}
+
+#[tokio::test]
+async fn catalog_and_metadata_agree() {
+    let s = Server::start(&[]);
+    let cat = s.json("/catalog").await;
+    let list = cat["textures"].as_array().unwrap();
+    let ids: Vec<&str> = list.iter().map(|t| t["id"].as_str().unwrap()).collect();
+    for id in ["gravel", "grass", "brick"] {
+        assert!(ids.contains(&id), "{ids:?}");
+    }
+    for t in list {
+        let id = t["id"].as_str().unwrap();
+        let meta = s.json(&format!("/textures/{id}")).await;
+        assert_eq!(meta["id"], t["id"]);
+        assert_eq!(meta["modes"], t["modes"]);
+        assert_eq!(meta["default_mode"], t["default_mode"]);
+        let tj_path = t["tilejson"].as_str().unwrap().strip_prefix(&s.base).unwrap().to_string();
+        let tj = s.json(&tj_path).await;
+        assert_eq!(tj["maxzoom"], meta["maxzoom"]);
+        assert_eq!(tj["minzoom"], meta["minzoom"]);
+        assert_eq!(meta["native_zoom"], meta["maxzoom"]);
+        let side = meta["exemplar"]["width"].as_u64().unwrap();
+        let ex = s.image(&format!("/textures/{id}/exemplar.png")).await;
+        assert_eq!(ex.dimensions(), (side as u32, side as u32));
+        let r = meta["parameters"]["randomness"]["default"].as_array().unwrap();
+        assert_eq!(r.len() as u64, meta["levels"].as_u64().unwrap());
+    }
+}
+
+#[tokio::test]
+async fn etag_304_cache_headers_head_and_cors() {
+    let s = Server::start(&[]);
+    let path = "/tiles/brick/7/11/-7.png?seed=77";
+    let first = s.client.get(s.url(path)).header("Origin", "https://example.org").send().await.unwrap();
+    assert_eq!(first.status(), 200);
+    assert_eq!(first.headers()["x-cache"], "MISS");
+    assert_eq!(first.headers()["access-control-allow-origin"], "*");
+    assert_eq!(first.headers()["cache-control"], "public, max-age=31536000, immutable");
+    let etag = first.headers()["etag"].to_str().unwrap().to_string();
+    assert!(etag.starts_with('"') && etag.ends_with('"') && !etag.starts_with("W/"));
+    let body = first.bytes().await.unwrap();
+    let second = s.get(path).await;
+    assert_eq!(second.headers()["x-cache"], "HIT");
+    assert_eq!(second.headers()["etag"].to_str().unwrap(), etag);
+    assert_eq!(second.bytes().await.unwrap(), body);
+    let cond = s.client.get(s.url(path)).header("If-None-Match", &etag).send().await.unwrap();
+    assert_eq!(cond.status(), 304);
+    assert!(cond.bytes().await.unwrap().is_empty());
+    let other = s.client.get(s.url(path)).header("If-None-Match", "\"nope\"").send().await.unwrap();
+    assert_eq!(other.status(), 200);
+    let head = s.client.head(s.url(path)).send().await.unwrap();
+    assert_eq!(head.status(), 200);
+    assert_eq!(head.headers()["etag"].to_str().unwrap(), etag);
+    assert_eq!(head.headers()["content-type"], "image/png");
+    assert!(head.bytes().await.unwrap().is_empty());
+    // Another parameter is another ETag; the version parameter is not.
+    let seeded = s.get("/tiles/brick/7/11/-7.png?seed=78").await;
+    assert_ne!(seeded.headers()["etag"].to_str().unwrap(), etag);
+    let versioned = s.get("/tiles/brick/7/11/-7.png?seed=77&v=abc").await;
+    assert_eq!(versioned.headers()["etag"].to_str().unwrap(), etag);
+}
+
+#[tokio::test]
+async fn health_ready_viewer_and_openapi() {
+    let s = Server::start(&[]);
+    let h = s.json("/health").await;
+    assert_eq!(h["status"], "ok");
+    let r = s.json("/ready").await;
+    assert_eq!(r["status"], "ready");
+    let page = s.get("/").await;
+    assert_eq!(page.status(), 200);
+    assert!(page.headers()["content-type"].to_str().unwrap().starts_with("text/html"));
+    let doc = s.json("/openapi.json").await;
+    assert!(doc["openapi"].as_str().unwrap().starts_with("3."));
+    let paths = doc["paths"].as_object().unwrap();
+    for p in [
+        "/",
+        "/health",
+        "/ready",
+        "/catalog",
+        "/openapi.json",
+        "/textures/{id}",
+        "/textures/{id}/exemplar.png",
+        "/tiles/{id}/tilejson.json",
+        "/tiles/{id}/{z}/{x}/{y}.{fmt}",
+        "/windows/{id}.{fmt}",
+    ] {
+        assert!(paths.contains_key(p), "openapi lacks {p}");
+    }
+}

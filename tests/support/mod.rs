@@ -1,0 +1,130 @@
+//! Black-box test support: start the real `textile` binary on an ephemeral port, wait for its
+//! "ready" line, talk to it over HTTP, and stop it when the test ends.
+#![allow(dead_code)]
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+/// Path of the binary under test.
+pub fn binary() -> &'static str {
+    env!("CARGO_BIN_EXE_textile")
+}
+
+/// A data directory shared by the tests (analyses are computed once, written atomically).
+pub fn shared_data_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("textile-test-data")
+}
+
+/// A running server process.
+pub struct Server {
+    child: Child,
+    /// `http://127.0.0.1:PORT`.
+    pub base: String,
+    /// Lines the server wrote to stderr (collected after exit only).
+    pub client: reqwest::Client,
+}
+
+impl Server {
+    /// Start with the shared data dir and extra arguments.
+    pub fn start(extra: &[&str]) -> Server {
+        let dir = shared_data_dir();
+        Self::start_in(&dir, extra, &[])
+    }
+
+    /// Start with a given data dir, extra arguments and environment.
+    pub fn start_in(data_dir: &Path, extra: &[&str], env: &[(&str, &str)]) -> Server {
+        let mut cmd = Command::new(binary());
+        cmd.arg("serve").arg("--bind").arg("127.0.0.1:0").arg("--data-dir").arg(data_dir);
+        cmd.args(extra).envs(env.iter().copied()).stdout(Stdio::piped()).stderr(Stdio::null()).stdin(Stdio::null());
+        let mut child = cmd.spawn().expect("start textile");
+        let stdout = child.stdout.take().expect("stdout");
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                let _ = tx.send(line);
+            }
+        });
+        let deadline = std::time::Instant::now() + Duration::from_secs(180);
+        loop {
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            match rx.recv_timeout(left) {
+                Ok(line) => {
+                    if let Some(rest) = line.strip_prefix("textile ready: viewer at ") {
+                        let url = rest.split_whitespace().next().unwrap_or_default().trim_end_matches('/');
+                        return Server { child, base: url.to_string(), client: reqwest::Client::new() };
+                    }
+                }
+                Err(_) => {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                    panic!("textile did not report ready within 180 s");
+                }
+            }
+        }
+    }
+
+    /// Absolute URL of a path.
+    pub fn url(&self, path: &str) -> String {
+        format!("{}{}", self.base, path)
+    }
+
+    /// GET a path.
+    pub async fn get(&self, path: &str) -> reqwest::Response {
+        self.client.get(self.url(path)).send().await.expect("request")
+    }
+
+    /// GET a path and return status and body bytes.
+    pub async fn get_bytes(&self, path: &str) -> (u16, Vec<u8>) {
+        let r = self.get(path).await;
+        let s = r.status().as_u16();
+        (s, r.bytes().await.expect("body").to_vec())
+    }
+
+    /// GET a path expecting 200 JSON.
+    pub async fn json(&self, path: &str) -> serde_json::Value {
+        let r = self.get(path).await;
+        assert_eq!(r.status(), 200, "GET {path}");
+        r.json().await.expect("json")
+    }
+
+    /// GET a path expecting a 200 image, decoded to RGB8.
+    pub async fn image(&self, path: &str) -> image::RgbImage {
+        let (s, b) = self.get_bytes(path).await;
+        assert_eq!(s, 200, "GET {path}: {}", String::from_utf8_lossy(&b[..b.len().min(300)]));
+        image::load_from_memory(&b).expect("decode").to_rgb8()
+    }
+
+    /// Send SIGTERM and wait for exit; returns the exit code.
+    pub fn terminate(mut self) -> Option<i32> {
+        let _ = Command::new("kill").arg("-TERM").arg(self.child.id().to_string()).status();
+        let code = self.child.wait().ok().and_then(|s| s.code());
+        std::mem::forget(self);
+        code
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Assert an error answer: status, JSON body with `error` = code, a non-empty message.
+pub async fn assert_error(s: &Server, path: &str, status: u16, code: &str) {
+    let r = s.get(path).await;
+    assert_eq!(r.status().as_u16(), status, "GET {path}");
+    let ct = r.headers().get("content-type").map(|v| v.to_str().unwrap_or("").to_string()).unwrap_or_default();
+    assert!(ct.starts_with("application/json"), "GET {path}: content-type {ct}");
+    let body: serde_json::Value = r.json().await.expect("json error body");
+    assert_eq!(body["error"], code, "GET {path}: {body}");
+    assert!(body["message"].as_str().is_some_and(|m| !m.is_empty()), "GET {path}: {body}");
+}
+
+/// Copy `src` (w×h) into `dst` at (x, y).
+pub fn paste(dst: &mut image::RgbImage, src: &image::RgbImage, x: u32, y: u32) {
+    image::imageops::replace(dst, src, x as i64, y as i64);
+}
