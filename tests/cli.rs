@@ -62,8 +62,19 @@ async fn render_writes_the_same_bytes_as_the_server() {
     let out = dir.path().join("tile.png");
     let data = shared_data_dir();
     let (code, _, err) = run(&[
-        "render", "--texture", "gravel", "--data-dir", data.to_str().unwrap(), "--x", "-3", "--y", "4", "--seed", "8",
-        "-o", out.to_str().unwrap(),
+        "render",
+        "--texture",
+        "gravel",
+        "--data-dir",
+        data.to_str().unwrap(),
+        "--x",
+        "-3",
+        "--y",
+        "4",
+        "--seed",
+        "8",
+        "-o",
+        out.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
     let s = Server::start(&[]);
@@ -72,7 +83,12 @@ async fn render_writes_the_same_bytes_as_the_server() {
     assert_eq!(std::fs::read(&out).unwrap(), body);
     let win = dir.path().join("win.png");
     let (code, _, err) = run(&[
-        "render", "--exemplar", &exemplar("brick.png"), "--window=-100,-50,300,200", "-o", win.to_str().unwrap(),
+        "render",
+        "--exemplar",
+        &exemplar("brick.png"),
+        "--window=-100,-50,300,200",
+        "-o",
+        win.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
     let img = image::open(&win).unwrap();

@@ -95,7 +95,8 @@ fn invalid_configuration_stops_start_up_naming_the_key() {
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
     assert!(err.contains("cache_mb"), "{err}");
-    std::fs::write(&cfg, "[[textures]]\nid = \"x\"\nname = \"X\"\nexemplar = \"e.png\"\ndefault_mode = \"magic\"\n").unwrap();
+    std::fs::write(&cfg, "[[textures]]\nid = \"x\"\nname = \"X\"\nexemplar = \"e.png\"\ndefault_mode = \"magic\"\n")
+        .unwrap();
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
     assert!(err.contains("default_mode") && err.contains("synth"), "{err}");

@@ -38,7 +38,10 @@ async fn tilejson_is_valid_and_its_template_fetches_tiles() {
     let center = tj["center"].as_array().unwrap();
     assert_eq!(center.len(), 3);
     let template = tiles[0].as_str().unwrap();
-    assert!(template.contains("seed=5") && template.contains("randomness=0.4") && template.contains("v="), "{template}");
+    assert!(
+        template.contains("seed=5") && template.contains("randomness=0.4") && template.contains("v="),
+        "{template}"
+    );
     let url = template.replace("{z}", &maxz.to_string()).replace("{x}", "-1").replace("{y}", "2");
     let path = url.strip_prefix(&s.base).expect("template on this server");
     let via_template = s.get_bytes(path).await;

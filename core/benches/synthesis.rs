@@ -1,1 +1,64 @@
-fn main() {}
+//! Engine benchmarks (criterion): analysis time for 64², 128² and 256² exemplars, a cold
+//! 256×256 native window (full padded pyramid, nothing cached), a zoomed-out tile, and a
+//! 1024×1024 window (report its time ÷ 16 as the cost per 256² of output).
+//!
+//! `cargo bench -p textile-core --bench synthesis`
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use textile_core::{render, Analysis, Exemplar, ExemplarOptions, NoProgress, Rect, SynthParams};
+
+fn exemplar(side: u32) -> Exemplar {
+    // The 256² gravel of the development set, area-resampled to the side wanted.
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/exemplars/gravel_256.png");
+    let bytes = std::fs::read(&path)
+        .or_else(|_| std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png")))
+        .expect("an exemplar");
+    let img = image::load_from_memory(&bytes).expect("decode").to_rgba8();
+    let img = image::imageops::resize(&img, side, side, image::imageops::FilterType::Triangle);
+    let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    Exemplar::from_rgba(side, side, &px, &ExemplarOptions::default())
+}
+
+fn analysis(c: &mut Criterion) {
+    let mut g = c.benchmark_group("analysis");
+    g.sample_size(10).measurement_time(Duration::from_secs(20));
+    for side in [64u32, 128, 256] {
+        let ex = exemplar(side);
+        g.bench_with_input(BenchmarkId::from_parameter(side), &ex, |b, ex| b.iter(|| Analysis::build(ex, &NoProgress)));
+    }
+    g.finish();
+}
+
+fn windows(c: &mut Criterion) {
+    let an = Analysis::build(&exemplar(128), &NoProgress);
+    let p = SynthParams::default();
+    let mut g = c.benchmark_group("window");
+    g.sample_size(30).measurement_time(Duration::from_secs(10));
+    let mut i = 0i64;
+    g.bench_function("cold_256_native", |b| {
+        b.iter(|| {
+            i += 1;
+            render(&an, &p, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
+        })
+    });
+    g.bench_function("cold_256_zoom_out_1", |b| {
+        b.iter(|| {
+            i += 1;
+            render(&an, &p, 1, Rect::new(256 * i, 256, 256, 256)).unwrap()
+        })
+    });
+    g.sample_size(10);
+    g.bench_function("cold_1024_native", |b| {
+        b.iter(|| {
+            i += 1;
+            render(&an, &p, 0, Rect::new(1024 * i, 77, 1024, 1024)).unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, analysis, windows);
+criterion_main!(benches);

@@ -36,12 +36,5 @@ fn main() {
         let _ = render(&an, &p, 0, Rect::new(0, 0, 256, 256)).unwrap();
         eprintln!("256 tile {:?}", t.elapsed());
     }
-    image::save_buffer(
-        &args[2],
-        &img.pixels,
-        img.width,
-        img.height,
-        image::ExtendedColorType::Rgb8,
-    )
-    .unwrap();
+    image::save_buffer(&args[2], &img.pixels, img.width, img.height, image::ExtendedColorType::Rgb8).unwrap();
 }

@@ -7,8 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::candidates::{candidate_sets, CandidateRules};
 use crate::exemplar::{Exemplar, Preparation};
 use crate::features::{
-    principal_directions, project_runtime, project_search, quantise_projection, LevelColours,
-    RUNTIME_DIMS, SEARCH_DIMS,
+    principal_directions, project_runtime, project_search, quantise_projection, LevelColours, RUNTIME_DIMS, SEARCH_DIMS,
 };
 use crate::stack::{build_stack, to_u8};
 
@@ -93,17 +92,8 @@ impl Analysis {
         let stack8 = derive_stack8(&stack);
         let mut corrected = Vec::new();
         for l in FIRST_CORRECTED_LEVEL..=levels {
-            progress.step(
-                l - FIRST_CORRECTED_LEVEL + 1,
-                total,
-                "neighbourhoods and candidates",
-            );
-            corrected.push(analyse_level(
-                &stack8[l as usize],
-                m,
-                ex.toroidal,
-                1 << (levels - l),
-            ));
+            progress.step(l - FIRST_CORRECTED_LEVEL + 1, total, "neighbourhoods and candidates");
+            corrected.push(analyse_level(&stack8[l as usize], m, ex.toroidal, 1 << (levels - l)));
         }
         progress.step(total, total, "done");
         let header = AnalysisHeader {
@@ -114,13 +104,7 @@ impl Analysis {
             toroidal: ex.toroidal,
             preparation: ex.preparation.clone(),
         };
-        Analysis {
-            header,
-            exemplar: ex.pixels.clone(),
-            stack,
-            corrected,
-            stack8,
-        }
+        Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8 }
     }
 
     /// The analysis id an exemplar would get: compare with a stored analysis's
@@ -141,8 +125,7 @@ impl Analysis {
 
     /// The analysis of corrected level `l`, if `l` is corrected.
     pub fn correction_level(&self, l: u32) -> Option<&CorrectionLevel> {
-        l.checked_sub(FIRST_CORRECTED_LEVEL)
-            .and_then(|i| self.corrected.get(i as usize))
+        l.checked_sub(FIRST_CORRECTED_LEVEL).and_then(|i| self.corrected.get(i as usize))
     }
 
     /// 8-bit stack colours of level `l`.
@@ -163,21 +146,12 @@ impl Analysis {
         corrected: Vec<CorrectionLevel>,
     ) -> Analysis {
         let stack8 = derive_stack8(&stack);
-        Analysis {
-            header,
-            exemplar,
-            stack,
-            corrected,
-            stack8,
-        }
+        Analysis { header, exemplar, stack, corrected, stack8 }
     }
 }
 
 fn derive_stack8(stack: &[Vec<[u16; 3]>]) -> Vec<Vec<[u8; 3]>> {
-    stack
-        .iter()
-        .map(|lv| lv.iter().map(|p| p.map(to_u8)).collect())
-        .collect()
+    stack.iter().map(|lv| lv.iter().map(|p| p.map(to_u8)).collect()).collect()
 }
 
 /// Content hash of what determines an analysis: algorithm version, side, toroidal flag, pixels.
@@ -195,12 +169,7 @@ fn analysis_id(ex: &Exemplar) -> String {
 
 fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize) -> CorrectionLevel {
     use rayon::prelude::*;
-    let cols = LevelColours {
-        px,
-        m: m as i64,
-        toroidal,
-        h: h as i64,
-    };
+    let cols = LevelColours { px, m: m as i64, toroidal, h: h as i64 };
     let dirs5 = principal_directions(&cols, 2, RUNTIME_DIMS);
     let proj = quantise_projection(&dirs5);
     let dirs7 = principal_directions(&cols, 3, SEARCH_DIMS);
@@ -217,10 +186,7 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize) -> Correcti
     let sets = candidate_sets(&search, &CandidateRules::for_level(m, toroidal, h));
     let cand = |i: u32| {
         let i = i as usize;
-        Candidate {
-            coord: (i % m) as u32 | ((i / m) as u32) << 16,
-            feat: runtime[i],
-        }
+        Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }
     };
     let cands = sets.iter().map(|&[a, b]| [cand(a), cand(b)]).collect();
     CorrectionLevel { proj, cands }

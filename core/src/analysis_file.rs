@@ -7,9 +7,7 @@ use std::fs;
 use std::io::Write;
 use std::path::Path;
 
-use crate::analysis::{
-    Analysis, AnalysisHeader, Candidate, CorrectionLevel, FIRST_CORRECTED_LEVEL,
-};
+use crate::analysis::{Analysis, AnalysisHeader, Candidate, CorrectionLevel, FIRST_CORRECTED_LEVEL};
 use crate::error::{AnalysisFileProblem, CoreError, Result};
 use crate::features::{RUNTIME_DIMS, TAPS5};
 
@@ -63,10 +61,7 @@ impl Analysis {
     /// Parse the file format. Problems are reported with an empty path; [`Analysis::load`]
     /// fills in the file name.
     pub fn from_bytes(bytes: &[u8]) -> Result<Analysis> {
-        parse(bytes).map_err(|problem| CoreError::AnalysisFile {
-            path: Default::default(),
-            problem,
-        })
+        parse(bytes).map_err(|problem| CoreError::AnalysisFile { path: Default::default(), problem })
     }
 
     /// Hash of the serialised file (hex), identifying these exact bytes.
@@ -76,19 +71,10 @@ impl Analysis {
 
     /// Write atomically: a temporary file beside `path`, fsync, rename.
     pub fn save(&self, path: &Path) -> Result<()> {
-        let io = |source| CoreError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let dir = path
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
+        let io = |source| CoreError::Io { path: path.to_path_buf(), source };
+        let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
         fs::create_dir_all(dir).map_err(io)?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
         let result = (|| {
             let mut f = fs::File::create(&tmp)?;
@@ -104,14 +90,8 @@ impl Analysis {
 
     /// Read and validate an analysis file.
     pub fn load(path: &Path) -> Result<Analysis> {
-        let bytes = fs::read(path).map_err(|source| CoreError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
-        parse(&bytes).map_err(|problem| CoreError::AnalysisFile {
-            path: path.to_path_buf(),
-            problem,
-        })
+        let bytes = fs::read(path).map_err(|source| CoreError::Io { path: path.to_path_buf(), source })?;
+        parse(&bytes).map_err(|problem| CoreError::AnalysisFile { path: path.to_path_buf(), problem })
     }
 
     /// Read only the descriptive header of an analysis file (after full validation).
@@ -128,9 +108,7 @@ struct Reader<'a> {
 impl<'a> Reader<'a> {
     fn take(&mut self, n: usize) -> Result<&'a [u8], AnalysisFileProblem> {
         let end = self.pos.checked_add(n).filter(|&e| e <= self.b.len());
-        let end = end.ok_or_else(|| {
-            AnalysisFileProblem::Corrupt("payload shorter than its header says".into())
-        })?;
+        let end = end.ok_or_else(|| AnalysisFileProblem::Corrupt("payload shorter than its header says".into()))?;
         let s = &self.b[self.pos..end];
         self.pos = end;
         Ok(s)
@@ -150,31 +128,19 @@ fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
         return Err(AnalysisFileProblem::BadMagic);
     }
     if bytes.len() < FIXED {
-        return Err(AnalysisFileProblem::Truncated {
-            actual: bytes.len() as u64,
-            declared: FIXED as u64,
-        });
+        return Err(AnalysisFileProblem::Truncated { actual: bytes.len() as u64, declared: FIXED as u64 });
     }
     let mut r = Reader { b: bytes, pos: 8 };
     let version = r.u32()?;
     if version != FORMAT_VERSION {
-        return Err(AnalysisFileProblem::UnsupportedVersion {
-            found: version,
-            expected: FORMAT_VERSION,
-        });
+        return Err(AnalysisFileProblem::UnsupportedVersion { found: version, expected: FORMAT_VERSION });
     }
     let total = u64::from_le_bytes(r.take(8)?.try_into().unwrap_or([0; 8]));
     if (bytes.len() as u64) < total {
-        return Err(AnalysisFileProblem::Truncated {
-            actual: bytes.len() as u64,
-            declared: total,
-        });
+        return Err(AnalysisFileProblem::Truncated { actual: bytes.len() as u64, declared: total });
     }
     if bytes.len() as u64 != total || total < (FIXED + CHECKSUM) as u64 {
-        return Err(AnalysisFileProblem::Corrupt(format!(
-            "length {} differs from declared {total}",
-            bytes.len()
-        )));
+        return Err(AnalysisFileProblem::Corrupt(format!("length {} differs from declared {total}", bytes.len())));
     }
     let (body, sum) = bytes.split_at(bytes.len() - CHECKSUM);
     if blake3::hash(body).as_bytes() != sum {
@@ -182,8 +148,8 @@ fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
     }
     let mut r = Reader { b: body, pos: 20 };
     let json_len = r.u32()? as usize;
-    let header: AnalysisHeader = serde_json::from_slice(r.take(json_len)?)
-        .map_err(|e| AnalysisFileProblem::Corrupt(format!("header: {e}")))?;
+    let header: AnalysisHeader =
+        serde_json::from_slice(r.take(json_len)?).map_err(|e| AnalysisFileProblem::Corrupt(format!("header: {e}")))?;
     if header.algorithm_version != crate::analysis::ALGORITHM_VERSION {
         return Err(AnalysisFileProblem::UnsupportedVersion {
             found: header.algorithm_version,
@@ -191,20 +157,11 @@ fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
         });
     }
     let m = header.side as usize;
-    if !(32..=512).contains(&m)
-        || !m.is_power_of_two()
-        || header.levels != header.side.trailing_zeros()
-    {
-        return Err(AnalysisFileProblem::Corrupt(format!(
-            "invalid exemplar side {m}"
-        )));
+    if !(32..=512).contains(&m) || !m.is_power_of_two() || header.levels != header.side.trailing_zeros() {
+        return Err(AnalysisFileProblem::Corrupt(format!("invalid exemplar side {m}")));
     }
     let n = m * m;
-    let exemplar: Vec<[u8; 3]> = r
-        .take(n * 3)?
-        .chunks_exact(3)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
+    let exemplar: Vec<[u8; 3]> = r.take(n * 3)?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let mut stack = Vec::new();
     for _ in 0..=header.levels {
         let mut lv = Vec::with_capacity(n);
@@ -215,20 +172,15 @@ fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
     }
     let mut corrected = Vec::new();
     for _ in FIRST_CORRECTED_LEVEL..=header.levels {
-        let proj: Vec<i16> = r
-            .take(TAPS5 * 3 * RUNTIME_DIMS * 2)?
-            .chunks_exact(2)
-            .map(|c| i16::from_le_bytes([c[0], c[1]]))
-            .collect();
+        let proj: Vec<i16> =
+            r.take(TAPS5 * 3 * RUNTIME_DIMS * 2)?.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]])).collect();
         let mut cands = Vec::with_capacity(n);
         for _ in 0..n {
             let mut pair = [Candidate::default(); 2];
             for c in pair.iter_mut() {
                 c.coord = r.u32()?;
                 if (c.coord & 0xFFFF) as usize >= m || (c.coord >> 16) as usize >= m {
-                    return Err(AnalysisFileProblem::Corrupt(
-                        "candidate outside the exemplar".into(),
-                    ));
+                    return Err(AnalysisFileProblem::Corrupt("candidate outside the exemplar".into()));
                 }
                 for f in c.feat.iter_mut() {
                     *f = r.u16()? as i16;
@@ -239,9 +191,7 @@ fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
         corrected.push(CorrectionLevel { proj, cands });
     }
     if r.pos != body.len() {
-        return Err(AnalysisFileProblem::Corrupt(
-            "trailing bytes after payload".into(),
-        ));
+        return Err(AnalysisFileProblem::Corrupt("trailing bytes after payload".into()));
     }
     Ok(Analysis::from_parts(header, exemplar, stack, corrected))
 }

@@ -25,12 +25,7 @@ pub struct CandidateRules {
 impl CandidateRules {
     /// Rules at a level with stride `h` (`b_l = min(2h, m/4)`, separation `⌈0.05·m⌉`).
     pub fn for_level(m: usize, toroidal: bool, h: usize) -> Self {
-        CandidateRules {
-            m,
-            toroidal,
-            border: (2 * h).min(m / 4),
-            separation: (m * 5).div_ceil(100),
-        }
+        CandidateRules { m, toroidal, border: (2 * h).min(m / 4), separation: (m * 5).div_ceil(100) }
     }
 
     fn is_border(&self, i: usize) -> bool {
@@ -44,12 +39,7 @@ impl CandidateRules {
 
     fn far_enough(&self, a: usize, b: usize) -> bool {
         let m = self.m as i64;
-        let (ax, ay, bx, by) = (
-            (a % self.m) as i64,
-            (a / self.m) as i64,
-            (b % self.m) as i64,
-            (b / self.m) as i64,
-        );
+        let (ax, ay, bx, by) = ((a % self.m) as i64, (a / self.m) as i64, (b % self.m) as i64, (b / self.m) as i64);
         let (mut dx, mut dy) = ((ax - bx).abs(), (ay - by).abs());
         if self.toroidal {
             dx = dx.min(m - dx);
@@ -82,19 +72,12 @@ pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules) -> V
             let mut c2 = None;
             for n in tries.iter_mut() {
                 let n = (*n).min(points.len()).max(1);
-                let mut found = tree.nearest_n::<SquaredEuclidean>(
-                    q,
-                    NonZeroUsize::new(n).unwrap_or(NonZeroUsize::MIN),
-                );
+                let mut found =
+                    tree.nearest_n::<SquaredEuclidean>(q, NonZeroUsize::new(n).unwrap_or(NonZeroUsize::MIN));
                 found.sort_by(|a, b| {
-                    a.distance
-                        .total_cmp(&b.distance)
-                        .then(inner[a.item as usize].cmp(&inner[b.item as usize]))
+                    a.distance.total_cmp(&b.distance).then(inner[a.item as usize].cmp(&inner[b.item as usize]))
                 });
-                if let Some(f) = found
-                    .iter()
-                    .find(|f| rules.far_enough(inner[f.item as usize], c1))
-                {
+                if let Some(f) = found.iter().find(|f| rules.far_enough(inner[f.item as usize], c1)) {
                     c2 = Some(inner[f.item as usize]);
                     break;
                 }

@@ -28,10 +28,7 @@ pub struct ExemplarOptions {
 
 impl Default for ExemplarOptions {
     fn default() -> Self {
-        ExemplarOptions {
-            max_input_side: 1024,
-            toroidal: None,
-        }
+        ExemplarOptions { max_input_side: 1024, toroidal: None }
     }
 }
 
@@ -76,9 +73,7 @@ impl Exemplar {
                 "unrecognised image format (expected PNG, JPEG, WebP, TGA or BMP)".into(),
             ));
         }
-        let (w, h) = reader
-            .into_dimensions()
-            .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        let (w, h) = reader.into_dimensions().map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
         check_size(w, h, opts.max_input_side)?;
         let mut reader = ImageReader::new(Cursor::new(bytes))
             .with_guessed_format()
@@ -88,9 +83,7 @@ impl Exemplar {
         limits.max_image_height = Some(opts.max_input_side);
         limits.max_alloc = Some(256 << 20);
         reader.limits(limits);
-        let img = reader
-            .decode()
-            .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        let img = reader.decode().map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
         let rgba = img.to_rgba8();
         let (w, h) = rgba.dimensions();
         let px: Vec<[u8; 4]> = rgba.pixels().map(|p| p.0).collect();
@@ -111,11 +104,7 @@ impl Exemplar {
             square.extend_from_slice(&rgb[row..row + s]);
         }
         let side = target_side(crop_side);
-        let pixels = if side == crop_side {
-            square
-        } else {
-            area_resample(&square, s, side as usize)
-        };
+        let pixels = if side == crop_side { square } else { area_resample(&square, s, side as usize) };
         let seam_ratio = seam_ratio(&pixels, side as usize);
         let toroidal = opts.toroidal.unwrap_or(seam_ratio <= 1.5);
         Exemplar {
@@ -136,12 +125,7 @@ impl Exemplar {
 
 fn check_size(w: u32, h: u32, max: u32) -> Result<()> {
     if w < MIN_INPUT_SIDE || h < MIN_INPUT_SIDE || w > max || h > max {
-        return Err(CoreError::ExemplarSize {
-            width: w,
-            height: h,
-            min: MIN_INPUT_SIDE,
-            max,
-        });
+        return Err(CoreError::ExemplarSize { width: w, height: h, min: MIN_INPUT_SIDE, max });
     }
     Ok(())
 }
@@ -149,11 +133,7 @@ fn check_size(w: u32, h: u32, max: u32) -> Result<()> {
 /// The prepared side for a crop of side `s`: the largest power of two ≤ `s`, clamped to
 /// `[MIN_SIDE, MAX_SIDE]`.
 pub fn target_side(s: u32) -> u32 {
-    let p = if s == 0 {
-        1
-    } else {
-        1u32 << (31 - s.leading_zeros())
-    };
+    let p = if s == 0 { 1 } else { 1u32 << (31 - s.leading_zeros()) };
     p.clamp(MIN_SIDE, MAX_SIDE)
 }
 
@@ -166,11 +146,7 @@ fn composite_over_mean(px: &[[u8; 4]]) -> Vec<[u8; 3]> {
         }
         wsum += p[3] as u64;
     }
-    let mean: [u64; 3] = if wsum == 0 {
-        [0; 3]
-    } else {
-        [0, 1, 2].map(|c| (sum[c] + wsum / 2) / wsum)
-    };
+    let mean: [u64; 3] = if wsum == 0 { [0; 3] } else { [0, 1, 2].map(|c| (sum[c] + wsum / 2) / wsum) };
     px.iter()
         .map(|p| {
             let a = p[3] as u64;

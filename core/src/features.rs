@@ -76,11 +76,7 @@ pub fn principal_directions(cols: &LevelColours, r: i64, k: usize) -> Vec<Vec<f6
     });
     let eig = SymmetricEigen::new(cov);
     let mut order: Vec<usize> = (0..dim).collect();
-    order.sort_by(|&a, &b| {
-        eig.eigenvalues[b]
-            .total_cmp(&eig.eigenvalues[a])
-            .then(a.cmp(&b))
-    });
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]).then(a.cmp(&b)));
     order
         .into_iter()
         .take(k)

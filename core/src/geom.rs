@@ -29,12 +29,7 @@ pub struct Rect {
 impl Rect {
     /// The rectangle with origin `(x, y)` and size `w × h`.
     pub fn new(x: i64, y: i64, w: i64, h: i64) -> Self {
-        Rect {
-            x0: x,
-            y0: y,
-            x1: x + w,
-            y1: y + h,
-        }
+        Rect { x0: x, y0: y, x1: x + w, y1: y + h }
     }
 
     /// Width in pixels (0 if empty).
@@ -59,12 +54,7 @@ impl Rect {
 
     /// The rectangle grown by `n` pixels on every side.
     pub fn grow(&self, n: i64) -> Self {
-        Rect {
-            x0: self.x0 - n,
-            y0: self.y0 - n,
-            x1: self.x1 + n,
-            y1: self.y1 + n,
-        }
+        Rect { x0: self.x0 - n, y0: self.y0 - n, x1: self.x1 + n, y1: self.y1 + n }
     }
 
     /// Smallest rectangle containing both (an empty operand is ignored).
@@ -75,12 +65,7 @@ impl Rect {
         if o.is_empty() {
             return *self;
         }
-        Rect {
-            x0: self.x0.min(o.x0),
-            y0: self.y0.min(o.y0),
-            x1: self.x1.max(o.x1),
-            y1: self.y1.max(o.y1),
-        }
+        Rect { x0: self.x0.min(o.x0), y0: self.y0.min(o.y0), x1: self.x1.max(o.x1), y1: self.y1.max(o.y1) }
     }
 
     /// True when `o` lies inside `self`.
@@ -90,22 +75,12 @@ impl Rect {
 
     /// The parents (one level coarser) of every pixel: `[a, b) → [a >> 1, (b + 1) >> 1)`.
     pub fn parents(&self) -> Self {
-        Rect {
-            x0: fl2(self.x0),
-            y0: fl2(self.y0),
-            x1: fl2(self.x1 + 1),
-            y1: fl2(self.y1 + 1),
-        }
+        Rect { x0: fl2(self.x0), y0: fl2(self.y0), x1: fl2(self.x1 + 1), y1: fl2(self.y1 + 1) }
     }
 
     /// The children (one level finer) of every pixel: `[2a, 2b)`.
     pub fn children(&self) -> Self {
-        Rect {
-            x0: self.x0 * 2,
-            y0: self.y0 * 2,
-            x1: self.x1 * 2,
-            y1: self.y1 * 2,
-        }
+        Rect { x0: self.x0 * 2, y0: self.y0 * 2, x1: self.x1 * 2, y1: self.y1 * 2 }
     }
 }
 
@@ -115,12 +90,7 @@ mod tests {
 
     #[test]
     fn parents_of_negative_rect_keep_the_edge_parent() {
-        let r = Rect {
-            x0: -11,
-            y0: -11,
-            x1: 267,
-            y1: 267,
-        };
+        let r = Rect { x0: -11, y0: -11, x1: 267, y1: 267 };
         let p = r.parents();
         assert_eq!((p.x0, p.x1), (-6, 134));
     }

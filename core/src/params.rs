@@ -47,10 +47,7 @@ fn parse_unit(name: &'static str, s: &str) -> Result<u32> {
         message: format!("'{s}' is not a number; expected a value in [0, 1]"),
     })?;
     if !v.is_finite() || !(0.0..=1.0).contains(&v) {
-        return Err(CoreError::Param {
-            name,
-            message: format!("{s} is outside [0, 1]"),
-        });
+        return Err(CoreError::Param { name, message: format!("{s} is outside [0, 1]") });
     }
     Ok((v * ONE_Q16 as f64).round() as u32)
 }
@@ -62,12 +59,7 @@ impl Randomness {
         if parts.len() == 1 {
             return Ok(Randomness::Uniform(parse_unit("randomness", parts[0])?));
         }
-        Ok(Randomness::PerLevel(
-            parts
-                .iter()
-                .map(|p| parse_unit("randomness", p))
-                .collect::<Result<_>>()?,
-        ))
+        Ok(Randomness::PerLevel(parts.iter().map(|p| parse_unit("randomness", p)).collect::<Result<_>>()?))
     }
 
     /// The fixed-point value at every level `0..=levels`.
@@ -84,11 +76,7 @@ impl Randomness {
         match self {
             Randomness::Default => "default".into(),
             Randomness::Uniform(r) => r.to_string(),
-            Randomness::PerLevel(v) => v
-                .iter()
-                .map(|x| x.to_string())
-                .collect::<Vec<_>>()
-                .join(","),
+            Randomness::PerLevel(v) => v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(","),
         }
     }
 }
@@ -146,28 +134,16 @@ impl SynthParams {
         }
         let in_unit = |v: u32| v <= ONE_Q16;
         if !self.randomness.resolve(levels).into_iter().all(in_unit) {
-            return Err(CoreError::Param {
-                name: "randomness",
-                message: "values must be in [0, 1]".into(),
-            });
+            return Err(CoreError::Param { name: "randomness", message: "values must be in [0, 1]".into() });
         }
         if self.passes > MAX_PASSES {
-            return Err(CoreError::Param {
-                name: "passes",
-                message: format!("must be 0 to {MAX_PASSES}"),
-            });
+            return Err(CoreError::Param { name: "passes", message: format!("must be 0 to {MAX_PASSES}") });
         }
         if self.subpasses != 1 && self.subpasses != 4 {
-            return Err(CoreError::Param {
-                name: "subpasses",
-                message: "must be 1 or 4".into(),
-            });
+            return Err(CoreError::Param { name: "subpasses", message: "must be 1 or 4".into() });
         }
         if !in_unit(self.kappa) {
-            return Err(CoreError::Param {
-                name: "kappa",
-                message: "must be in [0, 1]".into(),
-            });
+            return Err(CoreError::Param { name: "kappa", message: "must be in [0, 1]".into() });
         }
         if let Some(n) = self.period {
             let m = an.side() as i64;
@@ -190,9 +166,7 @@ impl SynthParams {
             self.passes,
             self.subpasses,
             self.kappa,
-            self.period
-                .map(|p| p.to_string())
-                .unwrap_or_else(|| "none".into())
+            self.period.map(|p| p.to_string()).unwrap_or_else(|| "none".into())
         )
     }
 
@@ -210,17 +184,11 @@ mod tests {
 
     #[test]
     fn randomness_parsing_is_canonical() {
-        assert_eq!(
-            Randomness::parse("0.5").unwrap(),
-            Randomness::parse("0.50").unwrap()
-        );
+        assert_eq!(Randomness::parse("0.5").unwrap(), Randomness::parse("0.50").unwrap());
         assert!(Randomness::parse("1.5").is_err());
         assert!(Randomness::parse("NaN").is_err());
         assert!(Randomness::parse("x").is_err());
-        assert_eq!(
-            Randomness::parse("0,1").unwrap(),
-            Randomness::PerLevel(vec![0, 65536])
-        );
+        assert_eq!(Randomness::parse("0,1").unwrap(), Randomness::PerLevel(vec![0, 65536]));
     }
 
     #[test]

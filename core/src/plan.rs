@@ -50,12 +50,7 @@ fn snap(r: Rect, cx: i64, cy: i64) -> Rect {
     let y0 = r.y0 + (cy - r.y0).rem_euclid(2);
     let x1 = (r.x1 - 1) - ((r.x1 - 1) - cx).rem_euclid(2) + 1;
     let y1 = (r.y1 - 1) - ((r.y1 - 1) - cy).rem_euclid(2) + 1;
-    Rect {
-        x0,
-        y0,
-        x1: x1.max(x0),
-        y1: y1.max(y0),
-    }
+    Rect { x0, y0, x1: x1.max(x0), y1: y1.max(y0) }
 }
 
 /// The exact padding of `w` for a subpass schedule (§1.5): returns the padded rect and each
@@ -87,17 +82,8 @@ pub fn plan_window(target: u32, rect: Rect, sched: &[Class]) -> Vec<LevelPlan> {
     let mut need = rect;
     for l in (0..=target).rev() {
         let corrected = l >= FIRST_CORRECTED_LEVEL && !sched.is_empty();
-        let (padded, subpasses) = if corrected {
-            pad_for_correction(need, sched)
-        } else {
-            (need, Vec::new())
-        };
-        plans.push(LevelPlan {
-            level: l,
-            need,
-            padded,
-            subpasses,
-        });
+        let (padded, subpasses) = if corrected { pad_for_correction(need, sched) } else { (need, Vec::new()) };
+        plans.push(LevelPlan { level: l, need, padded, subpasses });
         need = padded.parents();
     }
     plans.reverse();
@@ -129,18 +115,11 @@ mod tests {
         for (l, (x0, x1, y0, y1), size) in expect {
             let p = &plans[l];
             assert_eq!(p.level, l as u32);
-            assert_eq!(
-                (p.need.x0, p.need.x1, p.need.y0, p.need.y1),
-                (x0, x1, y0, y1),
-                "need at level {l}"
-            );
+            assert_eq!((p.need.x0, p.need.x1, p.need.y0, p.need.y1), (x0, x1, y0, y1), "need at level {l}");
             assert_eq!(sizes(p.padded), size, "padded at level {l}");
         }
         let top = &plans[7];
-        assert_eq!(
-            (top.padded.x0, top.padded.x1, top.padded.y0, top.padded.y1),
-            (-10, 265, -10, 267)
-        );
+        assert_eq!((top.padded.x0, top.padded.x1, top.padded.y0, top.padded.y1), (-10, 265, -10, 267));
     }
 
     #[test]
@@ -150,9 +129,6 @@ mod tests {
         for (p, q) in a.iter().zip(&b) {
             assert_eq!(sizes(p.padded), sizes(q.padded), "level {}", p.level);
         }
-        assert_eq!(
-            (b[6].need.x0, b[6].need.x1, b[6].need.y0, b[6].need.y1),
-            (-133, 5, -133, 6)
-        );
+        assert_eq!((b[6].need.x0, b[6].need.x1, b[6].need.y0, b[6].need.y1), (-133, 5, -133, 6));
     }
 }

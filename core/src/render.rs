@@ -51,12 +51,7 @@ pub fn render(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) ->
         };
         for j in 0..h {
             for i in 0..w {
-                let q = [
-                    at(2 * i, 2 * j),
-                    at(2 * i + 1, 2 * j),
-                    at(2 * i, 2 * j + 1),
-                    at(2 * i + 1, 2 * j + 1),
-                ];
+                let q = [at(2 * i, 2 * j), at(2 * i + 1, 2 * j), at(2 * i, 2 * j + 1), at(2 * i + 1, 2 * j + 1)];
                 for c in 0..3 {
                     let s: u32 = q.iter().map(|p| p[c] as u32).sum();
                     pixels.push(((s + 512) >> 10).min(255) as u8);
@@ -70,9 +65,5 @@ pub fn render(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) ->
             pixels.extend_from_slice(&mean);
         }
     }
-    Ok(RgbWindow {
-        width: w as u32,
-        height: h as u32,
-        pixels,
-    })
+    Ok(RgbWindow { width: w as u32, height: h as u32, pixels })
 }

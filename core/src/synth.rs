@@ -44,10 +44,7 @@ struct Buf {
 impl Buf {
     fn crop(&self, r: Rect) -> Buf {
         let w = self.rect.width() as usize;
-        let (ox, oy) = (
-            (r.x0 - self.rect.x0) as usize,
-            (r.y0 - self.rect.y0) as usize,
-        );
+        let (ox, oy) = ((r.x0 - self.rect.x0) as usize, (r.y0 - self.rect.y0) as usize);
         let rw = r.width() as usize;
         let mut s = Vec::with_capacity(r.area() as usize);
         for j in 0..r.height() as usize {
@@ -59,18 +56,10 @@ impl Buf {
 }
 
 /// Synthesize the exemplar coordinates of `rect` at pyramid `level` (`0..=L`).
-pub fn synthesize(
-    an: &Analysis,
-    params: &SynthParams,
-    level: u32,
-    rect: Rect,
-) -> Result<CoordWindow> {
+pub fn synthesize(an: &Analysis, params: &SynthParams, level: u32, rect: Rect) -> Result<CoordWindow> {
     params.validate_for(an)?;
     if level > an.levels() {
-        return Err(CoreError::Param {
-            name: "level",
-            message: format!("must be 0 to {}", an.levels()),
-        });
+        return Err(CoreError::Param { name: "level", message: format!("must be 0 to {}", an.levels()) });
     }
     if rect.is_empty() || rect.area() > MAX_WINDOW_PIXELS {
         return Err(CoreError::Window {
@@ -85,23 +74,13 @@ pub fn synthesize(
     let mut parent: Option<Buf> = None;
     for lp in &plans {
         let mut buf = ctx.upsample_jitter(lp, parent.as_ref());
-        if let Some(cl) = an
-            .correction_level(lp.level)
-            .filter(|_| !lp.subpasses.is_empty())
-        {
+        if let Some(cl) = an.correction_level(lp.level).filter(|_| !lp.subpasses.is_empty()) {
             ctx.correct(lp, cl, &mut buf);
         }
         parent = Some(buf.crop(lp.need));
     }
-    let out = parent.unwrap_or(Buf {
-        rect,
-        s: Vec::new(),
-    });
-    Ok(CoordWindow {
-        level,
-        rect,
-        coords: out.s,
-    })
+    let out = parent.unwrap_or(Buf { rect, s: Vec::new() });
+    Ok(CoordWindow { level, rect, coords: out.s })
 }
 
 struct Ctx<'a> {
@@ -148,42 +127,39 @@ impl<'a> Ctx<'a> {
                 d - 1
             }
         };
-        s.par_chunks_mut(w)
-            .enumerate()
-            .with_min_len(8)
-            .for_each(|(j, row)| {
-                let y = rect.y0 + j as i64;
-                let oy = off(par(y));
-                let prow = parent.map(|p| {
-                    let pw = p.rect.width() as usize;
-                    let py = (fl2(y) - p.rect.y0) as usize;
-                    (&p.s[py * pw..(py + 1) * pw], p.rect.x0)
-                });
-                for (i, out) in row.iter_mut().enumerate() {
-                    let x = rect.x0 + i as i64;
-                    let (mut sx, mut sy) = match prow {
-                        Some((pr, px0)) => {
-                            let v = pr[(fl2(x) - px0) as usize];
-                            ((v & 0xFFFF) as i64, (v >> 16) as i64)
-                        }
-                        None => (0, 0),
-                    };
-                    sx += off(par(x));
-                    sy += oy;
-                    if rq != 0 {
-                        let (hx_, hy_) = match period_l {
-                            Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
-                            None => (x, y),
-                        };
-                        let z = hash(TAG_JITTER, self.seed, l as i64, hx_, hy_);
-                        let hx = ((z >> 40) as i64) - (1 << 23);
-                        let hy = (((z >> 16) & 0xFF_FFFF) as i64) - (1 << 23);
-                        sx += (h * hx * rq + (1 << 38)) >> 39;
-                        sy += (h * hy * rq + (1 << 38)) >> 39;
-                    }
-                    *out = ((sx & mask) | ((sy & mask) << 16)) as u32;
-                }
+        s.par_chunks_mut(w).enumerate().with_min_len(8).for_each(|(j, row)| {
+            let y = rect.y0 + j as i64;
+            let oy = off(par(y));
+            let prow = parent.map(|p| {
+                let pw = p.rect.width() as usize;
+                let py = (fl2(y) - p.rect.y0) as usize;
+                (&p.s[py * pw..(py + 1) * pw], p.rect.x0)
             });
+            for (i, out) in row.iter_mut().enumerate() {
+                let x = rect.x0 + i as i64;
+                let (mut sx, mut sy) = match prow {
+                    Some((pr, px0)) => {
+                        let v = pr[(fl2(x) - px0) as usize];
+                        ((v & 0xFFFF) as i64, (v >> 16) as i64)
+                    }
+                    None => (0, 0),
+                };
+                sx += off(par(x));
+                sy += oy;
+                if rq != 0 {
+                    let (hx_, hy_) = match period_l {
+                        Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
+                        None => (x, y),
+                    };
+                    let z = hash(TAG_JITTER, self.seed, l as i64, hx_, hy_);
+                    let hx = ((z >> 40) as i64) - (1 << 23);
+                    let hy = (((z >> 16) & 0xFF_FFFF) as i64) - (1 << 23);
+                    sx += (h * hx * rq + (1 << 38)) >> 39;
+                    sy += (h * hy * rq + (1 << 38)) >> 39;
+                }
+                *out = ((sx & mask) | ((sy & mask) << 16)) as u32;
+            }
+        });
         Buf { rect, s }
     }
 
@@ -192,25 +168,15 @@ impl<'a> Ctx<'a> {
         let l = lp.level;
         let h = 1i64 << (self.levels - l);
         let m = self.m as usize;
-        let pal: Vec<u32> = self
-            .an
-            .colours8(l)
-            .iter()
-            .map(|c| c[0] as u32 | (c[1] as u32) << 8 | (c[2] as u32) << 16)
-            .collect();
+        let pal: Vec<u32> =
+            self.an.colours8(l).iter().map(|c| c[0] as u32 | (c[1] as u32) << 8 | (c[2] as u32) << 16).collect();
         let w = buf.rect.width() as usize;
         let colour = |v: u32| pal[(v >> 16) as usize * m + (v & 0xFFFF) as usize];
         let mut col: Vec<u32> = buf.s.iter().map(|&v| colour(v)).collect();
-        let taps: Vec<isize> = (-2..=2)
-            .flat_map(|dy| (-2..=2).map(move |dx| dy * w as isize + dx))
-            .collect::<Vec<_>>();
+        let taps: Vec<isize> = (-2..=2).flat_map(|dy| (-2..=2).map(move |dx| dy * w as isize + dx)).collect::<Vec<_>>();
         // Candidate neighbours: (0,0) first, then the other 8 in raster order.
         let mut nb: Vec<(i64, i64)> = vec![(0, 0)];
-        nb.extend(
-            (-1..=1)
-                .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
-                .filter(|&d| d != (0, 0)),
-        );
+        nb.extend((-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))).filter(|&d| d != (0, 0)));
         let nb_off: Vec<(isize, u32, u32)> = nb
             .iter()
             .map(|&(dx, dy)| {
@@ -229,18 +195,15 @@ impl<'a> Ctx<'a> {
             let rows = ((r.height() - 1) / step + 1) as usize;
             let mut out = vec![0u32; cols * rows];
             let (s, colr) = (&buf.s, &col);
-            out.par_chunks_mut(cols)
-                .enumerate()
-                .with_min_len(4)
-                .for_each(|(j, row)| {
-                    let y = r.y0 + j as i64 * step;
-                    let by = (y - buf.rect.y0) as usize;
-                    for (i, o) in row.iter_mut().enumerate() {
-                        let x = r.x0 + i as i64 * step;
-                        let idx = by * w + (x - buf.rect.x0) as usize;
-                        *o = correct_pixel(idx, s, colr, &taps, &nb_off, cl, m, mask, phi);
-                    }
-                });
+            out.par_chunks_mut(cols).enumerate().with_min_len(4).for_each(|(j, row)| {
+                let y = r.y0 + j as i64 * step;
+                let by = (y - buf.rect.y0) as usize;
+                for (i, o) in row.iter_mut().enumerate() {
+                    let x = r.x0 + i as i64 * step;
+                    let idx = by * w + (x - buf.rect.x0) as usize;
+                    *o = correct_pixel(idx, s, colr, &taps, &nb_off, cl, m, mask, phi);
+                }
+            });
             for (j, row) in out.chunks(cols).enumerate() {
                 let by = (r.y0 - buf.rect.y0) as usize + j * step as usize;
                 for (i, &v) in row.iter().enumerate() {
@@ -271,16 +234,10 @@ fn correct_pixel(
     let mut acc = [0i32; RUNTIME_DIMS];
     for t in 0..TAPS5 {
         let c = col[(idx as isize + taps[t]) as usize];
-        let (r, g, b) = (
-            (c & 255) as i32,
-            ((c >> 8) & 255) as i32,
-            ((c >> 16) & 255) as i32,
-        );
+        let (r, g, b) = ((c & 255) as i32, ((c >> 8) & 255) as i32, ((c >> 16) & 255) as i32);
         let pr = &proj[t * 3 * RUNTIME_DIMS..(t + 1) * 3 * RUNTIME_DIMS];
         for d in 0..RUNTIME_DIMS {
-            acc[d] += pr[d] as i32 * r
-                + pr[RUNTIME_DIMS + d] as i32 * g
-                + pr[2 * RUNTIME_DIMS + d] as i32 * b;
+            acc[d] += pr[d] as i32 * r + pr[RUNTIME_DIMS + d] as i32 * g + pr[2 * RUNTIME_DIMS + d] as i32 * b;
         }
     }
     let ns = acc.map(|a| a >> FEAT_SHIFT);

@@ -9,22 +9,14 @@ use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress};
 
 /// Path of a development exemplar in `../shared/exemplars` (beside the repository).
 pub fn shared_exemplar(name: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/exemplars")
-        .join(name);
-    assert!(
-        p.exists(),
-        "missing development exemplar {} (shared/ must sit beside the repo)",
-        p.display()
-    );
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/exemplars").join(name);
+    assert!(p.exists(), "missing development exemplar {} (shared/ must sit beside the repo)", p.display());
     p
 }
 
 /// Path of an embedded default exemplar in `config/exemplars`.
 pub fn embedded_exemplar(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../config/exemplars")
-        .join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars").join(name)
 }
 
 pub fn analyse(path: &PathBuf, opts: ExemplarOptions) -> Analysis {

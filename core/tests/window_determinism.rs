@@ -59,29 +59,17 @@ fn single_pixels_agree_with_a_window() {
     let whole = synthesize(an, &p, 6, Rect::new(-7, -9, 23, 19)).unwrap();
     for (j, i) in [(0, 0), (5, 7), (18, 22), (11, 3)] {
         let one = synthesize(an, &p, 6, Rect::new(-7 + i, -9 + j, 1, 1)).unwrap();
-        assert_eq!(
-            one.coords[0],
-            whole.coords[(j * 23 + i) as usize],
-            "pixel ({i},{j})"
-        );
+        assert_eq!(one.coords[0], whole.coords[(j * 23 + i) as usize], "pixel ({i},{j})");
     }
 }
 
 #[test]
 fn thread_count_does_not_change_pixels() {
     let an = common::small();
-    let p = SynthParams {
-        seed: 42,
-        ..SynthParams::default()
-    };
+    let p = SynthParams { seed: 42, ..SynthParams::default() };
     let r = Rect::new(-300, 129, 301, 257);
-    let run = |n| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .unwrap()
-            .install(|| render(an, &p, 0, r).unwrap())
-    };
+    let run =
+        |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap().install(|| render(an, &p, 0, r).unwrap());
     let one = run(1);
     assert_eq!(one, run(4));
     assert_eq!(one, run(7));
@@ -95,15 +83,9 @@ fn save_load_round_trip_gives_identical_output() {
     an.save(&path).unwrap();
     let back = Analysis::load(&path).unwrap();
     assert_eq!(back.header, an.header);
-    let p = SynthParams {
-        seed: 3,
-        ..SynthParams::default()
-    };
+    let p = SynthParams { seed: 3, ..SynthParams::default() };
     let r = Rect::new(1000, -2000, 128, 96);
-    assert_eq!(
-        render(an, &p, 0, r).unwrap(),
-        render(&back, &p, 0, r).unwrap()
-    );
+    assert_eq!(render(an, &p, 0, r).unwrap(), render(&back, &p, 0, r).unwrap());
     assert_eq!(back.to_bytes(), an.to_bytes());
 }
 
@@ -111,21 +93,14 @@ fn save_load_round_trip_gives_identical_output() {
 fn periodic_output_repeats_exactly_with_its_period() {
     let an = common::small();
     let n = 256;
-    let p = SynthParams {
-        seed: 9,
-        period: Some(n),
-        ..SynthParams::default()
-    };
+    let p = SynthParams { seed: 9, period: Some(n), ..SynthParams::default() };
     let base = render(an, &p, 0, Rect::new(-40, 17, 96, 80)).unwrap();
     for (i, j) in [(1, 0), (0, 1), (-1, 3), (1 << 20, -(1 << 22))] {
         let moved = render(an, &p, 0, Rect::new(-40 + n * i, 17 + n * j, 96, 80)).unwrap();
         assert_eq!(base, moved, "shift by ({i},{j}) periods");
     }
     // Without a period the same shift gives another texture.
-    let q = SynthParams {
-        period: None,
-        ..p.clone()
-    };
+    let q = SynthParams { period: None, ..p.clone() };
     assert_ne!(
         render(an, &q, 0, Rect::new(-40, 17, 96, 80)).unwrap(),
         render(an, &q, 0, Rect::new(216, 17, 96, 80)).unwrap()
@@ -136,56 +111,23 @@ fn periodic_output_repeats_exactly_with_its_period() {
 fn seeds_give_different_textures() {
     let an = common::small();
     let r = Rect::new(0, 0, 64, 64);
-    let a = render(
-        an,
-        &SynthParams {
-            seed: 1,
-            ..SynthParams::default()
-        },
-        0,
-        r,
-    )
-    .unwrap();
-    let b = render(
-        an,
-        &SynthParams {
-            seed: 2,
-            ..SynthParams::default()
-        },
-        0,
-        r,
-    )
-    .unwrap();
-    let differing = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .filter(|(x, y)| x != y)
-        .count();
-    assert!(
-        differing > a.pixels.len() / 2,
-        "only {differing} bytes differ"
-    );
+    let a = render(an, &SynthParams { seed: 1, ..SynthParams::default() }, 0, r).unwrap();
+    let b = render(an, &SynthParams { seed: 2, ..SynthParams::default() }, 0, r).unwrap();
+    let differing = a.pixels.iter().zip(&b.pixels).filter(|(x, y)| x != y).count();
+    assert!(differing > a.pixels.len() / 2, "only {differing} bytes differ");
 }
 
 #[test]
 fn zero_randomness_without_correction_is_the_tiled_exemplar_anywhere() {
     let an = common::small();
-    let p = SynthParams {
-        randomness: Randomness::Uniform(0),
-        passes: 0,
-        ..SynthParams::default()
-    };
+    let p = SynthParams { randomness: Randomness::Uniform(0), passes: 0, ..SynthParams::default() };
     let m = an.side() as i64;
     for (x0, y0) in [(0, 0), (-77, -5), (1 << 40, -(1 << 39) - 3)] {
         let w = synthesize(an, &p, an.levels(), Rect::new(x0, y0, 70, 70)).unwrap();
         for j in 0..70 {
             for i in 0..70 {
                 let (sx, sy) = w.get(i as usize, j as usize);
-                assert_eq!(
-                    (sx as i64, sy as i64),
-                    ((x0 + i).rem_euclid(m), (y0 + j).rem_euclid(m))
-                );
+                assert_eq!((sx as i64, sy as i64), ((x0 + i).rem_euclid(m), (y0 + j).rem_euclid(m)));
             }
         }
     }

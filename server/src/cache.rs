@@ -43,10 +43,7 @@ impl TileCache {
     /// A cache holding at most `limit` bytes of values (keys are small and not counted).
     pub fn new(limit: u64) -> Self {
         TileCache {
-            lru: Mutex::new(Lru {
-                map: LruCache::unbounded(),
-                bytes: 0,
-            }),
+            lru: Mutex::new(Lru { map: LruCache::unbounded(), bytes: 0 }),
             limit,
             inflight: Mutex::new(HashMap::new()),
             stats: CacheStats::default(),
@@ -60,12 +57,7 @@ impl TileCache {
     }
 
     fn get(&self, key: &str) -> Option<Bytes> {
-        self.lru
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .map
-            .get(key)
-            .cloned()
+        self.lru.lock().unwrap_or_else(|e| e.into_inner()).map.get(key).cloned()
     }
 
     fn insert(&self, key: &str, value: Bytes) {
@@ -91,11 +83,7 @@ impl TileCache {
 
     /// The cached value for `key`, or the result of `compute` — run once for all concurrent
     /// callers with the same key. Returns whether it was a cache hit. Errors are not cached.
-    pub async fn get_or_compute<F, Fut>(
-        &self,
-        key: &str,
-        compute: F,
-    ) -> (Result<Bytes, ApiError>, bool)
+    pub async fn get_or_compute<F, Fut>(&self, key: &str, compute: F) -> (Result<Bytes, ApiError>, bool)
     where
         F: FnOnce() -> Fut,
         Fut: Future<Output = Result<Bytes, ApiError>>,
@@ -136,17 +124,11 @@ mod tests {
     #[tokio::test]
     async fn evicts_by_bytes_and_coalesces() {
         let c = TileCache::new(10);
-        let (r, hit) = c
-            .get_or_compute("a", || async { Ok(Bytes::from_static(b"123456")) })
-            .await;
+        let (r, hit) = c.get_or_compute("a", || async { Ok(Bytes::from_static(b"123456")) }).await;
         assert_eq!((r.unwrap().len(), hit), (6, false));
-        let (_, hit) = c
-            .get_or_compute("a", || async { Err(ApiError::internal("not called")) })
-            .await;
+        let (_, hit) = c.get_or_compute("a", || async { Err(ApiError::internal("not called")) }).await;
         assert!(hit);
-        let _ = c
-            .get_or_compute("b", || async { Ok(Bytes::from_static(b"123456")) })
-            .await;
+        let _ = c.get_or_compute("b", || async { Ok(Bytes::from_static(b"123456")) }).await;
         assert_eq!(c.usage(), (1, 6));
         assert_eq!(c.stats.evictions.load(Ordering::Relaxed), 1);
     }

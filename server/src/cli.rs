@@ -85,11 +85,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub config: ConfigArgs,
     /// A configured texture id.
-    #[arg(
-        long,
-        conflicts_with = "exemplar",
-        required_unless_present = "exemplar"
-    )]
+    #[arg(long, conflicts_with = "exemplar", required_unless_present = "exemplar")]
     pub texture: Option<String>,
     /// An exemplar image, analysed on the fly.
     #[arg(long, value_name = "IMAGE")]
@@ -98,12 +94,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub z: Option<u32>,
     /// Tile column (with --y); renders one 256 px tile.
-    #[arg(
-        long,
-        allow_hyphen_values = true,
-        requires = "y",
-        conflicts_with = "window"
-    )]
+    #[arg(long, allow_hyphen_values = true, requires = "y", conflicts_with = "window")]
     pub x: Option<i64>,
     /// Tile row (with --x).
     #[arg(long, allow_hyphen_values = true, requires = "x")]

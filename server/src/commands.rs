@@ -13,9 +13,7 @@ use crate::encode::{encode, Format};
 use crate::render::{render_tile, render_window};
 use crate::serve::CliResult;
 use crate::textures::{exemplar_bytes, load_registry, Texture};
-use crate::tile_request::{
-    RenderParams, TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE, TILE_SIZE,
-};
+use crate::tile_request::{RenderParams, TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE, TILE_SIZE};
 
 struct Bar(Mutex<Option<ProgressBar>>);
 
@@ -24,9 +22,8 @@ impl Progress for Bar {
         let mut g = self.0.lock().unwrap_or_else(|e| e.into_inner());
         let bar = g.get_or_insert_with(|| {
             let b = ProgressBar::new(total as u64);
-            if let Ok(s) = ProgressStyle::with_template(
-                "{spinner} analysing [{bar:30}] {pos}/{len} {msg} ({elapsed})",
-            ) {
+            if let Ok(s) = ProgressStyle::with_template("{spinner} analysing [{bar:30}] {pos}/{len} {msg} ({elapsed})")
+            {
                 b.set_style(s.progress_chars("=> "));
             }
             b
@@ -39,10 +36,7 @@ impl Progress for Bar {
     }
 }
 
-fn read_exemplar(
-    path: &Path,
-    opts: &ExemplarOptions,
-) -> Result<Exemplar, Box<dyn std::error::Error>> {
+fn read_exemplar(path: &Path, opts: &ExemplarOptions) -> Result<Exemplar, Box<dyn std::error::Error>> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     Ok(Exemplar::from_bytes(&bytes, opts).map_err(|e| format!("{}: {e}", path.display()))?)
 }
@@ -54,13 +48,7 @@ pub fn analyze(a: AnalyzeArgs) -> CliResult {
         "false" => Some(false),
         _ => None,
     };
-    let ex = read_exemplar(
-        &a.exemplar,
-        &ExemplarOptions {
-            max_input_side: a.max_side,
-            toroidal,
-        },
-    )?;
+    let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
     let t = std::time::Instant::now();
     let an = Analysis::build(&ex, &Bar(Mutex::new(None)));
     an.save(&a.output)?;
@@ -86,33 +74,18 @@ pub fn info(a: InfoArgs) -> CliResult {
     println!("file:              {}", a.file.display());
     println!("analysis id:       {}", h.id);
     println!("file hash:         {}", an.file_hash());
-    println!(
-        "format version:    {}",
-        textile_core::analysis_file::FORMAT_VERSION
-    );
+    println!("format version:    {}", textile_core::analysis_file::FORMAT_VERSION);
     println!("algorithm version: {}", h.algorithm_version);
     println!(
         "exemplar:          {}x{} (input {}x{}, crop {})",
-        h.side,
-        h.side,
-        h.preparation.input_width,
-        h.preparation.input_height,
-        h.preparation.crop_side
+        h.side, h.side, h.preparation.input_width, h.preparation.input_height, h.preparation.crop_side
     );
     println!(
         "toroidal:          {} ({})",
         h.toroidal,
-        if h.preparation.toroidal_forced {
-            "forced"
-        } else {
-            "detected"
-        }
+        if h.preparation.toroidal_forced { "forced" } else { "detected" }
     );
-    println!(
-        "levels:            {} (native zoom {})",
-        h.levels + 1,
-        h.levels
-    );
+    println!("levels:            {} (native zoom {})", h.levels + 1, h.levels);
     Ok(())
 }
 
@@ -124,10 +97,7 @@ pub fn render(a: RenderArgs) -> CliResult {
         texture_from(an)
     } else {
         let id = a.texture.clone().unwrap_or_default();
-        let overrides = Overrides {
-            data_dir: a.config.data_dir.clone(),
-            ..Default::default()
-        };
+        let overrides = Overrides { data_dir: a.config.data_dir.clone(), ..Default::default() };
         let cfg = Config::load(a.config.config.as_deref(), &overrides)?;
         let mut only = cfg.clone();
         only.textures.retain(|t| t.id == id);
@@ -169,10 +139,7 @@ pub fn render(a: RenderArgs) -> CliResult {
         .and_then(|e| e.to_str())
         .and_then(Format::from_ext)
         .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
-    let p = RenderParams {
-        mode: "synth".into(),
-        synth,
-    };
+    let p = RenderParams { mode: "synth".into(), synth };
     let img = if let Some(win) = &a.window {
         let v: Vec<i64> = win
             .split(',')
@@ -185,43 +152,17 @@ pub fn render(a: RenderArgs) -> CliResult {
         if !(1..=MAX_WINDOW_SIDE).contains(&w) || !(1..=MAX_WINDOW_SIDE).contains(&h) {
             return Err(format!("--window width and height must be 1..={MAX_WINDOW_SIDE}").into());
         }
-        render_window(
-            &tex,
-            &p,
-            &WindowSpec {
-                z,
-                x,
-                y,
-                w,
-                h,
-                format: fmt,
-            },
-        )?
+        render_window(&tex, &p, &WindowSpec { z, x, y, w, h, format: fmt })?
     } else {
         let (x, y) = (a.x.unwrap_or(0), a.y.unwrap_or(0));
         if !(COORD_MIN..=COORD_MAX).contains(&x) || !(COORD_MIN..=COORD_MAX).contains(&y) {
             return Err("--x and --y must be in [-2^31, 2^31-1]".into());
         }
-        render_tile(
-            &tex,
-            &p,
-            &TileSpec {
-                z,
-                x,
-                y,
-                scale: 1,
-                format: fmt,
-            },
-        )?
+        render_tile(&tex, &p, &TileSpec { z, x, y, scale: 1, format: fmt })?
     };
     let bytes = encode(&img.pixels, img.width, img.height, fmt)?;
     write_atomic(&a.output, &bytes)?;
-    println!(
-        "wrote {} ({}x{})",
-        a.output.display(),
-        img.width,
-        img.height
-    );
+    println!("wrote {} ({}x{})", a.output.display(), img.width, img.height);
     Ok(())
 }
 

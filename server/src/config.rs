@@ -143,10 +143,7 @@ impl Config {
         let mut base_dir = std::env::current_dir().unwrap_or_default();
         if let Some(path) = file {
             if !path.is_file() {
-                return Err(ConfigError(format!(
-                    "config file {} does not exist",
-                    path.display()
-                )));
+                return Err(ConfigError(format!("config file {} does not exist", path.display())));
             }
             let text = std::fs::read_to_string(path)
                 .map_err(|e| ConfigError(format!("config file {}: {e}", path.display())))?;
@@ -155,9 +152,7 @@ impl Config {
                 base_dir = dir.to_path_buf();
             }
         }
-        fig = fig
-            .merge(Env::prefixed("TEXTILE_").only(ENV_KEYS))
-            .merge(Serialized::defaults(overrides));
+        fig = fig.merge(Env::prefixed("TEXTILE_").only(ENV_KEYS)).merge(Serialized::defaults(overrides));
         let mut cfg: Config = fig.extract().map_err(|e| {
             let msgs: Vec<String> = e.into_iter().map(|e| e.to_string()).collect();
             ConfigError(msgs.join("; "))
@@ -170,43 +165,22 @@ impl Config {
     fn validate(&self) -> Result<(), ConfigError> {
         let bad = |key: &str, msg: String| Err(ConfigError(format!("key '{key}': {msg}")));
         if self.bind.parse::<std::net::SocketAddr>().is_err() {
-            return bad(
-                "bind",
-                format!("'{}' is not an address like 127.0.0.1:8080", self.bind),
-            );
+            return bad("bind", format!("'{}' is not an address like 127.0.0.1:8080", self.bind));
         }
         if !(1..=65536).contains(&self.cache_mib) {
-            return bad(
-                "cache_mib",
-                format!("{} is outside 1..=65536", self.cache_mib),
-            );
+            return bad("cache_mib", format!("{} is outside 1..=65536", self.cache_mib));
         }
         if self.worker_threads > 1024 {
-            return bad(
-                "worker_threads",
-                format!(
-                    "{} is outside 0..=1024 (0 = one per core)",
-                    self.worker_threads
-                ),
-            );
+            return bad("worker_threads", format!("{} is outside 0..=1024 (0 = one per core)", self.worker_threads));
         }
         if !(1..=3600).contains(&self.request_timeout_secs) {
-            return bad(
-                "request_timeout_secs",
-                format!("{} is outside 1..=3600", self.request_timeout_secs),
-            );
+            return bad("request_timeout_secs", format!("{} is outside 1..=3600", self.request_timeout_secs));
         }
         if !(1..=100_000).contains(&self.max_in_flight) {
-            return bad(
-                "max_in_flight",
-                format!("{} is outside 1..=100000", self.max_in_flight),
-            );
+            return bad("max_in_flight", format!("{} is outside 1..=100000", self.max_in_flight));
         }
         if !(16..=8192).contains(&self.max_exemplar_side) {
-            return bad(
-                "max_exemplar_side",
-                format!("{} is outside 16..=8192", self.max_exemplar_side),
-            );
+            return bad("max_exemplar_side", format!("{} is outside 16..=8192", self.max_exemplar_side));
         }
         if axum::http::HeaderValue::from_str(&self.cache_control).is_err() {
             return bad("cache_control", "must be a valid header value".into());
@@ -217,25 +191,15 @@ impl Config {
         let mut seen = std::collections::HashSet::new();
         for (i, t) in self.textures.iter().enumerate() {
             if !valid_id(&t.id) {
-                return bad(
-                    &format!("textures[{i}].id"),
-                    format!("'{}' must be 1-64 of a-z 0-9 _ -", t.id),
-                );
+                return bad(&format!("textures[{i}].id"), format!("'{}' must be 1-64 of a-z 0-9 _ -", t.id));
             }
             if !seen.insert(&t.id) {
-                return bad(
-                    &format!("textures[{i}].id"),
-                    format!("'{}' is used twice", t.id),
-                );
+                return bad(&format!("textures[{i}].id"), format!("'{}' is used twice", t.id));
             }
             if !crate::tile_request::MODES.contains(&t.default_mode.as_str()) {
                 return bad(
                     &format!("textures[{i}].default_mode"),
-                    format!(
-                        "'{}' is not one of {:?}",
-                        t.default_mode,
-                        crate::tile_request::MODES
-                    ),
+                    format!("'{}' is not one of {:?}", t.default_mode, crate::tile_request::MODES),
                 );
             }
             if !t.default_randomness.is_empty() {
@@ -266,9 +230,7 @@ impl Config {
 pub fn valid_id(id: &str) -> bool {
     !id.is_empty()
         && id.len() <= 64
-        && id
-            .bytes()
-            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_' || b == b'-')
+        && id.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_' || b == b'-')
 }
 
 #[cfg(test)]
@@ -284,11 +246,7 @@ mod tests {
 
     #[test]
     fn overrides_win() {
-        let o = Overrides {
-            bind: Some("127.0.0.1:0".into()),
-            cache_mib: Some(5),
-            ..Default::default()
-        };
+        let o = Overrides { bind: Some("127.0.0.1:0".into()), cache_mib: Some(5), ..Default::default() };
         let cfg = Config::load(None, &o).unwrap();
         assert_eq!((cfg.bind.as_str(), cfg.cache_mib), ("127.0.0.1:0", 5));
     }

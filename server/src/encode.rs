@@ -57,12 +57,7 @@ pub fn encode(rgb: &[u8], w: u32, h: u32, fmt: Format) -> Result<Vec<u8>, ImageE
         Format::Png => png(rgb, w, h),
         Format::Jpeg => {
             let mut out = Vec::new();
-            JpegEncoder::new_with_quality(&mut out, 90).write_image(
-                rgb,
-                w,
-                h,
-                ExtendedColorType::Rgb8,
-            )?;
+            JpegEncoder::new_with_quality(&mut out, 90).write_image(rgb, w, h, ExtendedColorType::Rgb8)?;
             Ok(out)
         }
         Format::Webp => {

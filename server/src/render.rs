@@ -12,43 +12,19 @@ pub fn render_tile(tex: &Texture, p: &RenderParams, t: &TileSpec) -> Result<RgbW
     let k = tex.native_zoom() - t.z;
     let an = &tex.analysis;
     if t.scale == 1 {
-        return render(
-            an,
-            &p.synth,
-            k,
-            Rect::new(TILE_SIZE * t.x, TILE_SIZE * t.y, TILE_SIZE, TILE_SIZE),
-        );
+        return render(an, &p.synth, k, Rect::new(TILE_SIZE * t.x, TILE_SIZE * t.y, TILE_SIZE, TILE_SIZE));
     }
     let big = 2 * TILE_SIZE;
     if k >= 1 {
-        return render(
-            an,
-            &p.synth,
-            k - 1,
-            Rect::new(big * t.x, big * t.y, big, big),
-        );
+        return render(an, &p.synth, k - 1, Rect::new(big * t.x, big * t.y, big, big));
     }
-    let img = render(
-        an,
-        &p.synth,
-        0,
-        Rect::new(TILE_SIZE * t.x, TILE_SIZE * t.y, TILE_SIZE, TILE_SIZE),
-    )?;
+    let img = render(an, &p.synth, 0, Rect::new(TILE_SIZE * t.x, TILE_SIZE * t.y, TILE_SIZE, TILE_SIZE))?;
     Ok(upscale2(&img))
 }
 
 /// Render a window.
-pub fn render_window(
-    tex: &Texture,
-    p: &RenderParams,
-    w: &WindowSpec,
-) -> Result<RgbWindow, CoreError> {
-    render(
-        &tex.analysis,
-        &p.synth,
-        tex.native_zoom() - w.z,
-        Rect::new(w.x, w.y, w.w, w.h),
-    )
+pub fn render_window(tex: &Texture, p: &RenderParams, w: &WindowSpec) -> Result<RgbWindow, CoreError> {
+    render(&tex.analysis, &p.synth, tex.native_zoom() - w.z, Rect::new(w.x, w.y, w.w, w.h))
 }
 
 fn upscale2(img: &RgbWindow) -> RgbWindow {
@@ -60,9 +36,5 @@ fn upscale2(img: &RgbWindow) -> RgbWindow {
             px.extend_from_slice(&img.pixels[s..s + 3]);
         }
     }
-    RgbWindow {
-        width: 2 * img.width,
-        height: 2 * img.height,
-        pixels: px,
-    }
+    RgbWindow { width: 2 * img.width, height: 2 * img.height, pixels: px }
 }

@@ -38,26 +38,19 @@ pub fn run(args: ServeArgs) -> CliResult {
         return Ok(());
     }
     tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_env("TEXTILE_LOG")
-                .unwrap_or_else(|_| "info".into()),
-        )
+        .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("TEXTILE_LOG").unwrap_or_else(|_| "info".into()))
         .with_writer(std::io::stderr)
         .init();
     rayon::ThreadPoolBuilder::new()
         .num_threads(cfg.worker_threads)
         .thread_name(|i| format!("textile-synth-{i}"))
         .build_global()?;
-    let rt = tokio::runtime::Builder::new_multi_thread()
-        .enable_all()
-        .build()?;
+    let rt = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
     rt.block_on(serve(cfg))
 }
 
 async fn serve(cfg: Config) -> CliResult {
-    let listener = TcpListener::bind(&cfg.bind)
-        .await
-        .map_err(|e| format!("cannot listen on {}: {e}", cfg.bind))?;
+    let listener = TcpListener::bind(&cfg.bind).await.map_err(|e| format!("cannot listen on {}: {e}", cfg.bind))?;
     let addr = listener.local_addr()?;
     let state = Arc::new(AppState::new(cfg));
     let app = crate::http::router(state.clone());
@@ -71,11 +64,8 @@ async fn serve(cfg: Config) -> CliResult {
             })
         })
     };
-    let server = tokio::spawn(async move {
-        axum::serve(listener, app)
-            .with_graceful_shutdown(shutdown_signal())
-            .await
-    });
+    let server =
+        tokio::spawn(async move { axum::serve(listener, app).with_graceful_shutdown(shutdown_signal()).await });
     match loader.await? {
         Ok(()) => {
             let n = state.registry.get().map(|r| r.list.len()).unwrap_or(0);

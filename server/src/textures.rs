@@ -12,18 +12,9 @@ use crate::config::{Config, TextureConfig};
 
 /// Exemplars compiled into the binary (`config/exemplars`, CC0; see LICENSE.md there).
 const EMBEDDED: &[(&str, &[u8])] = &[
-    (
-        "gravel.png",
-        include_bytes!("../../config/exemplars/gravel.png"),
-    ),
-    (
-        "grass.png",
-        include_bytes!("../../config/exemplars/grass.png"),
-    ),
-    (
-        "brick.png",
-        include_bytes!("../../config/exemplars/brick.png"),
-    ),
+    ("gravel.png", include_bytes!("../../config/exemplars/gravel.png")),
+    ("grass.png", include_bytes!("../../config/exemplars/grass.png")),
+    ("brick.png", include_bytes!("../../config/exemplars/brick.png")),
 ];
 
 /// The bytes of an embedded exemplar.
@@ -88,9 +79,7 @@ pub enum LoadError {
         source: std::io::Error,
     },
     /// `embedded:NAME` names no embedded exemplar.
-    #[error(
-        "texture '{id}': no embedded exemplar '{name}' (have: gravel.png, grass.png, brick.png)"
-    )]
+    #[error("texture '{id}': no embedded exemplar '{name}' (have: gravel.png, grass.png, brick.png)")]
     NoEmbedded {
         /// Texture id.
         id: String,
@@ -112,57 +101,34 @@ pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadEr
     if let Some(name) = t.exemplar.strip_prefix("embedded:") {
         return embedded(name)
             .map(|b| b.to_vec())
-            .ok_or_else(|| LoadError::NoEmbedded {
-                id: t.id.clone(),
-                name: name.into(),
-            });
+            .ok_or_else(|| LoadError::NoEmbedded { id: t.id.clone(), name: name.into() });
     }
     let path = cfg.base_dir.join(&t.exemplar);
-    std::fs::read(&path).map_err(|source| LoadError::Read {
-        id: t.id.clone(),
-        path,
-        source,
-    })
+    std::fs::read(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path, source })
 }
 
 /// Load or compute the analysis of every configured texture. `log` receives one line per
 /// event; `progress` receives analysis progress.
-pub fn load_registry(
-    cfg: &Config,
-    log: &dyn Fn(String),
-    progress: &dyn Progress,
-) -> Result<Registry, LoadError> {
+pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress) -> Result<Registry, LoadError> {
     let data_dir = cfg.data_dir();
     let mut list = Vec::new();
     for t in &cfg.textures {
-        let core = |source| LoadError::Core {
-            id: t.id.clone(),
-            source,
-        };
+        let core = |source| LoadError::Core { id: t.id.clone(), source };
         let bytes = exemplar_bytes(cfg, t)?;
-        let opts = ExemplarOptions {
-            max_input_side: cfg.max_exemplar_side,
-            toroidal: t.toroidal.as_option(),
-        };
+        let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
         let ex = Exemplar::from_bytes(&bytes, &opts).map_err(core)?;
         let path = data_dir.join(format!("{}.tex", t.id));
         let expected = Analysis::id_for(&ex);
         let analysis = match Analysis::load(&path) {
             Ok(a) if a.header.id == expected => {
-                log(format!(
-                    "texture '{}': loaded analysis {} from {}",
-                    t.id,
-                    a.header.id,
-                    path.display()
-                ));
+                log(format!("texture '{}': loaded analysis {} from {}", t.id, a.header.id, path.display()));
                 a
             }
             other => {
                 match other {
-                    Ok(_) => log(format!(
-                        "texture '{}': stored analysis is stale (exemplar changed); recomputing",
-                        t.id
-                    )),
+                    Ok(_) => {
+                        log(format!("texture '{}': stored analysis is stale (exemplar changed); recomputing", t.id))
+                    }
                     Err(textile_core::CoreError::Io { .. }) => {
                         log(format!("texture '{}': no stored analysis; computing", t.id))
                     }
@@ -189,10 +155,7 @@ pub fn load_registry(
             id: t.id.clone(),
             source: textile_core::CoreError::ExemplarUndecodable(e.to_string()),
         })?;
-        let mut defaults = SynthParams {
-            seed: t.default_seed,
-            ..SynthParams::default()
-        };
+        let mut defaults = SynthParams { seed: t.default_seed, ..SynthParams::default() };
         if !t.default_randomness.is_empty() {
             defaults.randomness = Randomness::parse(&t.default_randomness).map_err(core)?;
         }
@@ -205,9 +168,6 @@ pub fn load_registry(
             defaults,
         }));
     }
-    let by_id = list
-        .iter()
-        .map(|t| (t.config.id.clone(), t.clone()))
-        .collect();
+    let by_id = list.iter().map(|t| (t.config.id.clone(), t.clone())).collect();
     Ok(Registry { list, by_id })
 }

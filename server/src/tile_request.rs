@@ -36,17 +36,11 @@ pub fn parse_query(raw: Option<&str>, allowed: &[&str]) -> Result<Query, ApiErro
         if !allowed.contains(&k.as_ref()) {
             return Err(ApiError::bad_request(
                 "unknown_parameter",
-                format!(
-                    "unknown query parameter '{k}'; allowed: {}",
-                    allowed.join(", ")
-                ),
+                format!("unknown query parameter '{k}'; allowed: {}", allowed.join(", ")),
             ));
         }
         if q.insert(k.to_string(), v.to_string()).is_some() {
-            return Err(ApiError::bad_request(
-                "invalid_parameter",
-                format!("parameter '{k}' is given more than once"),
-            ));
+            return Err(ApiError::bad_request("invalid_parameter", format!("parameter '{k}' is given more than once")));
         }
     }
     Ok(q)
@@ -70,17 +64,11 @@ impl RenderParams {
 
 /// Resolve a request's parameters against a texture's defaults.
 pub fn render_params(tex: &Texture, q: &Query) -> Result<RenderParams, ApiError> {
-    let mode = q
-        .get("mode")
-        .cloned()
-        .unwrap_or_else(|| tex.config.default_mode.clone());
+    let mode = q.get("mode").cloned().unwrap_or_else(|| tex.config.default_mode.clone());
     if !MODES.contains(&mode.as_str()) {
         return Err(ApiError::bad_request(
             "invalid_parameter",
-            format!(
-                "parameter 'mode': '{mode}' is not available; allowed: {}",
-                MODES.join(", ")
-            ),
+            format!("parameter 'mode': '{mode}' is not available; allowed: {}", MODES.join(", ")),
         ));
     }
     let mut synth = tex.defaults.clone();
@@ -96,20 +84,18 @@ pub fn render_params(tex: &Texture, q: &Query) -> Result<RenderParams, ApiError>
         synth.randomness = Randomness::parse(s).map_err(ApiError::from)?;
     }
     if let Some(s) = q.get("world") {
-        let w: i64 = s.parse().ok().filter(|w: &i64| *w >= 1 && *w <= MAX_WORLD && w.count_ones() == 1).ok_or_else(|| {
-            ApiError::bad_request(
-                "invalid_parameter",
-                format!("parameter 'world': '{s}' is not a power of two from 1 to 2^31 (tiles at the native zoom)"),
-            )
-        })?;
+        let w: i64 =
+            s.parse().ok().filter(|w: &i64| *w >= 1 && *w <= MAX_WORLD && w.count_ones() == 1).ok_or_else(|| {
+                ApiError::bad_request(
+                    "invalid_parameter",
+                    format!("parameter 'world': '{s}' is not a power of two from 1 to 2^31 (tiles at the native zoom)"),
+                )
+            })?;
         synth.period = Some(w * TILE_SIZE);
     }
     if let Some(v) = q.get("v") {
         if v.len() > 64 {
-            return Err(ApiError::bad_request(
-                "invalid_parameter",
-                "parameter 'v': at most 64 characters".into(),
-            ));
+            return Err(ApiError::bad_request("invalid_parameter", "parameter 'v': at most 64 characters".into()));
         }
     }
     synth.validate_for(&tex.analysis).map_err(|e| match e {
@@ -143,16 +129,10 @@ pub struct TileSpec {
 
 fn parse_int(name: &str, s: &str, lo: i64, hi: i64) -> Result<i64, ApiError> {
     let v: i64 = s.parse().map_err(|_| {
-        ApiError::bad_request(
-            "invalid_coordinate",
-            format!("'{name}' = '{s}' is not an integer in [{lo}, {hi}]"),
-        )
+        ApiError::bad_request("invalid_coordinate", format!("'{name}' = '{s}' is not an integer in [{lo}, {hi}]"))
     })?;
     if v < lo || v > hi {
-        return Err(ApiError::bad_request(
-            "invalid_coordinate",
-            format!("'{name}' = {v} is outside [{lo}, {hi}]"),
-        ));
+        return Err(ApiError::bad_request("invalid_coordinate", format!("'{name}' = {v} is outside [{lo}, {hi}]")));
     }
     Ok(v)
 }
@@ -166,10 +146,7 @@ pub fn split_format(s: &str) -> Result<(&str, Format), ApiError> {
         )
     })?;
     let fmt = Format::from_ext(ext).ok_or_else(|| {
-        ApiError::bad_request(
-            "invalid_format",
-            format!("format '{ext}' is not supported; use png, jpg, jpeg or webp"),
-        )
+        ApiError::bad_request("invalid_format", format!("format '{ext}' is not supported; use png, jpg, jpeg or webp"))
     })?;
     Ok((stem, fmt))
 }
@@ -184,13 +161,7 @@ pub fn parse_tile(tex: &Texture, z: &str, x: &str, y_fmt: &str) -> Result<TileSp
     let z = parse_int("z", z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32;
     let x = parse_int("x", x, COORD_MIN, COORD_MAX)?;
     let y = parse_int("y", y, COORD_MIN, COORD_MAX)?;
-    Ok(TileSpec {
-        z,
-        x,
-        y,
-        scale,
-        format,
-    })
+    Ok(TileSpec { z, x, y, scale, format })
 }
 
 /// A window request (`/windows/{id}.{fmt}`).
@@ -211,25 +182,12 @@ pub struct WindowSpec {
 }
 
 /// Query keys of the window endpoint.
-pub const WINDOW_KEYS: &[&str] = &[
-    "mode",
-    "seed",
-    "randomness",
-    "world",
-    "v",
-    "x",
-    "y",
-    "w",
-    "h",
-    "z",
-];
+pub const WINDOW_KEYS: &[&str] = &["mode", "seed", "randomness", "world", "v", "x", "y", "w", "h", "z"];
 
 /// Parse a window request's geometry from its query.
 pub fn parse_window(tex: &Texture, q: &Query, format: Format) -> Result<WindowSpec, ApiError> {
     let need = |k: &str| {
-        q.get(k).ok_or_else(|| {
-            ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required"))
-        })
+        q.get(k).ok_or_else(|| ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required")))
     };
     let z = match q.get("z") {
         Some(z) => parse_int("z", z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32,
@@ -239,12 +197,5 @@ pub fn parse_window(tex: &Texture, q: &Query, format: Format) -> Result<WindowSp
     let y = parse_int("y", need("y")?, -MAX_WINDOW_COORD, MAX_WINDOW_COORD)?;
     let w = parse_int("w", need("w")?, 1, MAX_WINDOW_SIDE)?;
     let h = parse_int("h", need("h")?, 1, MAX_WINDOW_SIDE)?;
-    Ok(WindowSpec {
-        z,
-        x,
-        y,
-        w,
-        h,
-        format,
-    })
+    Ok(WindowSpec { z, x, y, w, h, format })
 }

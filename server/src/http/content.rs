@@ -56,14 +56,8 @@ pub fn not_modified(etag: &str, cache_control: &str) -> Response {
 pub fn image(bytes: Bytes, fmt: Format, etag: &str, cache_control: &str, hit: bool) -> Response {
     let mut r = bytes.into_response();
     let h = r.headers_mut();
-    h.insert(
-        header::CONTENT_TYPE,
-        HeaderValue::from_static(fmt.content_type()),
-    );
+    h.insert(header::CONTENT_TYPE, HeaderValue::from_static(fmt.content_type()));
     common(h, etag, cache_control);
-    h.insert(
-        "x-cache",
-        HeaderValue::from_static(if hit { "HIT" } else { "MISS" }),
-    );
+    h.insert("x-cache", HeaderValue::from_static(if hit { "HIT" } else { "MISS" }));
     r
 }

@@ -23,12 +23,7 @@ pub struct ApiError {
 impl ApiError {
     /// A new error.
     pub fn new(status: StatusCode, code: &'static str, message: impl Into<String>) -> Self {
-        ApiError {
-            status,
-            code,
-            message: message.into(),
-            retry_after: None,
-        }
+        ApiError { status, code, message: message.into(), retry_after: None }
     }
     /// 400.
     pub fn bad_request(code: &'static str, message: String) -> Self {
@@ -36,44 +31,28 @@ impl ApiError {
     }
     /// 404 for a route.
     pub fn not_found_route(path: &str) -> Self {
-        Self::new(
-            StatusCode::NOT_FOUND,
-            "not_found",
-            format!("no route for '{path}'; see /openapi.json"),
-        )
+        Self::new(StatusCode::NOT_FOUND, "not_found", format!("no route for '{path}'; see /openapi.json"))
     }
     /// 404 for a texture id.
     pub fn unknown_texture(id: &str, known: &[String]) -> Self {
         Self::new(
             StatusCode::NOT_FOUND,
             "unknown_texture",
-            format!(
-                "no texture '{}'; available: {}",
-                id.escape_debug(),
-                known.join(", ")
-            ),
+            format!("no texture '{}'; available: {}", id.escape_debug(), known.join(", ")),
         )
     }
     /// 503 while textures are still being prepared.
     pub fn not_ready() -> Self {
         ApiError {
             retry_after: Some(2),
-            ..Self::new(
-                StatusCode::SERVICE_UNAVAILABLE,
-                "not_ready",
-                "textures are still loading",
-            )
+            ..Self::new(StatusCode::SERVICE_UNAVAILABLE, "not_ready", "textures are still loading")
         }
     }
     /// 503 when the synthesis queue is full.
     pub fn overloaded() -> Self {
         ApiError {
             retry_after: Some(1),
-            ..Self::new(
-                StatusCode::SERVICE_UNAVAILABLE,
-                "overloaded",
-                "too many syntheses in flight; retry shortly",
-            )
+            ..Self::new(StatusCode::SERVICE_UNAVAILABLE, "overloaded", "too many syntheses in flight; retry shortly")
         }
     }
     /// 500.
@@ -88,12 +67,8 @@ impl From<CoreError> for ApiError {
         match e {
             CoreError::Param { .. } => Self::new(StatusCode::BAD_REQUEST, "invalid_parameter", msg),
             CoreError::Window { .. } => Self::new(StatusCode::BAD_REQUEST, "invalid_window", msg),
-            CoreError::ExemplarUndecodable(_) => {
-                Self::new(StatusCode::UNPROCESSABLE_ENTITY, "undecodable_image", msg)
-            }
-            CoreError::ExemplarSize { .. } => {
-                Self::new(StatusCode::UNPROCESSABLE_ENTITY, "image_size", msg)
-            }
+            CoreError::ExemplarUndecodable(_) => Self::new(StatusCode::UNPROCESSABLE_ENTITY, "undecodable_image", msg),
+            CoreError::ExemplarSize { .. } => Self::new(StatusCode::UNPROCESSABLE_ENTITY, "image_size", msg),
             CoreError::Io { .. } | CoreError::AnalysisFile { .. } => Self::internal(msg),
         }
     }
@@ -104,11 +79,9 @@ impl IntoResponse for ApiError {
         let body = serde_json::json!({ "error": self.code, "message": self.message });
         let mut r = (self.status, Json(body)).into_response();
         if let Some(s) = self.retry_after {
-            r.headers_mut()
-                .insert(header::RETRY_AFTER, HeaderValue::from(s));
+            r.headers_mut().insert(header::RETRY_AFTER, HeaderValue::from(s));
         }
-        r.headers_mut()
-            .insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+        r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
         r
     }
 }

@@ -90,10 +90,7 @@ pub async fn tile(
         spec.scale,
         spec.format.ext()
     );
-    answer(&st, &headers, key, spec.format, move || {
-        render_tile(&tex, &p, &spec)
-    })
-    .await
+    answer(&st, &headers, key, spec.format, move || render_tile(&tex, &p, &spec)).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -119,11 +116,8 @@ pub async fn window(
     let tex = texture(reg, id)?;
     let q = parse_query(q.as_deref(), WINDOW_KEYS)?;
     let spec = parse_window(&tex, &q, fmt)?;
-    let params: crate::tile_request::Query = q
-        .iter()
-        .filter(|(k, _)| PARAM_KEYS.contains(&k.as_str()))
-        .map(|(k, v)| (k.clone(), v.clone()))
-        .collect();
+    let params: crate::tile_request::Query =
+        q.iter().filter(|(k, _)| PARAM_KEYS.contains(&k.as_str())).map(|(k, v)| (k.clone(), v.clone())).collect();
     let p = render_params(&tex, &params)?;
     let key = format!(
         "{}|{}|{}|{}|window|{}|{}|{}|{}|{}|{}",
@@ -138,8 +132,5 @@ pub async fn window(
         spec.h,
         fmt.ext()
     );
-    answer(&st, &headers, key, fmt, move || {
-        render_window(&tex, &p, &spec)
-    })
-    .await
+    answer(&st, &headers, key, fmt, move || render_window(&tex, &p, &spec)).await
 }

@@ -28,10 +28,7 @@ pub(crate) fn texture(reg: &Registry, id: &str) -> Result<Arc<Texture>, ApiError
 }
 
 fn base_url(st: &AppState, headers: &HeaderMap) -> String {
-    let host = headers
-        .get(header::HOST)
-        .and_then(|h| h.to_str().ok())
-        .unwrap_or(&st.config.bind);
+    let host = headers.get(header::HOST).and_then(|h| h.to_str().ok()).unwrap_or(&st.config.bind);
     format!("http://{host}")
 }
 
@@ -66,10 +63,7 @@ pub async fn ready(State(st): State<Arc<AppState>>) -> Result<Json<Value>, ApiEr
 
 /// The textures served.
 #[utoipa::path(get, path = "/catalog", tag = "textures", responses((status = 200, description = "catalog")))]
-pub async fn catalog(
-    State(st): State<Arc<AppState>>,
-    headers: HeaderMap,
-) -> Result<Json<Value>, ApiError> {
+pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap) -> Result<Json<Value>, ApiError> {
     let reg = st.ready()?;
     let base = base_url(&st, &headers);
     let textures: Vec<Value> = reg
@@ -142,12 +136,8 @@ pub async fn exemplar(
     let Path(id) = path.map_err(path_error)?;
     let t = texture(reg, &id)?;
     let mut r = t.exemplar_png.clone().into_response();
-    r.headers_mut()
-        .insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
-    r.headers_mut().insert(
-        header::CACHE_CONTROL,
-        HeaderValue::from_static("public, max-age=3600"),
-    );
+    r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
+    r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("public, max-age=3600"));
     Ok(r)
 }
 
@@ -170,8 +160,7 @@ pub async fn tilejson(
     let t = texture(reg, &id)?;
     let q = parse_query(raw.as_deref(), PARAM_KEYS)?;
     render_params(&t, &q)?;
-    let version =
-        &blake3::hash(format!("{}|{}", engine_version(), t.file_hash).as_bytes()).to_hex()[..12];
+    let version = &blake3::hash(format!("{}|{}", engine_version(), t.file_hash).as_bytes()).to_hex()[..12];
     let mut qs = form_urlencoded::Serializer::new(String::new());
     qs.append_pair("v", version);
     for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
@@ -198,10 +187,7 @@ pub async fn tilejson(
 /// The OpenAPI 3 document of every route, generated from the handlers' annotations.
 #[derive(OpenApi)]
 #[openapi(
-    info(
-        title = "textile",
-        description = "Infinite, deterministic, example-based texture tiles"
-    ),
+    info(title = "textile", description = "Infinite, deterministic, example-based texture tiles"),
     paths(
         crate::http::meta::health,
         crate::http::meta::ready,
@@ -239,9 +225,6 @@ pub async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
     ApiError::new(
         axum::http::StatusCode::METHOD_NOT_ALLOWED,
         "method_not_allowed",
-        format!(
-            "{method} is not allowed on '{}'; use GET or HEAD",
-            uri.path()
-        ),
+        format!("{method} is not allowed on '{}'; use GET or HEAD", uri.path()),
     )
 }

@@ -29,13 +29,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .allow_origin(if state.config.cors_origins.iter().any(|o| o == "*") {
             AllowOrigin::any()
         } else {
-            AllowOrigin::list(
-                state
-                    .config
-                    .cors_origins
-                    .iter()
-                    .filter_map(|o| HeaderValue::from_str(o).ok()),
-            )
+            AllowOrigin::list(state.config.cors_origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()))
         });
     Router::new()
         .route("/", get(meta::index))
@@ -53,7 +47,5 @@ pub fn router(state: Arc<AppState>) -> Router {
         .with_state(state)
         .layer(CompressionLayer::new())
         .layer(cors)
-        .layer(CatchPanicLayer::custom(|_| {
-            ApiError::internal("the request handler panicked").into_response()
-        }))
+        .layer(CatchPanicLayer::custom(|_| ApiError::internal("the request handler panicked").into_response()))
 }

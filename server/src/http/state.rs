@@ -70,11 +70,7 @@ impl AppState {
         match tokio::time::timeout(wait, rx).await {
             Err(_) => Err(ApiError {
                 retry_after: Some(5),
-                ..ApiError::new(
-                    axum::http::StatusCode::SERVICE_UNAVAILABLE,
-                    "timeout",
-                    "synthesis took too long",
-                )
+                ..ApiError::new(axum::http::StatusCode::SERVICE_UNAVAILABLE, "timeout", "synthesis took too long")
             }),
             Ok(Err(_)) | Ok(Ok(Err(_))) => Err(ApiError::internal("synthesis failed unexpectedly")),
             Ok(Ok(Ok(r))) => r.map(Bytes::from),
