@@ -2,13 +2,10 @@
 //! near a non-toroidal border, its best match away from the border) and its best match at least
 //! 5 % of the exemplar away. Exact nearest neighbours in the 7×7 PCA space with a k-d tree.
 
-use std::num::NonZeroUsize;
-
-use kiddo::immutable::float::kdtree::ImmutableKdTree;
-use kiddo::SquaredEuclidean;
 use rayon::prelude::*;
 
 use crate::features::SEARCH_DIMS;
+use crate::kdtree::KdTree;
 
 /// Geometry of one level's candidate problem.
 pub struct CandidateRules {
@@ -52,53 +49,17 @@ impl CandidateRules {
 
 /// Compute `[C_1(u), C_2(u)]` (texel indices `y·m + x`) for every texel `u`.
 pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules) -> Vec<[u32; 2]> {
-    let inner: Vec<usize> = (0..feats.len()).filter(|&i| !rules.is_border(i)).collect();
-    let points: Vec<[f64; SEARCH_DIMS]> = inner.iter().map(|&i| feats[i]).collect();
-    let tree: ImmutableKdTree<f64, u64, SEARCH_DIMS, 32> = ImmutableKdTree::new_from_slice(&points);
-    let dist = |a: &[f64; SEARCH_DIMS], b: &[f64; SEARCH_DIMS]| -> f64 {
-        a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
-    };
+    let inner: Vec<([f64; SEARCH_DIMS], u32)> =
+        (0..feats.len()).filter(|&i| !rules.is_border(i)).map(|i| (feats[i], i as u32)).collect();
+    let tree = KdTree::new(inner);
     (0..feats.len())
         .into_par_iter()
         .map(|u| {
             let q = &feats[u];
-            let mut tries = [48usize, 1024];
-            let c1 = if rules.is_border(u) {
-                let n = tree.nearest_one::<SquaredEuclidean>(q);
-                inner[n.item as usize]
-            } else {
-                u
-            };
-            let mut c2 = None;
-            for n in tries.iter_mut() {
-                let n = (*n).min(points.len()).max(1);
-                let mut found =
-                    tree.nearest_n::<SquaredEuclidean>(q, NonZeroUsize::new(n).unwrap_or(NonZeroUsize::MIN));
-                found.sort_by(|a, b| {
-                    a.distance.total_cmp(&b.distance).then(inner[a.item as usize].cmp(&inner[b.item as usize]))
-                });
-                if let Some(f) = found.iter().find(|f| rules.far_enough(inner[f.item as usize], c1)) {
-                    c2 = Some(inner[f.item as usize]);
-                    break;
-                }
-                if n == points.len() {
-                    break;
-                }
-            }
-            let c2 = c2.unwrap_or_else(|| {
-                // Exhaustive fallback (tiny exemplars): best far-enough texel, ties by index.
-                let mut best: Option<(f64, usize)> = None;
-                for &v in &inner {
-                    if rules.far_enough(v, c1) {
-                        let d = dist(q, &feats[v]);
-                        if best.is_none_or(|(bd, _)| d < bd) {
-                            best = Some((d, v));
-                        }
-                    }
-                }
-                best.map(|b| b.1).unwrap_or(c1)
-            });
-            [c1 as u32, c2 as u32]
+            let c1 =
+                if rules.is_border(u) { tree.nearest(q, |_| true).map(|b| b.1).unwrap_or(u as u32) } else { u as u32 };
+            let c2 = tree.nearest(q, |v| rules.far_enough(v as usize, c1 as usize)).map(|b| b.1).unwrap_or(c1);
+            [c1, c2]
         })
         .collect()
 }

@@ -37,6 +37,7 @@ pub mod exemplar;
 pub mod features;
 pub mod geom;
 pub mod hash;
+pub mod kdtree;
 pub mod params;
 pub mod plan;
 pub mod render;

@@ -1,0 +1,118 @@
+//! An exact k-d tree for the candidate search (design note §1.2d, §3): nearest neighbour under a
+//! predicate, so the 5 % separation rule is applied during the search instead of by retrying
+//! ever larger k-nearest queries (which degrades to brute force on blurred coarse levels, where
+//! every near match is a spatial neighbour). Deterministic: ties go to the smallest item.
+
+/// Points per leaf.
+const LEAF: usize = 16;
+
+enum Node {
+    Leaf { start: usize, end: usize },
+    Split { dim: usize, value: f64, left: usize, right: usize },
+}
+
+/// A static k-d tree over `D`-dimensional points, each tagged with an item number.
+pub struct KdTree<const D: usize> {
+    points: Vec<[f64; D]>,
+    items: Vec<u32>,
+    nodes: Vec<Node>,
+}
+
+impl<const D: usize> KdTree<D> {
+    /// Build over `(point, item)` pairs. Median splits on the widest dimension.
+    pub fn new(mut entries: Vec<([f64; D], u32)>) -> Self {
+        let mut nodes = Vec::new();
+        let n = entries.len();
+        build(&mut entries, 0, n, &mut nodes);
+        let (points, items) = entries.into_iter().unzip();
+        KdTree { points, items, nodes }
+    }
+
+    /// The item nearest to `q` (squared Euclidean distance) among those `keep` accepts, with its
+    /// distance; ties go to the smallest item. `None` if no item is accepted.
+    pub fn nearest(&self, q: &[f64; D], keep: impl Fn(u32) -> bool) -> Option<(f64, u32)> {
+        let mut best = (f64::INFINITY, u32::MAX);
+        if !self.nodes.is_empty() {
+            self.search(0, q, &keep, &mut best);
+        }
+        (best.1 != u32::MAX).then_some(best)
+    }
+
+    fn search(&self, node: usize, q: &[f64; D], keep: &impl Fn(u32) -> bool, best: &mut (f64, u32)) {
+        match self.nodes[node] {
+            Node::Leaf { start, end } => {
+                for i in start..end {
+                    let p = &self.points[i];
+                    let mut d = 0.0;
+                    for k in 0..D {
+                        let e = p[k] - q[k];
+                        d += e * e;
+                    }
+                    let item = self.items[i];
+                    if (d < best.0 || (d == best.0 && item < best.1)) && keep(item) {
+                        *best = (d, item);
+                    }
+                }
+            }
+            Node::Split { dim, value, left, right } => {
+                let diff = q[dim] - value;
+                let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
+                self.search(near, q, keep, best);
+                if diff * diff <= best.0 {
+                    self.search(far, q, keep, best);
+                }
+            }
+        }
+    }
+}
+
+fn build<const D: usize>(e: &mut [([f64; D], u32)], start: usize, end: usize, nodes: &mut Vec<Node>) -> usize {
+    let id = nodes.len();
+    if end - start <= LEAF {
+        nodes.push(Node::Leaf { start, end });
+        return id;
+    }
+    let slice = &mut e[start..end];
+    let mut dim = 0;
+    let mut widest = -1.0;
+    for k in 0..D {
+        let (lo, hi) =
+            slice.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.0[k]), hi.max(p.0[k])));
+        if hi - lo > widest {
+            widest = hi - lo;
+            dim = k;
+        }
+    }
+    let mid = slice.len() / 2;
+    slice.select_nth_unstable_by(mid, |a, b| a.0[dim].total_cmp(&b.0[dim]).then(a.1.cmp(&b.1)));
+    let value = slice[mid].0[dim];
+    nodes.push(Node::Split { dim, value, left: 0, right: 0 });
+    // Left: points ordered before the median (coordinate ≤ value); right: the rest (≥ value).
+    let left = build(e, start, start + mid, nodes);
+    let right = build(e, start + mid, end, nodes);
+    nodes[id] = Node::Split { dim, value, left, right };
+    id
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn matches_brute_force_with_a_predicate() {
+        let pts: Vec<[f64; 3]> =
+            (0..500u32).map(|i| [((i * 37) % 101) as f64, ((i * 53) % 97) as f64, ((i * 11) % 7) as f64]).collect();
+        let tree = KdTree::new(pts.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect());
+        for qi in 0..60u32 {
+            let q = [(qi * 13 % 100) as f64 + 0.5, (qi * 29 % 90) as f64, (qi % 7) as f64];
+            let keep = |i: u32| i % 3 != qi % 3;
+            let brute = pts
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| keep(*i as u32))
+                .map(|(i, p)| (p.iter().zip(&q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>(), i as u32))
+                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            assert_eq!(tree.nearest(&q, keep), brute);
+        }
+    }
+}
