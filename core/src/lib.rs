@@ -14,6 +14,9 @@
 //! 4. [`synth`] — upsample, jitter by a [`hash`] of absolute coordinates, correct;
 //! 5. [`render`] — exemplar coordinates to colours, at native or zoomed-out scale.
 //!
+//! The cheap mode, [`mosaic`], is Xu, Guo & Shum's chaos mosaic: the tiled exemplar with blocks
+//! moved by the cat map, evaluated lazily for any window.
+//!
 //! ```
 //! use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress, Rect, SynthParams, render};
 //!
@@ -38,6 +41,7 @@ pub mod features;
 pub mod geom;
 pub mod hash;
 pub mod kdtree;
+pub mod mosaic;
 pub mod params;
 pub mod plan;
 pub mod render;
@@ -48,6 +52,7 @@ pub use analysis::{Analysis, AnalysisHeader, NoProgress, Progress, ALGORITHM_VER
 pub use error::{AnalysisFileProblem, CoreError, Result};
 pub use exemplar::{Exemplar, ExemplarOptions};
 pub use geom::Rect;
+pub use mosaic::MosaicParams;
 pub use params::{Randomness, SynthParams};
 pub use render::{render, RgbWindow};
 pub use synth::{synthesize, CoordWindow};

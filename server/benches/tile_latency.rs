@@ -1,8 +1,9 @@
 //! End-to-end tile latency and encoding cost (issue: tile server). Starts the real `textile`
 //! binary on a free loopback port, then with one connection, one request at a time:
 //! * cold: N distinct, never-requested native tiles (synthesis + PNG + HTTP);
-//! * cached: the same N tiles again (cache hits);
-//! and in-process: PNG/JPEG/WebP encode time of one synthesized 256² tile.
+//! * cached: the same N tiles again (cache hits).
+//!
+//! In process it also times one 256² synthesis and the PNG/JPEG/WebP encoding of a tile.
 //! Prints median / p90 / p99 / max per figure.
 //!
 //! `cargo bench -p textile-server --bench tile_latency [-- N]` (default N = 1000)

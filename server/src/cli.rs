@@ -102,9 +102,18 @@ pub struct RenderArgs {
     /// A window instead of a tile: X,Y,W,H in pixels at zoom --z.
     #[arg(long, value_name = "X,Y,W,H", allow_hyphen_values = true)]
     pub window: Option<String>,
+    /// Engine: synth (parallel controllable synthesis) or mosaic (chaos mosaic).
+    #[arg(long, default_value = "synth", value_parser = ["synth", "mosaic"])]
+    pub mode: String,
     /// Seed.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Mosaic: cat-map iterations (0 = plain tiling).
+    #[arg(long)]
+    pub iterations: Option<u32>,
+    /// Mosaic: pixel layers smoothed at block edges (0-3).
+    #[arg(long)]
+    pub smoothing: Option<u32>,
     /// Randomness: one value in [0,1] or a comma list, one per level (coarse to fine).
     #[arg(long)]
     pub randomness: Option<String>,

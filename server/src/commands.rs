@@ -139,7 +139,19 @@ pub fn render(a: RenderArgs) -> CliResult {
         .and_then(|e| e.to_str())
         .and_then(Format::from_ext)
         .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
-    let p = RenderParams { mode: "synth".into(), synth };
+    let p = if a.mode == "mosaic" {
+        let m = textile_core::MosaicParams {
+            seed: synth.seed,
+            period: synth.period,
+            iterations: a.iterations.unwrap_or(10),
+            smoothing: a.smoothing.unwrap_or(3),
+            ..Default::default()
+        };
+        m.validate_for(&tex.analysis)?;
+        RenderParams::Mosaic(m)
+    } else {
+        RenderParams::Synth(synth)
+    };
     let img = if let Some(win) = &a.window {
         let v: Vec<i64> = win
             .split(',')

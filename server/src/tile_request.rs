@@ -3,14 +3,14 @@
 
 use std::collections::BTreeMap;
 
-use textile_core::{Randomness, SynthParams};
+use textile_core::{MosaicParams, Randomness, SynthParams};
 
 use crate::encode::Format;
 use crate::http::error::ApiError;
 use crate::textures::Texture;
 
 /// Synthesis modes served.
-pub const MODES: &[&str] = &["synth"];
+pub const MODES: &[&str] = &["synth", "mosaic"];
 /// Tile side in pixels (`@2x` tiles are twice that).
 pub const TILE_SIZE: i64 = 256;
 /// Smallest tile coordinate.
@@ -24,7 +24,7 @@ pub const MAX_WINDOW_COORD: i64 = 1 << 40;
 /// Largest `world` (tiles at native zoom).
 pub const MAX_WORLD: i64 = 1 << 31;
 /// Query parameters every image endpoint accepts.
-pub const PARAM_KEYS: &[&str] = &["mode", "seed", "randomness", "world", "v"];
+pub const PARAM_KEYS: &[&str] = &["mode", "seed", "randomness", "world", "v", "iterations", "block_area", "smoothing"];
 
 /// Parsed, de-duplicated query parameters.
 pub type Query = BTreeMap<String, String>;
@@ -46,70 +46,123 @@ pub fn parse_query(raw: Option<&str>, allowed: &[&str]) -> Result<Query, ApiErro
     Ok(q)
 }
 
-/// Mode and synthesis parameters of a request.
+/// The engine and its parameters for a request.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct RenderParams {
-    /// Synthesis mode.
-    pub mode: String,
-    /// Engine parameters.
-    pub synth: SynthParams,
+pub enum RenderParams {
+    /// Parallel controllable synthesis.
+    Synth(SynthParams),
+    /// Chaos mosaic.
+    Mosaic(MosaicParams),
 }
 
 impl RenderParams {
     /// Canonical form for cache keys and ETags.
     pub fn canonical(&self) -> String {
-        format!("mode={};{}", self.mode, self.synth.canonical())
+        match self {
+            RenderParams::Synth(p) => format!("mode=synth;{}", p.canonical()),
+            RenderParams::Mosaic(p) => format!("mode=mosaic;{}", p.canonical()),
+        }
     }
+
+    /// The mode's name.
+    pub fn mode(&self) -> &'static str {
+        match self {
+            RenderParams::Synth(_) => "synth",
+            RenderParams::Mosaic(_) => "mosaic",
+        }
+    }
+}
+
+fn invalid(message: String) -> ApiError {
+    ApiError::bad_request("invalid_parameter", message)
+}
+
+fn parse_u32(name: &str, s: &str, max: u32) -> Result<u32, ApiError> {
+    s.parse()
+        .ok()
+        .filter(|v| *v <= max)
+        .ok_or_else(|| invalid(format!("parameter '{name}': '{s}' is not an integer in 0..={max}")))
 }
 
 /// Resolve a request's parameters against a texture's defaults.
 pub fn render_params(tex: &Texture, q: &Query) -> Result<RenderParams, ApiError> {
     let mode = q.get("mode").cloned().unwrap_or_else(|| tex.config.default_mode.clone());
-    if !MODES.contains(&mode.as_str()) {
-        return Err(ApiError::bad_request(
-            "invalid_parameter",
-            format!("parameter 'mode': '{mode}' is not available; allowed: {}", MODES.join(", ")),
-        ));
-    }
-    let mut synth = tex.defaults.clone();
-    if let Some(s) = q.get("seed") {
-        synth.seed = s.parse().map_err(|_| {
-            ApiError::bad_request(
-                "invalid_parameter",
-                format!("parameter 'seed': '{s}' is not an integer in 0..=18446744073709551615"),
-            )
-        })?;
-    }
-    if let Some(s) = q.get("randomness") {
-        synth.randomness = Randomness::parse(s).map_err(ApiError::from)?;
-    }
-    if let Some(s) = q.get("world") {
-        let w: i64 =
-            s.parse().ok().filter(|w: &i64| *w >= 1 && *w <= MAX_WORLD && w.count_ones() == 1).ok_or_else(|| {
-                ApiError::bad_request(
-                    "invalid_parameter",
-                    format!("parameter 'world': '{s}' is not a power of two from 1 to 2^31 (tiles at the native zoom)"),
-                )
-            })?;
-        synth.period = Some(w * TILE_SIZE);
-    }
-    if let Some(v) = q.get("v") {
-        if v.len() > 64 {
-            return Err(ApiError::bad_request("invalid_parameter", "parameter 'v': at most 64 characters".into()));
+    let only = |keys: &[&str], m: &str| -> Result<(), ApiError> {
+        match keys.iter().find(|k| q.contains_key(**k)) {
+            Some(k) => Err(invalid(format!("parameter '{k}' does not apply to mode={mode}; it is for mode={m}"))),
+            None => Ok(()),
         }
+    };
+    let seed =
+        match q.get("seed") {
+            Some(s) => Some(s.parse::<u64>().map_err(|_| {
+                invalid(format!("parameter 'seed': '{s}' is not an integer in 0..=18446744073709551615"))
+            })?),
+            None => None,
+        };
+    let period = match q.get("world") {
+        Some(s) => {
+            let w: i64 =
+                s.parse().ok().filter(|w: &i64| *w >= 1 && *w <= MAX_WORLD && w.count_ones() == 1).ok_or_else(
+                    || {
+                        invalid(format!(
+                            "parameter 'world': '{s}' is not a power of two from 1 to 2^31 (tiles at the native zoom)"
+                        ))
+                    },
+                )?;
+            Some(w * TILE_SIZE)
+        }
+        None => None,
+    };
+    if q.get("v").is_some_and(|v| v.len() > 64) {
+        return Err(invalid("parameter 'v': at most 64 characters".into()));
     }
-    synth.validate_for(&tex.analysis).map_err(|e| match e {
-        textile_core::CoreError::Param { name: "period", .. } => ApiError::bad_request(
-            "invalid_parameter",
-            format!(
-                "parameter 'world': the period must be at least the exemplar side ({} texels), so world >= {}",
-                tex.analysis.side(),
-                (tex.analysis.side() as i64 / TILE_SIZE).max(1)
-            ),
-        ),
+    let world_error = |e: textile_core::CoreError| match e {
+        textile_core::CoreError::Param { name: "period", .. } => invalid(format!(
+            "parameter 'world': the period must be at least the exemplar side ({} texels), so world >= {}",
+            tex.analysis.side(),
+            (tex.analysis.side() as i64 / TILE_SIZE).max(1)
+        )),
         other => ApiError::from(other),
-    })?;
-    Ok(RenderParams { mode, synth })
+    };
+    match mode.as_str() {
+        "synth" => {
+            only(&["iterations", "block_area", "smoothing"], "mosaic")?;
+            let mut p = tex.defaults.clone();
+            p.seed = seed.unwrap_or(p.seed);
+            p.period = period;
+            if let Some(s) = q.get("randomness") {
+                p.randomness = Randomness::parse(s).map_err(ApiError::from)?;
+            }
+            p.validate_for(&tex.analysis).map_err(world_error)?;
+            Ok(RenderParams::Synth(p))
+        }
+        "mosaic" => {
+            only(&["randomness"], "synth")?;
+            let mut p = MosaicParams { seed: seed.unwrap_or(tex.defaults.seed), period, ..MosaicParams::default() };
+            if let Some(s) = q.get("iterations") {
+                p.iterations = parse_u32("iterations", s, textile_core::mosaic::MAX_ITERATIONS)?;
+            }
+            if let Some(s) = q.get("smoothing") {
+                p.smoothing = parse_u32("smoothing", s, textile_core::mosaic::MAX_SMOOTHING)?;
+            }
+            if let Some(s) = q.get("block_area") {
+                let msg = || {
+                    invalid(format!("parameter 'block_area': '{s}' must be MIN,MAX fractions of the exemplar area with 0.05 <= MIN <= MAX <= 1"))
+                };
+                let (a, b) = s.split_once(',').ok_or_else(msg)?;
+                let f = |v: &str| v.trim().parse::<f64>().ok().filter(|x| x.is_finite()).map(|x| (x * 1000.0).round());
+                let (a, b) = (f(a).ok_or_else(msg)?, f(b).ok_or_else(msg)?);
+                if !(50.0..=1000.0).contains(&a) || !(a..=1000.0).contains(&b) {
+                    return Err(msg());
+                }
+                (p.area_min, p.area_max) = (a as u32, b as u32);
+            }
+            p.validate_for(&tex.analysis).map_err(world_error)?;
+            Ok(RenderParams::Mosaic(p))
+        }
+        _ => Err(invalid(format!("parameter 'mode': '{mode}' is not available; allowed: {}", MODES.join(", ")))),
+    }
 }
 
 /// A tile address.
@@ -182,7 +235,8 @@ pub struct WindowSpec {
 }
 
 /// Query keys of the window endpoint.
-pub const WINDOW_KEYS: &[&str] = &["mode", "seed", "randomness", "world", "v", "x", "y", "w", "h", "z"];
+pub const WINDOW_KEYS: &[&str] =
+    &["mode", "seed", "randomness", "world", "v", "iterations", "block_area", "smoothing", "x", "y", "w", "h", "z"];
 
 /// Parse a window request's geometry from its query.
 pub fn parse_window(tex: &Texture, q: &Query, format: Format) -> Result<WindowSpec, ApiError> {

@@ -113,6 +113,7 @@ pub async fn texture_meta(
         "parameters": {
             "seed": { "default": t.defaults.seed, "min": 0, "max": u64::MAX },
             "randomness": {
+                "modes": ["synth"],
                 "default": t.defaults.randomness.resolve(levels).iter().map(|&r| r as f64 / 65536.0).collect::<Vec<_>>(),
                 "min": 0.0, "max": 1.0, "values": levels + 1,
                 "description": "one value for every level or a comma list of one per level, coarse to fine",
@@ -120,6 +121,10 @@ pub async fn texture_meta(
             "world": { "default": null, "min": (h.side as i64 / crate::tile_request::TILE_SIZE).max(1),
                        "max": crate::tile_request::MAX_WORLD, "description": "power of two: period in native tiles" },
             "mode": { "default": t.config.default_mode, "values": MODES },
+            "iterations": { "default": 10, "min": 0, "max": textile_core::mosaic::MAX_ITERATIONS, "modes": ["mosaic"] },
+            "smoothing": { "default": 3, "min": 0, "max": textile_core::mosaic::MAX_SMOOTHING, "modes": ["mosaic"] },
+            "block_area": { "default": [0.5, 0.75], "min": 0.05, "max": 1.0, "modes": ["mosaic"],
+                            "description": "MIN,MAX block area as fractions of the exemplar area" },
         },
     })))
 }

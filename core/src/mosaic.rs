@@ -1,0 +1,393 @@
+//! Chaos mosaic (Xu, Guo & Shum; design note §4): the cheap mode. The exemplar is tiled; every
+//! tile contributes one block of the exemplar (area between the paper's bounds) moved by the cat
+//! map inside its super-tile and pasted over the tiling, higher priority on top; block and tile
+//! edges are smoothed over three pixel layers. Everything is a function of absolute
+//! coordinates, so any window equals the same pixels cut from any larger one.
+
+use crate::analysis::Analysis;
+use crate::error::{CoreError, Result};
+use crate::geom::Rect;
+use crate::hash::hash;
+use crate::params::MAX_PERIOD;
+use crate::render::RgbWindow;
+
+/// Domain tag of block geometry.
+pub const TAG_MOSAIC_BLOCK: u64 = 0x4D4F_5341_4943_0001;
+/// Domain tag of block priority.
+pub const TAG_MOSAIC_PRIO: u64 = 0x4D4F_5341_4943_0002;
+/// Tiles per super-tile side (the cat map's torus is `SUPER·n` texels).
+pub const SUPER: i64 = 16;
+/// Largest number of cat-map iterations accepted.
+pub const MAX_ITERATIONS: u32 = 64;
+/// Smoothing layers at most (the tent filter is 7×7).
+pub const MAX_SMOOTHING: u32 = 3;
+/// Largest native window, in pixels, one call may evaluate (2^26).
+pub const MAX_PIXELS: i64 = 1 << 26;
+
+/// Validated mosaic parameters.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct MosaicParams {
+    /// Selects another arrangement of blocks.
+    pub seed: u64,
+    /// Cat-map iterations (0 = blocks stay in place: the plain tiling).
+    pub iterations: u32,
+    /// Smallest block area, per mille of the exemplar area.
+    pub area_min: u32,
+    /// Largest block area, per mille of the exemplar area.
+    pub area_max: u32,
+    /// Pixel layers smoothed on each side of block and tile edges (0–3).
+    pub smoothing: u32,
+    /// Optional period in texels (power of two ≥ the exemplar side): a mosaic on a torus.
+    pub period: Option<i64>,
+}
+
+impl Default for MosaicParams {
+    fn default() -> Self {
+        MosaicParams { seed: 0, iterations: 10, area_min: 500, area_max: 750, smoothing: 3, period: None }
+    }
+}
+
+impl MosaicParams {
+    /// Check ranges against an analysis.
+    pub fn validate_for(&self, an: &Analysis) -> Result<()> {
+        let bad = |name, message: String| Err(CoreError::Param { name, message });
+        if self.iterations > MAX_ITERATIONS {
+            return bad("iterations", format!("{} is outside 0..={MAX_ITERATIONS}", self.iterations));
+        }
+        if !(50..=1000).contains(&self.area_min) || !(self.area_min..=1000).contains(&self.area_max) {
+            return bad(
+                "block_area",
+                format!(
+                    "{},{} must be two fractions of the exemplar area with 0.05 <= min <= max <= 1",
+                    self.area_min as f64 / 1000.0,
+                    self.area_max as f64 / 1000.0
+                ),
+            );
+        }
+        if self.smoothing > MAX_SMOOTHING {
+            return bad("smoothing", format!("{} is outside 0..={MAX_SMOOTHING}", self.smoothing));
+        }
+        if let Some(p) = self.period {
+            let n = an.side() as i64;
+            if p < n || p > MAX_PERIOD || p.count_ones() != 1 {
+                return bad("period", format!("must be a power of two from {n} (the exemplar side) to 2^40 texels"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Canonical text form for cache keys and ETags.
+    pub fn canonical(&self) -> String {
+        format!(
+            "seed={};it={};area={},{};smooth={};period={}",
+            self.seed,
+            self.iterations,
+            self.area_min,
+            self.area_max,
+            self.smoothing,
+            self.period.map(|p| p.to_string()).unwrap_or_else(|| "none".into())
+        )
+    }
+}
+
+/// One pasted block: source rect in the exemplar, absolute destination, priority.
+#[derive(Debug, Clone, Copy)]
+struct Block {
+    sx: i64,
+    sy: i64,
+    w: i64,
+    h: i64,
+    dx: i64,
+    dy: i64,
+    prio: (u64, i64, i64),
+}
+
+/// Block geometry and placement for a plane of `n`-texel tiles.
+struct Layout {
+    n: i64,
+    tiles: i64,    // tiles per super-tile side
+    span: i64,     // texels per super-tile side
+    cat: [u64; 4], // A^iterations mod span
+    period_tiles: Option<i64>,
+    p: MosaicParams,
+}
+
+impl Layout {
+    fn new(n: i64, p: &MosaicParams) -> Layout {
+        let period_tiles = p.period.map(|per| per / n);
+        let tiles = period_tiles.map_or(SUPER, |t| t.min(SUPER));
+        let span = tiles * n;
+        let mask = span as u64 - 1;
+        let mut cat = [1u64, 0, 0, 1];
+        for _ in 0..p.iterations {
+            // cat · [[1,1],[1,2]]
+            let [a, b, c, d] = cat;
+            cat = [(a + b) & mask, (a + 2 * b) & mask, (c + d) & mask, (c + 2 * d) & mask];
+        }
+        Layout { n, tiles, span, cat, period_tiles, p: p.clone() }
+    }
+
+    /// The block of absolute tile `(k1, k2)`.
+    fn block(&self, k1: i64, k2: i64) -> Block {
+        let (h1, h2) = match self.period_tiles {
+            Some(t) => (k1.rem_euclid(t), k2.rem_euclid(t)),
+            None => (k1, k2),
+        };
+        let z = hash(TAG_MOSAIC_BLOCK, self.p.seed, h1, h2, 0);
+        let n = self.n;
+        let rho = self.p.area_min as f64 + (((z & 0xFFFF) * (self.p.area_max - self.p.area_min) as u64) >> 16) as f64;
+        let rho = rho / 1000.0;
+        // Aspect in [2/3, 3/2], symmetric in log scale (α and 1/α equally likely).
+        let u = ((z >> 16) & 0xFFFF) as f64 / 32768.0 - 1.0;
+        let alpha = if u >= 0.0 { 1.0 + 0.5 * u } else { 1.0 / (1.0 - 0.5 * u) };
+        let w = ((n as f64 * (rho * alpha).sqrt()).round() as i64).clamp(1, n);
+        let h = ((n as f64 * (rho / alpha).sqrt()).round() as i64).clamp(1, n);
+        let sx = (((z >> 32) & 0xFFFF) as i64 * (n - w + 1)) >> 16;
+        let sy = (((z >> 48) & 0xFFFF) as i64 * (n - h + 1)) >> 16;
+        let (s1, s2) = (k1.div_euclid(self.tiles), k2.div_euclid(self.tiles));
+        let (a1, a2) = (k1.rem_euclid(self.tiles), k2.rem_euclid(self.tiles));
+        let (x0, y0) = ((sx + a1 * n) as u64, (sy + a2 * n) as u64);
+        let mask = self.span as u64 - 1;
+        let [a, b, c, d] = self.cat;
+        let s = (a.wrapping_mul(x0).wrapping_add(b.wrapping_mul(y0))) & mask;
+        let t = (c.wrapping_mul(x0).wrapping_add(d.wrapping_mul(y0))) & mask;
+        let prio = hash(TAG_MOSAIC_PRIO, self.p.seed, h1, h2, 0);
+        Block { sx, sy, w, h, dx: s1 * self.span + s as i64, dy: s2 * self.span + t as i64, prio: (prio, k2, k1) }
+    }
+
+    /// Every block whose destination meets `r`, in ascending priority.
+    fn blocks_meeting(&self, r: Rect) -> Vec<Block> {
+        // A block lies within its super-tile or spills at most n−1 texels right/down.
+        let lo = |v: i64| (v - self.n).div_euclid(self.span);
+        let hi = |v: i64| (v - 1).div_euclid(self.span);
+        let mut out = Vec::new();
+        for s2 in lo(r.y0)..=hi(r.y1) {
+            for s1 in lo(r.x0)..=hi(r.x1) {
+                for a2 in 0..self.tiles {
+                    for a1 in 0..self.tiles {
+                        let b = self.block(s1 * self.tiles + a1, s2 * self.tiles + a2);
+                        if b.dx < r.x1 && b.dx + b.w > r.x0 && b.dy < r.y1 && b.dy + b.h > r.y0 {
+                            out.push(b);
+                        }
+                    }
+                }
+            }
+        }
+        out.sort_by_key(|b| b.prio);
+        out
+    }
+}
+
+/// Labels (which block or background tile shows) and source texels over a rect, on a grid of
+/// sample points `origin + step·(i, j) + offset`.
+struct Paint {
+    label: Vec<u64>,
+    src: Vec<u32>,
+}
+
+fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) -> Paint {
+    let n = layout.n;
+    let (w, h) = (rect.width() as usize, rect.height() as usize);
+    let mut label = vec![0u64; w * h];
+    let mut src = vec![0u32; w * h];
+    for j in 0..h {
+        let y = (rect.y0 + j as i64) * step + offset;
+        for i in 0..w {
+            let x = (rect.x0 + i as i64) * step + offset;
+            let (tx, ty) = (x.div_euclid(n), y.div_euclid(n));
+            label[j * w + i] =
+                if toroidal { 1 << 63 } else { (1 << 63) | (((ty & 0x7FFF_FFFF) << 31) ^ (tx & 0x7FFF_FFFF)) as u64 };
+            src[j * w + i] = (x.rem_euclid(n) | (y.rem_euclid(n) << 16)) as u32;
+        }
+    }
+    // Texel extent of the sample grid.
+    let tex = Rect {
+        x0: rect.x0 * step + offset,
+        y0: rect.y0 * step + offset,
+        x1: (rect.x1 - 1) * step + offset + 1,
+        y1: (rect.y1 - 1) * step + offset + 1,
+    };
+    for (id, b) in layout.blocks_meeting(tex).iter().enumerate() {
+        // Sample indices whose texel lies in the block.
+        // Sample i shows texel i·step + offset: the first index at or after texel d, and one
+        // past the last index before texel e.
+        let first = |d: i64| (d - offset).div_euclid(step) + i64::from((d - offset).rem_euclid(step) != 0);
+        let end = |e: i64| (e - 1 - offset).div_euclid(step) + 1;
+        let (i0, i1) = (first(b.dx).max(rect.x0), end(b.dx + b.w).min(rect.x1));
+        let (j0, j1) = (first(b.dy).max(rect.y0), end(b.dy + b.h).min(rect.y1));
+        for j in j0..j1 {
+            let y = j * step + offset;
+            let row = (j - rect.y0) as usize * w;
+            for i in i0..i1 {
+                let x = i * step + offset;
+                let k = row + (i - rect.x0) as usize;
+                label[k] = id as u64;
+                src[k] = ((b.sx + x - b.dx) | ((b.sy + y - b.dy) << 16)) as u32;
+            }
+        }
+    }
+    Paint { label, src }
+}
+
+/// Render `rect` of the mosaic viewed `zoom_out` steps coarser than native.
+pub fn render(an: &Analysis, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    p.validate_for(an)?;
+    let scale = 1i64.checked_shl(zoom_out.min(62)).unwrap_or(i64::MAX);
+    if rect.is_empty() || rect.area() > MAX_PIXELS || (zoom_out <= 3 && rect.area() * scale * scale > MAX_PIXELS) {
+        return Err(CoreError::Window {
+            width: rect.width(),
+            height: rect.height(),
+            message: format!("must be non-empty with at most {MAX_PIXELS} pixels at native scale"),
+        });
+    }
+    let layout = Layout::new(an.side() as i64, p);
+    if zoom_out == 0 {
+        return Ok(native(an, &layout, rect));
+    }
+    if zoom_out <= 3 {
+        // Exact: the box average of the native pixels.
+        let big = native(
+            an,
+            &layout,
+            Rect { x0: rect.x0 * scale, y0: rect.y0 * scale, x1: rect.x1 * scale, y1: rect.y1 * scale },
+        );
+        return Ok(box_down(&big, scale as usize));
+    }
+    Ok(sampled(an, &layout, zoom_out, rect))
+}
+
+fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
+    let n = layout.n as usize;
+    let s = layout.p.smoothing as i64;
+    let g = rect.grow(4);
+    let pt = paint(layout, g, an.header.toroidal, 1, 0);
+    let gw = g.width() as usize;
+    let colour = |k: usize| {
+        let v = pt.src[k];
+        an.exemplar[(v >> 16) as usize * n + (v & 0xFFFF) as usize]
+    };
+    let (w, h) = (rect.width() as usize, rect.height() as usize);
+    let mut pixels = Vec::with_capacity(3 * w * h);
+    if s == 0 {
+        for j in 0..h {
+            for i in 0..w {
+                pixels.extend_from_slice(&colour((j + 4) * gw + i + 4));
+            }
+        }
+        return RgbWindow { width: w as u32, height: h as u32, pixels };
+    }
+    // Edge pixels (a 4-neighbour with another label) on rect ⊕ 3.
+    let e = rect.grow(3);
+    let ew = e.width() as usize;
+    let mut edge = vec![false; ew * e.height() as usize];
+    for j in 0..e.height() as usize {
+        for i in 0..ew {
+            let k = (j + 1) * gw + i + 1;
+            let l = pt.label[k];
+            edge[j * ew + i] =
+                pt.label[k - 1] != l || pt.label[k + 1] != l || pt.label[k - gw] != l || pt.label[k + gw] != l;
+        }
+    }
+    // Chebyshev distance to the nearest edge pixel, capped at 4: rows, then columns.
+    let mut hd = vec![4u8; ew * e.height() as usize];
+    for j in 0..e.height() as usize {
+        for i in 0..ew {
+            let mut d = 4u8;
+            for dx in 0..=3usize {
+                if (i >= dx && edge[j * ew + i - dx]) || (i + dx < ew && edge[j * ew + i + dx]) {
+                    d = dx as u8;
+                    break;
+                }
+            }
+            hd[j * ew + i] = d;
+        }
+    }
+    // Horizontal tent sums of M0 over rect's columns, rows of rect ⊕ 3.
+    const TENT: [u32; 7] = [1, 2, 3, 4, 3, 2, 1];
+    let mut hs = vec![[0u32; 3]; w * e.height() as usize];
+    for j in 0..e.height() as usize {
+        for i in 0..w {
+            let mut acc = [0u32; 3];
+            for (t, &wt) in TENT.iter().enumerate() {
+                let c = colour((j + 1) * gw + i + 1 + t);
+                for ch in 0..3 {
+                    acc[ch] += wt * c[ch] as u32;
+                }
+            }
+            hs[j * w + i] = acc;
+        }
+    }
+    for j in 0..h {
+        for i in 0..w {
+            let m0 = colour((j + 4) * gw + i + 4);
+            let mut d = 4i64;
+            for dy in 0..=3usize {
+                for y in [j + 3 - dy, j + 3 + dy] {
+                    d = d.min((dy as i64).max(hd[y * ew + i + 3] as i64));
+                }
+            }
+            if d >= s {
+                pixels.extend_from_slice(&m0);
+                continue;
+            }
+            let mut t = [0u32; 3];
+            for (k, &wt) in TENT.iter().enumerate() {
+                let r = hs[(j + k) * w + i];
+                for ch in 0..3 {
+                    t[ch] += wt * r[ch];
+                }
+            }
+            for ch in 0..3 {
+                let v = (m0[ch] as i64 * 256 * d + t[ch] as i64 * (s - d) + 128 * s) / (256 * s);
+                pixels.push(v.clamp(0, 255) as u8);
+            }
+        }
+    }
+    RgbWindow { width: w as u32, height: h as u32, pixels }
+}
+
+fn box_down(img: &RgbWindow, f: usize) -> RgbWindow {
+    let (w, h) = (img.width as usize / f, img.height as usize / f);
+    let iw = img.width as usize;
+    let area = (f * f) as u32;
+    let mut pixels = Vec::with_capacity(3 * w * h);
+    for j in 0..h {
+        for i in 0..w {
+            let mut s = [0u32; 3];
+            for y in j * f..(j + 1) * f {
+                for x in i * f..(i + 1) * f {
+                    for c in 0..3 {
+                        s[c] += img.pixels[3 * (y * iw + x) + c] as u32;
+                    }
+                }
+            }
+            pixels.extend(s.map(|v| ((v + area / 2) / area) as u8));
+        }
+    }
+    RgbWindow { width: w as u32, height: h as u32, pixels }
+}
+
+/// Far zoom-out (`2^k` texels per pixel, k > 3): label each pixel by its centre texel and colour
+/// it from the box-filtered exemplar at that scale (the mean colour once a pixel covers the
+/// whole exemplar). Approximate, like the paper's reduced-scale rendering.
+fn sampled(an: &Analysis, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
+    let n = layout.n as usize;
+    let (w, h) = (rect.width() as usize, rect.height() as usize);
+    let lvl = k.min(an.levels()) as usize;
+    let side = n >> lvl;
+    let mip = box_mip(&an.exemplar, n, lvl);
+    let mut pixels = Vec::with_capacity(3 * w * h);
+    let step = 1i64 << k.min(40);
+    let pt = paint(layout, rect, an.header.toroidal, step, step / 2);
+    for v in &pt.src {
+        let (x, y) = ((v & 0xFFFF) as usize >> lvl, (v >> 16) as usize >> lvl);
+        pixels.extend_from_slice(&mip[y.min(side - 1) * side + x.min(side - 1)]);
+    }
+    RgbWindow { width: w as u32, height: h as u32, pixels }
+}
+
+/// The exemplar box-filtered `lvl` times (side `n >> lvl`).
+fn box_mip(px: &[[u8; 3]], n: usize, lvl: usize) -> Vec<[u8; 3]> {
+    let full = RgbWindow { width: n as u32, height: n as u32, pixels: px.iter().flatten().copied().collect() };
+    box_down(&full, 1 << lvl).pixels.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
