@@ -355,9 +355,10 @@ fn box_down(img: &RgbWindow, f: usize) -> RgbWindow {
         for i in 0..w {
             let mut s = [0u32; 3];
             for y in j * f..(j + 1) * f {
-                for x in i * f..(i + 1) * f {
-                    for c in 0..3 {
-                        s[c] += img.pixels[3 * (y * iw + x) + c] as u32;
+                let row = &img.pixels[3 * (y * iw + i * f)..3 * (y * iw + (i + 1) * f)];
+                for px in row.chunks_exact(3) {
+                    for (acc, &v) in s.iter_mut().zip(px) {
+                        *acc += v as u32;
                     }
                 }
             }
