@@ -39,7 +39,7 @@ proptest! {
     ) {
         let an = common::small();
         let p = MosaicParams { seed, iterations: it, period: world, ..MosaicParams::default() };
-        let (w, h) = if k >= 1 && k <= 3 { (w.min(100), h.min(100)) } else { (w, h) };
+        let (w, h) = if (1..=3).contains(&k) { (w.min(100), h.min(100)) } else { (w, h) };
         let whole = Rect::new((far >> k) + dx, (far >> k) + dy, w, h);
         let sx = ((w as f64 * fx) as i64).clamp(1, w - 1);
         let sy = ((h as f64 * fy) as i64).clamp(1, h - 1);
