@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Quality benchmark (issue: core engine). Synthesizes 512×512 from each development exemplar
-# (../shared/exemplars/NAME.png, 128×128) with three settings — default parameters, correction
-# off, plain tiling (randomness 0) — scores them with ../shared/tools/texq.py and writes
+# (../shared/exemplars/NAME.png, 128×128) with four settings — default parameters, correction
+# off, plain tiling (randomness 0), and the cheap chaos-mosaic mode — scores them with ../shared/tools/texq.py and writes
 #   bench/out/quality/scores.md     the texq table (one block per setting, mean rows)
 #   docs/contact-sheet.png          exemplar beside the default output, for every exemplar
 # Usage: bench/quality.sh [extra render args, e.g. --seed 3]
@@ -12,7 +12,7 @@ OUT=bench/out/quality
 python3 -c 'import numpy, scipy, PIL' 2>/dev/null || pip install -q numpy scipy pillow
 cargo build --release -q -p textile-server
 BIN=target/release/textile
-rm -rf "$OUT" && mkdir -p "$OUT"/{exemplars,default,no_correction,tiling}
+rm -rf "$OUT" && mkdir -p "$OUT"/{exemplars,default,no_correction,tiling,mosaic}
 WIN=--window=4096,-8192,512,512
 for f in "$SHARED"/exemplars/*.png; do
   name=$(basename "$f" .png)
@@ -21,8 +21,9 @@ for f in "$SHARED"/exemplars/*.png; do
   "$BIN" render --exemplar "$f" "$WIN" "$@" -o "$OUT/default/$name.png" >/dev/null
   "$BIN" render --exemplar "$f" "$WIN" --passes 0 "$@" -o "$OUT/no_correction/$name.png" >/dev/null
   "$BIN" render --exemplar "$f" "$WIN" --randomness 0 --passes 0 -o "$OUT/tiling/$name.png" >/dev/null
+  "$BIN" render --exemplar "$f" "$WIN" --mode mosaic "$@" -o "$OUT/mosaic/$name.png" >/dev/null
 done
 python3 "$SHARED/tools/texq.py" table --exemplar-dir "$OUT/exemplars" \
-  --output-dir "$OUT/default" "$OUT/no_correction" "$OUT/tiling" > "$OUT/scores.md"
+  --output-dir "$OUT/default" "$OUT/no_correction" "$OUT/tiling" "$OUT/mosaic" > "$OUT/scores.md"
 python3 bench/contact_sheet.py "$OUT/exemplars" "$OUT/default" docs/contact-sheet.png
 cat "$OUT/scores.md"

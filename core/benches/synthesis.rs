@@ -1,6 +1,7 @@
 //! Engine benchmarks (criterion): analysis time for 64², 128² and 256² exemplars, a cold
 //! 256×256 native window (full padded pyramid, nothing cached), a zoomed-out tile, and a
-//! 1024×1024 window (report its time ÷ 16 as the cost per 256² of output).
+//! 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
+//! 512² windows.
 //!
 //! `cargo bench -p textile-core --bench synthesis`
 
@@ -8,7 +9,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use textile_core::{render, Analysis, Exemplar, ExemplarOptions, NoProgress, Rect, SynthParams};
+use textile_core::{render, Analysis, Exemplar, ExemplarOptions, MosaicParams, NoProgress, Rect, SynthParams};
 
 fn exemplar(side: u32) -> Exemplar {
     // The 256² gravel of the development set, area-resampled to the side wanted.
@@ -60,5 +61,22 @@ fn windows(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, analysis, windows);
+fn mosaic(c: &mut Criterion) {
+    let an = Analysis::build(&exemplar(128), &NoProgress);
+    let p = MosaicParams::default();
+    let mut g = c.benchmark_group("mosaic");
+    g.sample_size(100).measurement_time(Duration::from_secs(5));
+    let mut i = 0i64;
+    for side in [256i64, 512] {
+        g.bench_function(format!("window_{side}"), |b| {
+            b.iter(|| {
+                i += 1;
+                textile_core::mosaic::render(&an, &p, 0, Rect::new(side * i, -side * i, side, side)).unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, analysis, windows, mosaic);
 criterion_main!(benches);

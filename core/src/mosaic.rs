@@ -4,6 +4,8 @@
 //! edges are smoothed over three pixel layers. Everything is a function of absolute
 //! coordinates, so any window equals the same pixels cut from any larger one.
 
+use rayon::prelude::*;
+
 use crate::analysis::Analysis;
 use crate::error::{CoreError, Result};
 use crate::geom::Rect;
@@ -179,25 +181,32 @@ impl Layout {
 }
 
 /// Labels (which block or background tile shows) and source texels over a rect, on a grid of
-/// sample points `origin + step·(i, j) + offset`.
+/// sample points `step·(i, j) + offset`. Background labels have the top bit set and identify
+/// the tiling tile (unique among neighbours); block labels are indices in priority order.
 struct Paint {
-    label: Vec<u64>,
+    label: Vec<u32>,
     src: Vec<u32>,
 }
 
 fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) -> Paint {
     let n = layout.n;
+    let (shift, mask) = (n.trailing_zeros(), n - 1);
     let (w, h) = (rect.width() as usize, rect.height() as usize);
-    let mut label = vec![0u64; w * h];
+    let mut label = vec![0u32; w * h];
     let mut src = vec![0u32; w * h];
+    let cols: Vec<(u32, u32)> = (rect.x0..rect.x1)
+        .map(|i| {
+            let x = i * step + offset;
+            (((x >> shift) & 0x7FFF) as u32, (x & mask) as u32)
+        })
+        .collect();
     for j in 0..h {
         let y = (rect.y0 + j as i64) * step + offset;
-        for i in 0..w {
-            let x = (rect.x0 + i as i64) * step + offset;
-            let (tx, ty) = (x.div_euclid(n), y.div_euclid(n));
-            label[j * w + i] =
-                if toroidal { 1 << 63 } else { (1 << 63) | (((ty & 0x7FFF_FFFF) << 31) ^ (tx & 0x7FFF_FFFF)) as u64 };
-            src[j * w + i] = (x.rem_euclid(n) | (y.rem_euclid(n) << 16)) as u32;
+        let (ty, sy) = ((((y >> shift) & 0x7FFF) as u32) << 15, ((y & mask) as u32) << 16);
+        let (lrow, srow) = (&mut label[j * w..(j + 1) * w], &mut src[j * w..(j + 1) * w]);
+        for ((l, s), &(tx, sx)) in lrow.iter_mut().zip(srow.iter_mut()).zip(&cols) {
+            *l = if toroidal { 1 << 31 } else { (1 << 31) | ty | tx };
+            *s = sy | sx;
         }
     }
     // Texel extent of the sample grid.
@@ -208,7 +217,6 @@ fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) ->
         y1: (rect.y1 - 1) * step + offset + 1,
     };
     for (id, b) in layout.blocks_meeting(tex).iter().enumerate() {
-        // Sample indices whose texel lies in the block.
         // Sample i shows texel i·step + offset: the first index at or after texel d, and one
         // past the last index before texel e.
         let first = |d: i64| (d - offset).div_euclid(step) + i64::from((d - offset).rem_euclid(step) != 0);
@@ -216,13 +224,12 @@ fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) ->
         let (i0, i1) = (first(b.dx).max(rect.x0), end(b.dx + b.w).min(rect.x1));
         let (j0, j1) = (first(b.dy).max(rect.y0), end(b.dy + b.h).min(rect.y1));
         for j in j0..j1 {
-            let y = j * step + offset;
+            let sy = ((b.sy + j * step + offset - b.dy) as u32) << 16;
             let row = (j - rect.y0) as usize * w;
             for i in i0..i1 {
-                let x = i * step + offset;
                 let k = row + (i - rect.x0) as usize;
-                label[k] = id as u64;
-                src[k] = ((b.sx + x - b.dx) | ((b.sy + y - b.dy) << 16)) as u32;
+                label[k] = id as u32;
+                src[k] = sy | (b.sx + i * step + offset - b.dx) as u32;
             }
         }
     }
@@ -258,91 +265,91 @@ pub fn render(an: &Analysis, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
 
 fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
     let n = layout.n as usize;
-    let s = layout.p.smoothing as i64;
+    let s = layout.p.smoothing as u32;
+    // Labels and unsmoothed colours M0 on rect ⊕ 4 (edges on rect ⊕ 3 need 4-neighbours).
     let g = rect.grow(4);
     let pt = paint(layout, g, an.header.toroidal, 1, 0);
     let gw = g.width() as usize;
-    let colour = |k: usize| {
-        let v = pt.src[k];
-        an.exemplar[(v >> 16) as usize * n + (v & 0xFFFF) as usize]
-    };
+    let m0: Vec<[u8; 3]> = pt
+        .src
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&v| an.exemplar[(v >> 16) as usize * n + (v & 0xFFFF) as usize])
+        .collect();
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let mut pixels = Vec::with_capacity(3 * w * h);
     if s == 0 {
         for j in 0..h {
-            for i in 0..w {
-                pixels.extend_from_slice(&colour((j + 4) * gw + i + 4));
+            for c in &m0[(j + 4) * gw + 4..(j + 4) * gw + 4 + w] {
+                pixels.extend_from_slice(c);
             }
         }
         return RgbWindow { width: w as u32, height: h as u32, pixels };
     }
-    // Edge pixels (a 4-neighbour with another label) on rect ⊕ 3.
-    let e = rect.grow(3);
-    let ew = e.width() as usize;
-    let mut edge = vec![false; ew * e.height() as usize];
-    for j in 0..e.height() as usize {
-        for i in 0..ew {
+    // Edge pixels (a 4-neighbour with another label) on e = rect ⊕ 3, and each pixel's
+    // horizontal distance to the nearest edge pixel in its row (capped at 4).
+    let (ew, eh) = (w + 6, h + 6);
+    let mut hd = vec![4u8; ew * eh];
+    hd.par_chunks_mut(ew).enumerate().with_min_len(16).for_each(|(j, row)| {
+        let mut last = 4u8;
+        for (i, d) in row.iter_mut().enumerate() {
             let k = (j + 1) * gw + i + 1;
             let l = pt.label[k];
-            edge[j * ew + i] =
-                pt.label[k - 1] != l || pt.label[k + 1] != l || pt.label[k - gw] != l || pt.label[k + gw] != l;
+            let edge = pt.label[k - 1] != l || pt.label[k + 1] != l || pt.label[k - gw] != l || pt.label[k + gw] != l;
+            last = if edge { 0 } else { (last + 1).min(4) };
+            *d = last;
         }
-    }
-    // Chebyshev distance to the nearest edge pixel, capped at 4: rows, then columns.
-    let mut hd = vec![4u8; ew * e.height() as usize];
-    for j in 0..e.height() as usize {
-        for i in 0..ew {
-            let mut d = 4u8;
-            for dx in 0..=3usize {
-                if (i >= dx && edge[j * ew + i - dx]) || (i + dx < ew && edge[j * ew + i + dx]) {
-                    d = dx as u8;
-                    break;
-                }
+        let mut last = 4u8;
+        for d in row.iter_mut().rev() {
+            last = if *d == 0 { 0 } else { (last + 1).min(4) };
+            *d = (*d).min(last);
+        }
+    });
+    // Horizontal tent (1,2,3,4,3,2,1) = two 4-wide boxes, over e's rows and rect's columns.
+    let mut th = vec![[0u32; 3]; w * eh];
+    th.par_chunks_mut(w).enumerate().with_min_len(16).for_each_init(
+        || vec![[0u32; 3]; w + 3],
+        |bx, (j, out)| {
+            let row = &m0[(j + 1) * gw + 1..(j + 1) * gw + 1 + ew];
+            // bx[t] = row[t] + … + row[t+3], t = 0..w+3
+            for (t, b) in bx.iter_mut().enumerate() {
+                let q = &row[t..t + 4];
+                *b = [0, 1, 2].map(|c| q.iter().map(|p| p[c] as u32).sum());
             }
-            hd[j * ew + i] = d;
-        }
-    }
-    // Horizontal tent sums of M0 over rect's columns, rows of rect ⊕ 3.
+            for (i, o) in out.iter_mut().enumerate() {
+                let q = &bx[i..i + 4];
+                *o = [0, 1, 2].map(|c| q.iter().map(|p| p[c]).sum());
+            }
+        },
+    );
     const TENT: [u32; 7] = [1, 2, 3, 4, 3, 2, 1];
-    let mut hs = vec![[0u32; 3]; w * e.height() as usize];
-    for j in 0..e.height() as usize {
-        for i in 0..w {
-            let mut acc = [0u32; 3];
-            for (t, &wt) in TENT.iter().enumerate() {
-                let c = colour((j + 1) * gw + i + 1 + t);
-                for ch in 0..3 {
-                    acc[ch] += wt * c[ch] as u32;
-                }
-            }
-            hs[j * w + i] = acc;
-        }
-    }
-    for j in 0..h {
-        for i in 0..w {
-            let m0 = colour((j + 4) * gw + i + 4);
-            let mut d = 4i64;
-            for dy in 0..=3usize {
-                for y in [j + 3 - dy, j + 3 + dy] {
-                    d = d.min((dy as i64).max(hd[y * ew + i + 3] as i64));
-                }
+    pixels.resize(3 * w * h, 0);
+    pixels.par_chunks_mut(3 * w).enumerate().with_min_len(16).for_each(|(j, out)| {
+        for (i, o) in out.chunks_exact_mut(3).enumerate() {
+            let c0 = m0[(j + 4) * gw + i + 4];
+            // Chebyshev distance to the nearest edge pixel, from the row distances.
+            let mut d = 4u32;
+            for dy in 0..7usize {
+                let ady = (dy as i32 - 3).unsigned_abs();
+                d = d.min(ady.max(hd[(j + dy) * ew + i + 3] as u32));
             }
             if d >= s {
-                pixels.extend_from_slice(&m0);
+                o.copy_from_slice(&c0);
                 continue;
             }
             let mut t = [0u32; 3];
             for (k, &wt) in TENT.iter().enumerate() {
-                let r = hs[(j + k) * w + i];
-                for ch in 0..3 {
-                    t[ch] += wt * r[ch];
+                let r = th[(j + k) * w + i];
+                for (acc, v) in t.iter_mut().zip(r) {
+                    *acc += wt * v;
                 }
             }
-            for ch in 0..3 {
-                let v = (m0[ch] as i64 * 256 * d + t[ch] as i64 * (s - d) + 128 * s) / (256 * s);
-                pixels.push(v.clamp(0, 255) as u8);
+            for ((o, c), &tc) in o.iter_mut().zip(&c0).zip(&t) {
+                let v = (*c as u32 * 256 * d + tc * (s - d) + 128 * s) / (256 * s);
+                *o = v.min(255) as u8;
             }
         }
-    }
+    });
     RgbWindow { width: w as u32, height: h as u32, pixels }
 }
 

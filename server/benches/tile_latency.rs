@@ -1,7 +1,8 @@
 //! End-to-end tile latency and encoding cost (issue: tile server). Starts the real `textile`
 //! binary on a free loopback port, then with one connection, one request at a time:
 //! * cold: N distinct, never-requested native tiles (synthesis + PNG + HTTP);
-//! * cached: the same N tiles again (cache hits).
+//! * cached: the same N tiles again (cache hits);
+//! * cold mosaic: N distinct `mode=mosaic` tiles.
 //!
 //! In process it also times one 256² synthesis and the PNG/JPEG/WebP encoding of a tile.
 //! Prints median / p90 / p99 / max per figure.
@@ -76,9 +77,14 @@ fn main() {
         let urls: Vec<String> = (0..n as i64)
             .map(|i| format!("{base}/tiles/gravel/7/{}/{}.png", (i * 7919) % 100_003 - 50_000, (i * 104_729) % 99_991))
             .collect();
-        for (name, pass) in [("cold tile over HTTP", 0), ("cached tile over HTTP", 1)] {
+        let mosaic: Vec<String> = urls.iter().map(|u| format!("{u}?mode=mosaic")).collect();
+        for (name, pass, list) in [
+            ("cold synth tile over HTTP", 0, &urls),
+            ("cached tile over HTTP", 1, &urls),
+            ("cold mosaic tile over HTTP", 0, &mosaic),
+        ] {
             let mut v = Vec::with_capacity(n);
-            for u in &urls {
+            for u in list {
                 let t = Instant::now();
                 let r = client.get(u).send().await.unwrap();
                 assert_eq!(r.headers()["x-cache"], if pass == 0 { "MISS" } else { "HIT" });
