@@ -265,7 +265,7 @@ pub fn render(an: &Analysis, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
 
 fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
     let n = layout.n as usize;
-    let s = layout.p.smoothing as u32;
+    let s = layout.p.smoothing;
     // Labels and unsmoothed colours M0 on rect ⊕ 4 (edges on rect ⊕ 3 need 4-neighbours).
     let g = rect.grow(4);
     let pt = paint(layout, g, an.header.toroidal, 1, 0);
