@@ -127,6 +127,7 @@ async fn health_ready_viewer_and_openapi() {
     let paths = doc["paths"].as_object().unwrap();
     for p in [
         "/",
+        "/world.html",
         "/health",
         "/ready",
         "/catalog",

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use axum::extract::rejection::PathRejection;
 use axum::extract::{Path, RawQuery, State};
 use axum::http::{header, HeaderMap, HeaderValue, Method, Uri};
-use axum::response::{Html, IntoResponse, Response};
+use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde_json::{json, Value};
 use utoipa::OpenApi;
@@ -203,7 +203,8 @@ pub async fn tilejson(
         crate::http::images::tile,
         crate::http::images::window,
         crate::http::meta::openapi,
-        crate::http::meta::index
+        crate::http::static_files::index,
+        crate::http::static_files::world
     )
 )]
 pub struct ApiDoc;
@@ -212,12 +213,6 @@ pub struct ApiDoc;
 #[utoipa::path(get, path = "/openapi.json", tag = "service", responses((status = 200, description = "OpenAPI 3")))]
 pub async fn openapi() -> Json<utoipa::openapi::OpenApi> {
     Json(ApiDoc::openapi())
-}
-
-/// The web viewer.
-#[utoipa::path(get, path = "/", tag = "service", responses((status = 200, description = "HTML")))]
-pub async fn index() -> Html<&'static str> {
-    Html(include_str!("../../../web/index.html"))
 }
 
 /// 404 for unknown routes.

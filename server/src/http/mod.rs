@@ -6,6 +6,7 @@ pub mod error;
 pub mod images;
 pub mod meta;
 pub mod state;
+pub mod static_files;
 
 use std::sync::Arc;
 
@@ -32,7 +33,9 @@ pub fn router(state: Arc<AppState>) -> Router {
             AllowOrigin::list(state.config.cors_origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()))
         });
     Router::new()
-        .route("/", get(meta::index))
+        .route("/", get(static_files::index))
+        .route("/world.html", get(static_files::world))
+        .route("/static/{*path}", get(static_files::static_file))
         .route("/health", get(meta::health))
         .route("/ready", get(meta::ready))
         .route("/catalog", get(meta::catalog))

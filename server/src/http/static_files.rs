@@ -1,0 +1,50 @@
+//! The web viewer's files, compiled into the binary (`web/`): pages at `/` and `/world.html`,
+//! scripts, styles and the vendored libraries (with their licences) under `/static/`.
+
+use axum::extract::Path;
+use axum::http::{header, HeaderValue};
+use axum::response::{IntoResponse, Response};
+
+use crate::http::error::ApiError;
+
+/// `(path under /static/, content type, bytes)`.
+const FILES: &[(&str, &str, &[u8])] = &[
+    ("app.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/app.js")),
+    ("world.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/world.js")),
+    ("style.css", "text/css; charset=utf-8", include_bytes!("../../../web/style.css")),
+    ("vendor/leaflet.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/vendor/leaflet.js")),
+    ("vendor/leaflet.css", "text/css; charset=utf-8", include_bytes!("../../../web/vendor/leaflet.css")),
+    ("vendor/ol.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/vendor/ol.js")),
+    ("vendor/ol.css", "text/css; charset=utf-8", include_bytes!("../../../web/vendor/ol.css")),
+    ("vendor/LICENSE-leaflet", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/LICENSE-leaflet")),
+    ("vendor/LICENSE-ol.md", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/LICENSE-ol.md")),
+    ("vendor/VERSIONS", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/VERSIONS")),
+];
+
+fn file(bytes: &'static [u8], content_type: &'static str) -> Response {
+    let mut r = bytes.into_response();
+    r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static(content_type));
+    r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("public, max-age=300"));
+    r
+}
+
+/// A file under `/static/`.
+pub async fn static_file(Path(path): Path<String>) -> Result<Response, ApiError> {
+    FILES
+        .iter()
+        .find(|(p, _, _)| *p == path)
+        .map(|(_, ct, b)| file(b, ct))
+        .ok_or_else(|| ApiError::not_found_route(&format!("/static/{path}")))
+}
+
+/// The infinite-plane viewer.
+#[utoipa::path(get, path = "/", tag = "viewer", responses((status = 200, description = "HTML")))]
+pub async fn index() -> Response {
+    file(include_bytes!("../../../web/index.html"), "text/html; charset=utf-8")
+}
+
+/// The Web-Mercator world map (`world=` periodic mode).
+#[utoipa::path(get, path = "/world.html", tag = "viewer", responses((status = 200, description = "HTML")))]
+pub async fn world() -> Response {
+    file(include_bytes!("../../../web/world.html"), "text/html; charset=utf-8")
+}

@@ -1,0 +1,191 @@
+// Headless-Chromium tests of the textile viewer against a running server (TEXTILE_URL).
+// Run by tests/browser.rs, which starts the real binary; see that file.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { chromium } from 'playwright-core';
+
+const BASE = process.env.TEXTILE_URL;
+const SHOT = process.env.TEXTILE_SCREENSHOT;
+let browser;
+
+before(async () => {
+  assert.ok(BASE, 'TEXTILE_URL must name the server under test');
+  browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync', '--no-first-run'],
+  });
+});
+
+after(async () => { await browser?.close(); });
+
+async function open(path, viewport = { width: 1280, height: 800 }) {
+  const page = await browser.newPage({ viewport });
+  const errors = [];
+  const tiles = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  page.on('response', (r) => { if (r.url().includes('/tiles/')) tiles.push({ url: r.url(), status: r.status() }); });
+  await page.goto(BASE + path);
+  await page.waitForSelector('body[data-ready="1"]', { timeout: 20000 });
+  return { page, errors, tiles };
+}
+
+/** Wait until every Leaflet tile image is loaded (and at least `min` exist). */
+async function settled(page, min = 4) {
+  await page.waitForFunction((min) => {
+    const imgs = [...document.querySelectorAll('img.leaflet-tile')];
+    return imgs.length >= min && imgs.every((i) => i.complete && i.naturalWidth === 256)
+      && !document.querySelector('.leaflet-tile-loading');
+  }, min, { timeout: 20000 });
+}
+
+/** Pixel statistics of loaded tile images: source URL, mean, spread and a checksum. */
+async function tileStats(page) {
+  return page.evaluate(() => [...document.querySelectorAll('img.leaflet-tile-loaded')].map((img) => {
+    const c = document.createElement('canvas');
+    c.width = img.naturalWidth; c.height = img.naturalHeight;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    let s = 0, s2 = 0, n = 0, h = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      const v = (d[i] + d[i + 1] + d[i + 2]) / 3;
+      s += v; s2 += v * v; n++;
+      h = (h * 31 + d[i] + 7 * d[i + 1] + 13 * d[i + 2]) >>> 0;
+    }
+    const mean = s / n;
+    return { src: img.src, mean, sd: Math.sqrt(s2 / n - mean * mean), sum: h };
+  }));
+}
+
+function assertTexture(stats) {
+  assert.ok(stats.length >= 4, `expected loaded tiles, got ${stats.length}`);
+  for (const t of stats) {
+    assert.ok(t.mean > 8 && t.mean < 247, `tile ${t.src} looks blank (mean ${t.mean})`);
+    assert.ok(t.sd > 4, `tile ${t.src} has no texture (sd ${t.sd})`);
+  }
+}
+
+test('the viewer loads with no console errors and shows texture tiles', async () => {
+  const { page, errors, tiles } = await open('/');
+  await settled(page);
+  assertTexture(await tileStats(page));
+  assert.ok(tiles.length > 0 && tiles.every((t) => t.status === 200), JSON.stringify(tiles.slice(0, 5)));
+  const labels = await page.$$eval('select, input, button', (els) => els.filter((e) => {
+    const id = e.id;
+    return !(e.labels && e.labels.length) && !e.getAttribute('aria-label') && !(e.tagName === 'BUTTON' && e.textContent.trim()) && id;
+  }).map((e) => e.id));
+  assert.deepEqual(labels, [], 'every control has a label');
+  if (SHOT) await page.screenshot({ path: SHOT });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('panning requests negative tile coordinates and they render', async () => {
+  const { page, errors, tiles } = await open('/#t=gravel&z=7&x=0&y=0');
+  await settled(page);
+  await page.evaluate(() => window.textileMap.panBy([-1800, -1400], { animate: false }));
+  await settled(page);
+  const negative = tiles.filter((t) => /\/7\/-\d+\/-\d+\.png/.test(t.url));
+  assert.ok(negative.length > 0, 'no negative tiles were requested');
+  assert.ok(negative.every((t) => t.status === 200));
+  const stats = await tileStats(page);
+  assert.ok(stats.some((s) => /\/7\/-\d+\/-\d+\.png/.test(s.src)), 'negative tiles are on screen');
+  assertTexture(stats);
+  const readout = await page.textContent('#readout');
+  assert.match(readout, /x -\d+, y -\d+/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a randomness slider (by keyboard) changes tile URLs and pixels; the permalink restores it', async () => {
+  const { page, errors } = await open('/#t=grass&m=synth&s=5&z=7&x=300&y=-200');
+  await settled(page);
+  const find = (stats, key) => stats.find((s) => s.src.includes(key));
+  const before = await tileStats(page);
+  const key = '/7/1/-1.png';
+  const old = find(before, key);
+  assert.ok(old, `tile ${key} on screen`);
+  assert.ok(!old.src.includes('randomness='));
+  await page.focus('#r3');
+  for (let i = 0; i < 6; i++) await page.keyboard.press('ArrowRight');
+  assert.equal(await page.inputValue('#r3'), '0.9');
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('randomness=')));
+  await settled(page);
+  const after = await tileStats(page);
+  const now = find(after, key);
+  assert.ok(now && now.src.includes('randomness=') && now.src.includes('0.90'), now && now.src);
+  assert.notEqual(now.sum, old.sum, 'pixels changed with the randomness');
+  await page.fill('#seed', '77');
+  await page.press('#seed', 'Enter');
+  await page.dispatchEvent('#seed', 'change');
+  await page.waitForFunction(() => location.hash.includes('s=77'));
+  const hash = await page.evaluate(() => location.hash);
+  assert.match(hash, /t=grass/);
+  assert.match(hash, /r=[^&]*0\.90/);
+  // Restore in a fresh page.
+  const second = await open('/' + hash);
+  await settled(second.page);
+  assert.equal(await second.page.inputValue('#texture'), 'grass');
+  assert.equal(await second.page.inputValue('#seed'), '77');
+  assert.equal(await second.page.inputValue('#r3'), '0.9');
+  assert.equal(await second.page.evaluate(() => window.textileMap.getZoom()), 7);
+  const restored = await tileStats(second.page);
+  assert.ok(restored.every((s) => s.src.includes('seed=77') && s.src.includes('0.90')));
+  assert.deepEqual(errors, []);
+  assert.deepEqual(second.errors, []);
+  await page.close();
+  await second.page.close();
+});
+
+test('mode and texture pickers re-request tiles; zoom out stays within minzoom', async () => {
+  const { page, errors } = await open('/#t=gravel&z=7&x=0&y=0');
+  await settled(page);
+  await page.selectOption('#mode', 'mosaic');
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('mode=mosaic')));
+  await settled(page);
+  assert.ok(await page.$eval('#randomness', (f) => f.disabled), 'randomness does not apply to mosaic');
+  await page.selectOption('#texture', 'brick');
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('/tiles/brick/')));
+  await settled(page);
+  assertTexture(await tileStats(page));
+  await page.evaluate(() => window.textileMap.setZoom(0, { animate: false }));
+  await settled(page, 1);
+  assert.equal(await page.evaluate(() => window.textileMap.getZoom()), 0);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('readable on a phone-sized viewport', async () => {
+  const { page, errors } = await open('/', { width: 390, height: 844 });
+  await settled(page, 1);
+  const box = async (sel) => page.$eval(sel, (e) => { const r = e.getBoundingClientRect(); return { w: r.width, h: r.height }; });
+  const map = await box('#map');
+  const panel = await box('#panel');
+  assert.ok(map.w >= 380 && map.h > 300, JSON.stringify(map));
+  assert.ok(panel.w >= 380 && panel.h > 100, JSON.stringify(panel));
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('the Web-Mercator world page wraps the world with world= tiles', async () => {
+  const { page, errors, tiles } = await open('/world.html');
+  await page.waitForFunction(() => window.textileWorld && window.textileWorld.getAllLayers()[0].getSource().getState() === 'ready');
+  const requested = async () => { await page.waitForTimeout(200); return tiles.length; };
+  await page.waitForFunction(() => performance.getEntriesByType('resource').some((e) => e.name.includes('/tiles/')));
+  await page.evaluate(() => new Promise((ok) => window.textileWorld.once('rendercomplete', ok)));
+  await page.evaluate(() => { window.textileWorld.getView().setCenter([20037508, 0]); });
+  await page.evaluate(() => new Promise((ok) => window.textileWorld.once('rendercomplete', ok)));
+  assert.ok((await requested()) > 0);
+  for (const t of tiles) {
+    const m = t.url.match(/\/tiles\/\w+\/(\d+)\/(-?\d+)\/(-?\d+)\.png\?(.*)$/);
+    assert.ok(m, t.url);
+    const [z, x, y] = [Number(m[1]), Number(m[2]), Number(m[3])];
+    assert.ok(x >= 0 && x < 2 ** z && y >= 0 && y < 2 ** z, `tile outside the world: ${t.url}`);
+    assert.match(m[4], /world=\d+/);
+    assert.equal(t.status, 200, t.url);
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});

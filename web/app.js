@@ -1,0 +1,175 @@
+// textile viewer: a Leaflet map (CRS.Simple, so tile coordinates are unbounded and may be
+// negative) over the infinite texture, with the synthesis controls and a permalink in the URL hash.
+'use strict';
+
+const state = { t: null, m: null, s: 0, r: null, z: null, x: 0, y: 0, g: false };
+let catalog = null, meta = null, map = null, layer = null, grid = null, debounce = null;
+const $ = (id) => document.getElementById(id);
+
+function readHash() {
+  const p = new URLSearchParams(location.hash.slice(1));
+  if (p.has('t')) state.t = p.get('t');
+  if (p.has('m')) state.m = p.get('m');
+  if (p.has('s') && /^\d+$/.test(p.get('s'))) state.s = p.get('s');
+  if (p.has('r')) state.r = p.get('r').split(',').map(Number).filter((v) => v >= 0 && v <= 1);
+  if (p.has('z')) state.z = Number(p.get('z'));
+  if (p.has('x')) state.x = Number(p.get('x'));
+  if (p.has('y')) state.y = Number(p.get('y'));
+  state.g = p.get('g') === '1';
+}
+
+function hash() {
+  const p = new URLSearchParams();
+  p.set('t', state.t); p.set('m', state.m); p.set('s', state.s);
+  if (state.r) p.set('r', state.r.map((v) => v.toFixed(2)).join(','));
+  p.set('z', state.z); p.set('x', Math.round(state.x)); p.set('y', Math.round(state.y));
+  if (state.g) p.set('g', '1');
+  return '#' + p.toString();
+}
+
+function writeHash() {
+  const h = hash();
+  history.replaceState(null, '', h);
+  $('permalink').href = h;
+}
+
+function native() { return meta ? meta.native_zoom : 0; }
+
+// Texel (native-zoom pixel) coordinates <-> CRS.Simple lat/lng.
+function toLatLng(x, y) { const s = 2 ** native(); return L.latLng(-y / s, x / s); }
+function fromLatLng(ll) { const s = 2 ** native(); return { x: ll.lng * s, y: -ll.lat * s }; }
+
+function tileUrl() {
+  const q = new URLSearchParams();
+  q.set('mode', state.m);
+  q.set('seed', state.s);
+  if (state.m === 'synth' && state.r) q.set('randomness', state.r.map((v) => v.toFixed(2)).join(','));
+  return `/tiles/${encodeURIComponent(state.t)}/{z}/{x}/{y}.png?` + q.toString();
+}
+
+function refreshLayer() {
+  const url = tileUrl();
+  if (!layer) {
+    layer = L.tileLayer(url, {
+      tileSize: 256, noWrap: true, minZoom: meta.minzoom, maxZoom: meta.maxzoom + 2,
+      minNativeZoom: meta.minzoom, maxNativeZoom: meta.maxzoom, keepBuffer: 1,
+      attribution: meta.attribution || '',
+    }).addTo(map);
+  } else if (layer._url !== url) {
+    layer.setUrl(url);
+  }
+  $('randomness').disabled = state.m !== 'synth';
+  writeHash();
+}
+
+function buildSliders() {
+  const defaults = meta.parameters.randomness.default;
+  if (!state.r || state.r.length !== defaults.length) state.r = null;
+  const values = state.r || defaults;
+  const box = $('sliders');
+  box.textContent = '';
+  values.forEach((v, l) => {
+    const row = document.createElement('div');
+    row.className = 'slider';
+    const id = `r${l}`;
+    const label = document.createElement('label');
+    label.htmlFor = id;
+    label.textContent = `level ${l}`;
+    const input = document.createElement('input');
+    Object.assign(input, { type: 'range', id, min: 0, max: 1, step: 0.05, value: v });
+    input.setAttribute('aria-label', `randomness of level ${l} of ${values.length - 1} (0 is coarsest)`);
+    const out = document.createElement('output');
+    out.htmlFor = id;
+    out.textContent = Number(v).toFixed(2);
+    input.addEventListener('input', () => {
+      out.textContent = Number(input.value).toFixed(2);
+      state.r = [...box.querySelectorAll('input')].map((i) => Number(i.value));
+      clearTimeout(debounce);
+      debounce = setTimeout(refreshLayer, 120);
+    });
+    row.append(label, input, out);
+    box.append(row);
+  });
+}
+
+async function selectTexture(id, keepView) {
+  const r = await fetch(`/textures/${encodeURIComponent(id)}`);
+  if (!r.ok) throw new Error(`texture ${id}: ${r.status}`);
+  meta = await r.json();
+  state.t = id;
+  $('texture').value = id;
+  const entry = catalog.textures.find((t) => t.id === id);
+  $('thumb').src = entry ? entry.exemplar : '';
+  const modes = $('mode');
+  modes.textContent = '';
+  for (const m of meta.modes) modes.append(new Option(m, m));
+  if (!meta.modes.includes(state.m)) state.m = meta.default_mode;
+  modes.value = state.m;
+  buildSliders();
+  map.setMinZoom(meta.minzoom);
+  map.setMaxZoom(meta.maxzoom + 2);
+  if (layer) { map.removeLayer(layer); layer = null; }
+  if (!keepView || state.z === null || Number.isNaN(state.z)) state.z = meta.native_zoom;
+  map.setView(toLatLng(state.x, state.y), state.z, { animate: false });
+  refreshLayer();
+}
+
+function setGrid(on) {
+  state.g = on;
+  $('grid').checked = on;
+  if (on && !grid) {
+    grid = L.gridLayer({ tileSize: 256, noWrap: true, zIndex: 10 });
+    grid.createTile = (c) => {
+      const d = document.createElement('div');
+      d.className = 'grid-tile';
+      d.textContent = `${c.z}/${c.x}/${c.y}`;
+      return d;
+    };
+    grid.addTo(map);
+  } else if (!on && grid) {
+    map.removeLayer(grid);
+    grid = null;
+  }
+  writeHash();
+}
+
+function onMove() {
+  const c = fromLatLng(map.getCenter());
+  state.x = c.x; state.y = c.y; state.z = map.getZoom();
+  $('readout').textContent = `x ${Math.round(c.x)}, y ${Math.round(c.y)} texels · zoom ${state.z} (native ${native()})`;
+  writeHash();
+}
+
+async function init() {
+  readHash();
+  catalog = await (await fetch('/catalog')).json();
+  const sel = $('texture');
+  for (const t of catalog.textures) sel.append(new Option(t.name, t.id));
+  if (!catalog.textures.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
+  map = L.map('map', { crs: L.CRS.Simple, zoomSnap: 1, keyboard: true, worldCopyJump: false });
+  window.textileMap = map;
+  map.on('moveend', onMove);
+  await selectTexture(state.t, true);
+  $('seed').value = state.s;
+  setGrid(state.g);
+  onMove();
+  sel.addEventListener('change', () => selectTexture(sel.value, true));
+  $('mode').addEventListener('change', (e) => { state.m = e.target.value; refreshLayer(); });
+  $('seed').addEventListener('change', (e) => {
+    const v = String(e.target.value).trim();
+    if (/^\d+$/.test(v)) { state.s = v; refreshLayer(); } else { e.target.value = state.s; }
+  });
+  $('newseed').addEventListener('click', () => {
+    state.s = String(Math.floor(Math.random() * 2 ** 32));
+    $('seed').value = state.s;
+    refreshLayer();
+  });
+  $('resetr').addEventListener('click', () => { state.r = null; buildSliders(); refreshLayer(); });
+  $('grid').addEventListener('change', (e) => setGrid(e.target.checked));
+  $('worldlink').addEventListener('click', (e) => {
+    e.currentTarget.href = `/world.html#t=${encodeURIComponent(state.t)}&m=${state.m}&s=${state.s}`;
+  });
+  document.body.dataset.ready = '1';
+}
+
+init().catch((e) => { console.error(e); $('readout').textContent = `error: ${e.message}`; });
