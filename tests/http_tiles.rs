@@ -137,6 +137,9 @@ async fn health_ready_viewer_and_openapi() {
         "/tiles/{id}/tilejson.json",
         "/tiles/{id}/{z}/{x}/{y}.{fmt}",
         "/windows/{id}.{fmt}",
+        "/gltf/{id}/{z}/{x}/{y}.{ext}",
+        "/gltf/{id}/patch.glb",
+        "/x3d/{id}/{z}/{x}/{y}.x3d",
     ] {
         assert!(paths.contains_key(p), "openapi lacks {p}");
     }

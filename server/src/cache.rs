@@ -56,6 +56,15 @@ impl TileCache {
         (l.map.len(), l.bytes)
     }
 
+    /// The cached value for `key`, counted as a hit; `None` when absent (not counted).
+    pub fn peek(&self, key: &str) -> Option<Bytes> {
+        let v = self.get(key);
+        if v.is_some() {
+            self.stats.hits.fetch_add(1, Ordering::Relaxed);
+        }
+        v
+    }
+
     fn get(&self, key: &str) -> Option<Bytes> {
         self.lru.lock().unwrap_or_else(|e| e.into_inner()).map.get(key).cloned()
     }

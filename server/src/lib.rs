@@ -8,6 +8,7 @@
 //! [`http::state::AppState::synthesize`] on the rayon pool → [`render`] (textile-core) →
 //! [`encode`] → [`http::content`] headers.
 
+pub mod assets;
 pub mod cache;
 pub mod cli;
 pub mod commands;

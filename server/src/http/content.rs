@@ -5,8 +5,6 @@ use axum::body::Bytes;
 use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 
-use crate::encode::Format;
-
 /// Version of everything besides the analysis that determines bytes.
 pub fn engine_version() -> String {
     format!(
@@ -52,11 +50,11 @@ pub fn not_modified(etag: &str, cache_control: &str) -> Response {
     r
 }
 
-/// 200 with an encoded image.
-pub fn image(bytes: Bytes, fmt: Format, etag: &str, cache_control: &str, hit: bool) -> Response {
+/// 200 with an encoded image or model of the given content type.
+pub fn image(bytes: Bytes, content_type: &'static str, etag: &str, cache_control: &str, hit: bool) -> Response {
     let mut r = bytes.into_response();
     let h = r.headers_mut();
-    h.insert(header::CONTENT_TYPE, HeaderValue::from_static(fmt.content_type()));
+    h.insert(header::CONTENT_TYPE, HeaderValue::from_static(content_type));
     common(h, etag, cache_control);
     h.insert("x-cache", HeaderValue::from_static(if hit { "HIT" } else { "MISS" }));
     r

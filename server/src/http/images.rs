@@ -4,6 +4,7 @@
 
 use std::sync::Arc;
 
+use axum::body::Bytes;
 use axum::extract::rejection::PathRejection;
 use axum::extract::{Path, RawQuery, State};
 use axum::http::HeaderMap;
@@ -15,12 +16,53 @@ use crate::http::error::ApiError;
 use crate::http::meta::texture;
 use crate::http::state::AppState;
 use crate::render::{render_tile, render_window};
+use crate::textures::Texture;
 use crate::tile_request::{
-    parse_query, parse_tile, parse_window, render_params, split_format, PARAM_KEYS, WINDOW_KEYS,
+    parse_query, parse_tile, parse_window, render_params, split_format, RenderParams, TileSpec, PARAM_KEYS, WINDOW_KEYS,
 };
 
 pub(crate) fn path_error(e: PathRejection) -> ApiError {
     ApiError::bad_request("invalid_path", format!("malformed path: {}", e.body_text()))
+}
+
+/// Bytes for a key from the cache, or from `make` on the synthesis pool (single-flight).
+pub(crate) async fn cached<F>(st: &Arc<AppState>, etag: &str, make: F) -> (Result<Bytes, ApiError>, bool)
+where
+    F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
+{
+    st.cache.get_or_compute(etag, || st.synthesize(make)).await
+}
+
+/// The cache key of a tile.
+pub(crate) fn tile_key(tex: &Texture, p: &RenderParams, spec: &TileSpec) -> String {
+    format!(
+        "{}|{}|{}|{}|tile|{}|{}|{}|{}|{}",
+        engine_version(),
+        tex.config.id,
+        tex.file_hash,
+        p.canonical(),
+        spec.z,
+        spec.x,
+        spec.y,
+        spec.scale,
+        spec.format.ext()
+    )
+}
+
+/// The encoded bytes of a tile, through the cache.
+pub(crate) async fn tile_bytes(
+    st: &Arc<AppState>,
+    tex: &Arc<Texture>,
+    p: &RenderParams,
+    spec: TileSpec,
+) -> Result<Bytes, ApiError> {
+    let (tex, p) = (tex.clone(), p.clone());
+    let etag = etag_for(&tile_key(&tex, &p, &spec));
+    cached(st, &etag, move || encode_window(render_tile(&tex, &p, &spec)?, spec.format)).await.0
+}
+
+fn encode_window(img: textile_core::RgbWindow, fmt: Format) -> Result<Vec<u8>, ApiError> {
+    encode(&img.pixels, img.width, img.height, fmt).map_err(|e| ApiError::internal(format!("encoding: {e}")))
 }
 
 async fn answer<F>(
@@ -38,17 +80,8 @@ where
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
-    let (bytes, hit) = st
-        .cache
-        .get_or_compute(&etag, || {
-            st.synthesize(move || {
-                let img = job()?;
-                encode(&img.pixels, img.width, img.height, fmt)
-                    .map_err(|e| ApiError::internal(format!("encoding: {e}")))
-            })
-        })
-        .await;
-    Ok(image(bytes?, fmt, &etag, cc, hit))
+    let (bytes, hit) = cached(st, &etag, move || encode_window(job()?, fmt)).await;
+    Ok(image(bytes?, fmt.content_type(), &etag, cc, hit))
 }
 
 /// A tile of the infinite texture.
@@ -78,18 +111,7 @@ pub async fn tile(
     let spec = parse_tile(&tex, &z, &x, &y)?;
     let q = parse_query(q.as_deref(), PARAM_KEYS)?;
     let p = render_params(&tex, &q)?;
-    let key = format!(
-        "{}|{}|{}|{}|tile|{}|{}|{}|{}|{}",
-        engine_version(),
-        tex.config.id,
-        tex.file_hash,
-        p.canonical(),
-        spec.z,
-        spec.x,
-        spec.y,
-        spec.scale,
-        spec.format.ext()
-    );
+    let key = tile_key(&tex, &p, &spec);
     answer(&st, &headers, key, spec.format, move || render_tile(&tex, &p, &spec)).await
 }
 

@@ -27,7 +27,8 @@ pub(crate) fn texture(reg: &Registry, id: &str) -> Result<Arc<Texture>, ApiError
     })
 }
 
-fn base_url(st: &AppState, headers: &HeaderMap) -> String {
+/// `http://HOST` of a request (for absolute URLs in documents).
+pub(crate) fn base_url(st: &AppState, headers: &HeaderMap) -> String {
     let host = headers.get(header::HOST).and_then(|h| h.to_str().ok()).unwrap_or(&st.config.bind);
     format!("http://{host}")
 }
@@ -204,7 +205,10 @@ pub async fn tilejson(
         crate::http::images::window,
         crate::http::meta::openapi,
         crate::http::static_files::index,
-        crate::http::static_files::world
+        crate::http::static_files::world,
+        crate::http::models::gltf_tile,
+        crate::http::models::gltf_patch,
+        crate::http::models::x3d_tile
     )
 )]
 pub struct ApiDoc;

@@ -5,6 +5,7 @@ pub mod content;
 pub mod error;
 pub mod images;
 pub mod meta;
+pub mod models;
 pub mod state;
 pub mod static_files;
 
@@ -45,6 +46,9 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/tiles/{id}/tilejson.json", get(meta::tilejson))
         .route("/tiles/{id}/{z}/{x}/{y}", get(images::tile))
         .route("/windows/{file}", get(images::window))
+        .route("/gltf/{id}/patch.glb", get(models::gltf_patch))
+        .route("/gltf/{id}/{z}/{x}/{y}", get(models::gltf_tile))
+        .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile))
         .fallback(meta::not_found)
         .method_not_allowed_fallback(meta::method_not_allowed)
         .with_state(state)

@@ -1,0 +1,164 @@
+//! 3D asset documents for mesh-texturing clients: glTF 2.0 (binary GLB with embedded tile
+//! images, or JSON referencing tile URLs) and X3D scenes, each a ground quad per tile.
+//!
+//! World frame (documented in the README): Y up, X east = texel x, Z south = texel y, 1 unit =
+//! 1 texel at the native zoom. A tile at zoom z covers `s = 256·2^(N−z)` units; its node is
+//! translated to `(s·x, 0, s·y)` and its mesh spans `[0, s]²` locally, so vertex positions stay
+//! small (f32-exact) however far the tile is. Texture coordinates put the image's top-left at the
+//! quad's north-west corner; samplers clamp to edge so neighbouring tiles meet without bleeding.
+
+use base64::Engine;
+use serde_json::{json, Value};
+
+/// One textured ground quad.
+pub struct Quad {
+    /// Node name.
+    pub name: String,
+    /// North-west corner in world units (texels at native zoom).
+    pub origin: (f64, f64),
+    /// Side in world units.
+    pub size: f64,
+}
+
+const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
+const CHUNK_JSON: u32 = 0x4E4F_534A;
+const CHUNK_BIN: u32 = 0x004E_4942;
+
+fn pad4(v: &mut Vec<u8>, byte: u8) {
+    while !v.len().is_multiple_of(4) {
+        v.push(byte);
+    }
+}
+
+/// Geometry shared by every quad of a document: positions, normals, texture coordinates and
+/// indices of a `size × size` quad facing up, as one little-endian byte block with its views.
+fn geometry(size: f32) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
+    let mut b = Vec::new();
+    let pos = [[0.0, 0.0, 0.0], [size, 0.0, 0.0], [size, 0.0, size], [0.0, 0.0, size]];
+    let nrm = [[0.0f32, 1.0, 0.0]; 4];
+    let uv = [[0.0f32, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let idx: [u16; 6] = [0, 2, 1, 0, 3, 2];
+    let mut views = Vec::new();
+    let mut push = |b: &mut Vec<u8>, bytes: Vec<u8>, target: u32| {
+        let offset = b.len();
+        b.extend_from_slice(&bytes);
+        views.push(json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target }));
+        pad4(b, 0);
+    };
+    push(&mut b, pos.iter().flatten().flat_map(|v: &f32| v.to_le_bytes()).collect(), 34962);
+    push(&mut b, nrm.iter().flatten().flat_map(|v| v.to_le_bytes()).collect(), 34962);
+    push(&mut b, uv.iter().flatten().flat_map(|v| v.to_le_bytes()).collect(), 34962);
+    push(&mut b, idx.iter().flat_map(|v| v.to_le_bytes()).collect(), 34963);
+    let accessors = vec![
+        json!({ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0.0, 0.0, 0.0], "max": [size, 0.0, size] }),
+        json!({ "bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3" }),
+        json!({ "bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2" }),
+        json!({ "bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR" }),
+    ];
+    (b, views, accessors)
+}
+
+/// The glTF JSON for quads of equal size, one material and texture per quad; `images[i]` is
+/// filled in by the caller (embedded buffer view or URI).
+fn document(quads: &[Quad], generator: &str, views: Vec<Value>, accessors: Vec<Value>, images: Vec<Value>) -> Value {
+    let n = quads.len();
+    json!({
+        "asset": { "version": "2.0", "generator": generator },
+        "scene": 0,
+        "scenes": [{ "nodes": (0..n).collect::<Vec<_>>() }],
+        "nodes": quads.iter().enumerate().map(|(i, q)| json!({
+            "name": q.name, "mesh": i, "translation": [q.origin.0, 0.0, q.origin.1],
+        })).collect::<Vec<_>>(),
+        "meshes": (0..n).map(|i| json!({ "primitives": [{
+            "attributes": { "POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2 }, "indices": 3, "material": i,
+        }]})).collect::<Vec<_>>(),
+        "materials": quads.iter().enumerate().map(|(i, q)| json!({
+            "name": q.name,
+            "pbrMetallicRoughness": { "baseColorTexture": { "index": i }, "metallicFactor": 0.0, "roughnessFactor": 1.0 },
+        })).collect::<Vec<_>>(),
+        "textures": (0..n).map(|i| json!({ "sampler": 0, "source": i })).collect::<Vec<_>>(),
+        "samplers": [{ "magFilter": 9729, "minFilter": 9729, "wrapS": 33071, "wrapT": 33071 }],
+        "images": images,
+        "accessors": accessors,
+        "bufferViews": views,
+    })
+}
+
+/// A GLB with each quad's image (`(bytes, mime)`) embedded.
+pub fn glb(quads: &[Quad], images: &[(Vec<u8>, &str)], generator: &str) -> Vec<u8> {
+    let size = quads.first().map(|q| q.size as f32).unwrap_or(1.0);
+    let (mut bin, mut views, accessors) = geometry(size);
+    let mut imgs = Vec::new();
+    for (bytes, mime) in images {
+        imgs.push(json!({ "bufferView": views.len(), "mimeType": mime }));
+        views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));
+        bin.extend_from_slice(bytes);
+        pad4(&mut bin, 0);
+    }
+    let mut doc = document(quads, generator, views, accessors, imgs);
+    doc["buffers"] = json!([{ "byteLength": bin.len() }]);
+    let mut js = serde_json::to_vec(&doc).unwrap_or_default();
+    pad4(&mut js, b' ');
+    let total = 12 + 8 + js.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    for v in [GLB_MAGIC, 2, total as u32, js.len() as u32, CHUNK_JSON] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&js);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
+    out.extend_from_slice(&bin);
+    out
+}
+
+/// glTF JSON whose images are URLs (clients fetch the tiles themselves); the geometry is an
+/// embedded base64 buffer.
+pub fn gltf_json(quads: &[Quad], image_urls: &[String], generator: &str) -> Value {
+    let size = quads.first().map(|q| q.size as f32).unwrap_or(1.0);
+    let (bin, views, accessors) = geometry(size);
+    let imgs = image_urls.iter().map(|u| json!({ "uri": u })).collect();
+    let mut doc = document(quads, generator, views, accessors, imgs);
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    doc["buffers"] =
+        json!([{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{data}") }]);
+    doc
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;").replace('\'', "&apos;")
+}
+
+/// An X3D scene: the quad with an `ImageTexture` pointing at the tile URL.
+pub fn x3d(q: &Quad, image_url: &str, generator: &str) -> String {
+    let s = q.size;
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<X3D profile="Interchange" version="3.3" xmlns:xsd="http://www.w3.org/2001/XMLSchema-instance">
+  <head>
+    <meta name="generator" content="{gen}"/>
+    <meta name="description" content="{name}: a ground quad (Y up, X east, Z south, 1 unit = 1 native texel)"/>
+  </head>
+  <Scene>
+    <Transform DEF="{def}" translation="{x} 0 {z}">
+      <Shape>
+        <Appearance>
+          <Material diffuseColor="1 1 1"/>
+          <ImageTexture url='"{url}"' repeatS="false" repeatT="false"/>
+        </Appearance>
+        <IndexedFaceSet solid="false" coordIndex="0 2 1 -1 0 3 2 -1" texCoordIndex="0 2 1 -1 0 3 2 -1">
+          <Coordinate point="0 0 0, {s} 0 0, {s} 0 {s}, 0 0 {s}"/>
+          <TextureCoordinate point="0 1, 1 1, 1 0, 0 0"/>
+        </IndexedFaceSet>
+      </Shape>
+    </Transform>
+  </Scene>
+</X3D>
+"#,
+        gen = xml_escape(generator),
+        name = xml_escape(&q.name),
+        def = xml_escape(&q.name.replace(['/', ' '], "_")),
+        x = q.origin.0,
+        z = q.origin.1,
+        url = xml_escape(image_url),
+    )
+}

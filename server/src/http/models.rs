@@ -1,0 +1,260 @@
+//! 3D asset endpoints: a tile as glTF (`.glb` with the tile image embedded, `.gltf` referencing
+//! the tile URL), an N×N patch of tiles as one GLB scene, and an X3D scene. Same parameters,
+//! validation, ETags and caching as tiles; the images come through the tile cache.
+
+use std::sync::Arc;
+
+use axum::extract::rejection::PathRejection;
+use axum::extract::{Path, RawQuery, State};
+use axum::http::HeaderMap;
+use axum::response::Response;
+use base64::Engine;
+
+use crate::assets::{glb, gltf_json, x3d, Quad};
+use crate::encode::Format;
+use crate::http::content::{engine_version, etag_for, if_none_match, image, not_modified};
+use crate::http::error::ApiError;
+use crate::http::images::{cached, path_error, tile_bytes, tile_key};
+use crate::http::meta::{base_url, texture};
+use crate::http::state::AppState;
+use crate::textures::Texture;
+use crate::tile_request::{
+    parse_query, parse_tile, render_params, Query, RenderParams, TileSpec, COORD_MAX, PARAM_KEYS, TILE_SIZE,
+};
+
+/// Largest patch side in tiles.
+pub const MAX_PATCH: i64 = 8;
+
+fn generator() -> String {
+    format!("textile {} ({})", env!("CARGO_PKG_VERSION"), engine_version())
+}
+
+fn quad(tex: &Texture, t: &TileSpec) -> Quad {
+    let size = (TILE_SIZE << (tex.native_zoom() - t.z)) as f64;
+    Quad { name: format!("tile {}/{}/{}", t.z, t.x, t.y), origin: (size * t.x as f64, size * t.y as f64), size }
+}
+
+/// The tile URL (absolute) with the request's parameters.
+fn tile_url(base: &str, tex: &Texture, t: &TileSpec, q: &Query) -> String {
+    let mut qs = form_urlencoded::Serializer::new(String::new());
+    for (k, v) in q {
+        qs.append_pair(k, v);
+    }
+    let qs = qs.finish();
+    let sep = if qs.is_empty() { "" } else { "?" };
+    format!("{base}/tiles/{}/{}/{}/{}.png{sep}{qs}", tex.config.id, t.z, t.x, t.y)
+}
+
+/// The relative URI of a tile image served beside its .gltf document.
+fn sibling_image(r: &TileRequest) -> String {
+    if r.query.is_empty() {
+        return format!("{}.png", r.spec.y);
+    }
+    let mut qs = form_urlencoded::Serializer::new(String::new());
+    for (k, v) in &r.query {
+        qs.append_pair(k, v);
+    }
+    format!("{}.{}.png", r.spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(qs.finish()))
+}
+
+fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), ApiError> {
+    match s.rsplit_once('.') {
+        Some((stem, ext)) if allowed.contains(&ext) => Ok((stem, ext)),
+        _ => Err(ApiError::bad_request("invalid_format", format!("'{s}' must end in .{}", allowed.join(" or .")))),
+    }
+}
+
+struct TileRequest {
+    tex: Arc<Texture>,
+    spec: TileSpec,
+    query: Query,
+    params: RenderParams,
+}
+
+fn tile_request(
+    st: &AppState,
+    path: Result<Path<(String, String, String, String)>, PathRejection>,
+    raw: Option<String>,
+    exts: &[&str],
+) -> Result<(TileRequest, String), ApiError> {
+    let reg = st.ready()?;
+    let Path((id, z, x, y)) = path.map_err(path_error)?;
+    let tex = texture(reg, &id)?;
+    let (y, ext) = split_ext(&y, exts)?;
+    // `{y}.{token}.png`: the parameters of an image beside a .gltf, base64url in the path.
+    let (y, raw) = match (ext, y.split_once('.')) {
+        ("png", Some((y, token))) if raw.is_none() => {
+            let q = base64::engine::general_purpose::URL_SAFE_NO_PAD
+                .decode(token)
+                .ok()
+                .and_then(|b| String::from_utf8(b).ok())
+                .ok_or_else(|| {
+                    ApiError::bad_request("invalid_parameter", format!("'{token}' is not a parameter token"))
+                })?;
+            (y, Some(q))
+        }
+        _ => (y, raw),
+    };
+    let spec = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
+    let query = parse_query(raw.as_deref(), PARAM_KEYS)?;
+    let params = render_params(&tex, &query)?;
+    Ok((TileRequest { tex, spec, query, params }, ext.to_string()))
+}
+
+fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
+    format!(
+        "{}|{}|{}|{}|{kind}|{}|{}|{}|{extra}",
+        engine_version(),
+        r.tex.config.id,
+        r.tex.file_hash,
+        r.params.canonical(),
+        r.spec.z,
+        r.spec.x,
+        r.spec.y
+    )
+}
+
+/// A tile as a glTF 2.0 ground quad: `.glb` embeds the PNG tile, `.gltf` references the tile
+/// endpoint (a URI relative to the document; the absolute URL is in `images[0].extras.tile_url`).
+#[utoipa::path(get, path = "/gltf/{id}/{z}/{x}/{y}.{ext}", tag = "3d",
+    params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
+           ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row"),
+           ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png`"),
+           ("mode" = Option<String>, Query, description = "as for tiles"), ("seed" = Option<u64>, Query, description = "as for tiles"),
+           ("randomness" = Option<String>, Query, description = "as for tiles"), ("world" = Option<u64>, Query, description = "as for tiles")),
+    responses((status = 200, description = "model/gltf-binary or model/gltf+json"), (status = 304, description = "not modified"),
+              (status = 400, description = "bad coordinates or parameters"), (status = 404, description = "unknown texture")))]
+pub async fn gltf_tile(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<(String, String, String, String)>, PathRejection>,
+    RawQuery(raw): RawQuery,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let (r, ext) = tile_request(&st, path, raw, &["glb", "gltf", "png"])?;
+    let cc = &st.config.cache_control;
+    if ext == "png" {
+        let etag = etag_for(&tile_key(&r.tex, &r.params, &r.spec));
+        if if_none_match(&headers, &etag) {
+            return Ok(not_modified(&etag, cc));
+        }
+        let hit = st.cache.peek(&etag);
+        let found = hit.is_some();
+        let bytes = match hit {
+            Some(b) => b,
+            None => tile_bytes(&st, &r.tex, &r.params, r.spec).await?,
+        };
+        return Ok(image(bytes, "image/png", &etag, cc, found));
+    }
+    if ext == "gltf" {
+        let base = base_url(&st, &headers);
+        let etag = etag_for(&key(&r, "gltf", &base));
+        if if_none_match(&headers, &etag) {
+            return Ok(not_modified(&etag, cc));
+        }
+        // glTF wants relative URIs without a query: the image is served beside this document as
+        // `{y}.png` or `{y}.{token}.png` (the parameters, base64url) with the tile's bytes. The
+        // tile endpoint's absolute URL is in the image's extras for clients that prefer it.
+        let mut doc = gltf_json(&[quad(&r.tex, &r.spec)], &[sibling_image(&r)], &generator());
+        doc["images"][0]["extras"] = serde_json::json!({ "tile_url": tile_url(&base, &r.tex, &r.spec, &r.query) });
+        let body = serde_json::to_vec(&doc).map_err(|e| ApiError::internal(e.to_string()))?;
+        return Ok(image(body.into(), "model/gltf+json", &etag, cc, false));
+    }
+    let etag = etag_for(&key(&r, "glb", ""));
+    if if_none_match(&headers, &etag) {
+        return Ok(not_modified(&etag, cc));
+    }
+    if let Some(b) = st.cache.peek(&etag) {
+        return Ok(image(b, "model/gltf-binary", &etag, cc, true));
+    }
+    let png = tile_bytes(&st, &r.tex, &r.params, r.spec).await?;
+    let q = quad(&r.tex, &r.spec);
+    let (bytes, hit) = cached(&st, &etag, move || Ok(glb(&[q], &[(png.to_vec(), "image/png")], &generator()))).await;
+    Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
+}
+
+/// An N×N patch of tiles (top-left tile `x, y`) as one GLB scene, one node per tile.
+#[utoipa::path(get, path = "/gltf/{id}/patch.glb", tag = "3d",
+    params(("id" = String, Path, description = "texture id"), ("z" = u32, Query, description = "zoom"),
+           ("x" = i64, Query, description = "left tile column"), ("y" = i64, Query, description = "top tile row"),
+           ("tiles" = u32, Query, description = "patch side in tiles, 1..=8"),
+           ("mode" = Option<String>, Query, description = "as for tiles"), ("seed" = Option<u64>, Query, description = "as for tiles"),
+           ("randomness" = Option<String>, Query, description = "as for tiles"), ("world" = Option<u64>, Query, description = "as for tiles")),
+    responses((status = 200, description = "model/gltf-binary"), (status = 400, description = "bad parameters"),
+              (status = 404, description = "unknown texture")))]
+pub async fn gltf_patch(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<String>, PathRejection>,
+    RawQuery(raw): RawQuery,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let reg = st.ready()?;
+    let Path(id) = path.map_err(path_error)?;
+    let tex = texture(reg, &id)?;
+    let mut keys: Vec<&str> = PARAM_KEYS.to_vec();
+    keys.extend(["z", "x", "y", "tiles"]);
+    let mut query = parse_query(raw.as_deref(), &keys)?;
+    let need = |q: &mut Query, k: &str| {
+        q.remove(k).ok_or_else(|| ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required")))
+    };
+    let (z, x, y, n) =
+        (need(&mut query, "z")?, need(&mut query, "x")?, need(&mut query, "y")?, need(&mut query, "tiles")?);
+    let n: i64 = n.parse().ok().filter(|n| (1..=MAX_PATCH).contains(n)).ok_or_else(|| {
+        ApiError::bad_request(
+            "invalid_parameter",
+            format!("parameter 'tiles': '{n}' is not an integer in 1..={MAX_PATCH}"),
+        )
+    })?;
+    let origin = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
+    if origin.x > COORD_MAX - (n - 1) || origin.y > COORD_MAX - (n - 1) {
+        return Err(ApiError::bad_request(
+            "invalid_coordinate",
+            format!("the patch must end at or before {COORD_MAX}"),
+        ));
+    }
+    let params = render_params(&tex, &query)?;
+    let r = TileRequest { tex: tex.clone(), spec: origin, query, params };
+    let etag = etag_for(&key(&r, "patch", &n.to_string()));
+    let cc = &st.config.cache_control;
+    if if_none_match(&headers, &etag) {
+        return Ok(not_modified(&etag, cc));
+    }
+    if let Some(b) = st.cache.peek(&etag) {
+        return Ok(image(b, "model/gltf-binary", &etag, cc, true));
+    }
+    let mut quads = Vec::new();
+    let mut images = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let spec = TileSpec { x: origin.x + i, y: origin.y + j, format: Format::Png, ..origin };
+            images.push((tile_bytes(&st, &tex, &r.params, spec).await?.to_vec(), "image/png"));
+            quads.push(quad(&tex, &spec));
+        }
+    }
+    let (bytes, hit) = cached(&st, &etag, move || Ok(glb(&quads, &images, &generator()))).await;
+    Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
+}
+
+/// A tile as an X3D scene whose `ImageTexture` points at the tile URL (the VRML use case).
+#[utoipa::path(get, path = "/x3d/{id}/{z}/{x}/{y}.x3d", tag = "3d",
+    params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
+           ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row"),
+           ("mode" = Option<String>, Query, description = "as for tiles"), ("seed" = Option<u64>, Query, description = "as for tiles"),
+           ("randomness" = Option<String>, Query, description = "as for tiles"), ("world" = Option<u64>, Query, description = "as for tiles")),
+    responses((status = 200, description = "model/x3d+xml"), (status = 400, description = "bad coordinates or parameters"),
+              (status = 404, description = "unknown texture")))]
+pub async fn x3d_tile(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<(String, String, String, String)>, PathRejection>,
+    RawQuery(raw): RawQuery,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let (r, _) = tile_request(&st, path, raw, &["x3d"])?;
+    let base = base_url(&st, &headers);
+    let etag = etag_for(&key(&r, "x3d", &base));
+    let cc = &st.config.cache_control;
+    if if_none_match(&headers, &etag) {
+        return Ok(not_modified(&etag, cc));
+    }
+    let doc = x3d(&quad(&r.tex, &r.spec), &tile_url(&base, &r.tex, &r.spec, &r.query), &generator());
+    Ok(image(doc.into_bytes().into(), "model/x3d+xml", &etag, cc, false))
+}
