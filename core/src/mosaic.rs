@@ -305,51 +305,78 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
             *d = (*d).min(last);
         }
     });
-    // Horizontal tent (1,2,3,4,3,2,1) = two 4-wide boxes, over e's rows and rect's columns.
+    // Horizontal tent (1,2,3,4,3,2,1) = two 4-wide boxes, as running sums, over e's rows and
+    // rect's columns.
     let mut th = vec![[0u32; 3]; w * eh];
     th.par_chunks_mut(w).enumerate().with_min_len(16).for_each_init(
         || vec![[0u32; 3]; w + 3],
         |bx, (j, out)| {
             let row = &m0[(j + 1) * gw + 1..(j + 1) * gw + 1 + ew];
             // bx[t] = row[t] + … + row[t+3], t = 0..w+3
-            for (t, b) in bx.iter_mut().enumerate() {
-                let q = &row[t..t + 4];
-                *b = [0, 1, 2].map(|c| q.iter().map(|p| p[c] as u32).sum());
+            let mut acc = [0u32; 3];
+            for p in &row[..4] {
+                for c in 0..3 {
+                    acc[c] += p[c] as u32;
+                }
             }
-            for (i, o) in out.iter_mut().enumerate() {
-                let q = &bx[i..i + 4];
-                *o = [0, 1, 2].map(|c| q.iter().map(|p| p[c]).sum());
+            bx[0] = acc;
+            for t in 1..w + 3 {
+                for c in 0..3 {
+                    acc[c] = acc[c] + row[t + 3][c] as u32 - row[t - 1][c] as u32;
+                }
+                bx[t] = acc;
+            }
+            let mut acc = [0u32; 3];
+            for b in &bx[..4] {
+                for c in 0..3 {
+                    acc[c] += b[c];
+                }
+            }
+            out[0] = acc;
+            for i in 1..w {
+                for c in 0..3 {
+                    acc[c] = acc[c] + bx[i + 3][c] - bx[i - 1][c];
+                }
+                out[i] = acc;
             }
         },
     );
     const TENT: [u32; 7] = [1, 2, 3, 4, 3, 2, 1];
     pixels.resize(3 * w * h, 0);
-    pixels.par_chunks_mut(3 * w).enumerate().with_min_len(16).for_each(|(j, out)| {
-        for (i, o) in out.chunks_exact_mut(3).enumerate() {
-            let c0 = m0[(j + 4) * gw + i + 4];
-            // Chebyshev distance to the nearest edge pixel, from the row distances.
-            let mut d = 4u32;
+    pixels.par_chunks_mut(3 * w).enumerate().with_min_len(16).for_each_init(
+        || vec![4u8; w],
+        |dist, (j, out)| {
+            // Chebyshev distance to the nearest edge pixel, from the row distances (dy outer
+            // so the inner loop vectorises).
+            dist.fill(4);
             for dy in 0..7usize {
-                let ady = (dy as i32 - 3).unsigned_abs();
-                d = d.min(ady.max(hd[(j + dy) * ew + i + 3] as u32));
-            }
-            if d >= s {
-                o.copy_from_slice(&c0);
-                continue;
-            }
-            let mut t = [0u32; 3];
-            for (k, &wt) in TENT.iter().enumerate() {
-                let r = th[(j + k) * w + i];
-                for (acc, v) in t.iter_mut().zip(r) {
-                    *acc += wt * v;
+                let ady = (dy as i32 - 3).unsigned_abs() as u8;
+                let row = &hd[(j + dy) * ew + 3..(j + dy) * ew + 3 + w];
+                for (d, &r) in dist.iter_mut().zip(row) {
+                    *d = (*d).min(ady.max(r));
                 }
             }
-            for ((o, c), &tc) in o.iter_mut().zip(&c0).zip(&t) {
-                let v = (*c as u32 * 256 * d + tc * (s - d) + 128 * s) / (256 * s);
-                *o = v.min(255) as u8;
+            let m0row = &m0[(j + 4) * gw + 4..(j + 4) * gw + 4 + w];
+            for (i, (o, (&c0, &d))) in out.chunks_exact_mut(3).zip(m0row.iter().zip(dist.iter())).enumerate() {
+                let d = d as u32;
+                if d >= s {
+                    o.copy_from_slice(&c0);
+                    continue;
+                }
+                let mut t = [0u32; 3];
+                for (k, &wt) in TENT.iter().enumerate() {
+                    let r = th[(j + k) * w + i];
+                    for (acc, v) in t.iter_mut().zip(r) {
+                        *acc += wt * v;
+                    }
+                }
+                for ((o, c), &tc) in o.iter_mut().zip(&c0).zip(&t) {
+                    let v = (*c as u32 * 256 * d + tc * (s - d) + 128 * s) / (256 * s);
+                    *o = v.min(255) as u8;
+                }
             }
-        }
-    });
+        },
+    );
     RgbWindow { width: w as u32, height: h as u32, pixels }
 }
 
