@@ -130,6 +130,7 @@ async fn health_ready_viewer_and_openapi() {
         "/world.html",
         "/health",
         "/ready",
+        "/metrics",
         "/catalog",
         "/openapi.json",
         "/textures/{id}",

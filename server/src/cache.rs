@@ -3,11 +3,11 @@
 
 use std::collections::HashMap;
 use std::future::Future;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use axum::body::Bytes;
 use lru::LruCache;
+use prometheus::{IntCounter, IntGauge};
 use tokio::sync::OnceCell;
 
 use crate::http::error::ApiError;
@@ -19,15 +19,28 @@ struct Lru {
     bytes: u64,
 }
 
-/// Counters of the cache.
-#[derive(Default)]
+/// Counters and gauges of the cache (Prometheus handles, shared with the metrics registry).
+#[derive(Clone)]
 pub struct CacheStats {
     /// Answers served from the cache.
-    pub hits: AtomicU64,
+    pub hits: IntCounter,
     /// Answers not in the cache.
-    pub misses: AtomicU64,
+    pub misses: IntCounter,
     /// Entries evicted to stay under the byte limit.
-    pub evictions: AtomicU64,
+    pub evictions: IntCounter,
+    /// Bytes held.
+    pub bytes: IntGauge,
+    /// Entries held.
+    pub entries: IntGauge,
+}
+
+impl CacheStats {
+    /// Handles not registered anywhere (for a cache used on its own).
+    pub fn unregistered() -> Self {
+        let c = |n: &str| IntCounter::new(n, n).unwrap_or_else(|e| panic!("{e}"));
+        let g = |n: &str| IntGauge::new(n, n).unwrap_or_else(|e| panic!("{e}"));
+        CacheStats { hits: c("h"), misses: c("m"), evictions: c("e"), bytes: g("b"), entries: g("n") }
+    }
 }
 
 /// Byte-bounded LRU of encoded images with request coalescing.
@@ -41,12 +54,12 @@ pub struct TileCache {
 
 impl TileCache {
     /// A cache holding at most `limit` bytes of values (keys are small and not counted).
-    pub fn new(limit: u64) -> Self {
+    pub fn new(limit: u64, stats: CacheStats) -> Self {
         TileCache {
             lru: Mutex::new(Lru { map: LruCache::unbounded(), bytes: 0 }),
             limit,
             inflight: Mutex::new(HashMap::new()),
-            stats: CacheStats::default(),
+            stats,
         }
     }
 
@@ -60,7 +73,7 @@ impl TileCache {
     pub fn peek(&self, key: &str) -> Option<Bytes> {
         let v = self.get(key);
         if v.is_some() {
-            self.stats.hits.fetch_add(1, Ordering::Relaxed);
+            self.stats.hits.inc();
         }
         v
     }
@@ -83,11 +96,13 @@ impl TileCache {
             match l.map.pop_lru() {
                 Some((_, v)) => {
                     l.bytes -= v.len() as u64;
-                    self.stats.evictions.fetch_add(1, Ordering::Relaxed);
+                    self.stats.evictions.inc();
                 }
                 None => break,
             }
         }
+        self.stats.bytes.set(l.bytes as i64);
+        self.stats.entries.set(l.map.len() as i64);
     }
 
     /// The cached value for `key`, or the result of `compute` — run once for all concurrent
@@ -98,10 +113,10 @@ impl TileCache {
         Fut: Future<Output = Result<Bytes, ApiError>>,
     {
         if let Some(v) = self.get(key) {
-            self.stats.hits.fetch_add(1, Ordering::Relaxed);
+            self.stats.hits.inc();
             return (Ok(v), true);
         }
-        self.stats.misses.fetch_add(1, Ordering::Relaxed);
+        self.stats.misses.inc();
         let cell = {
             let mut m = self.inflight.lock().unwrap_or_else(|e| e.into_inner());
             m.entry(key.to_string()).or_default().clone()
@@ -132,13 +147,13 @@ mod tests {
 
     #[tokio::test]
     async fn evicts_by_bytes_and_coalesces() {
-        let c = TileCache::new(10);
+        let c = TileCache::new(10, CacheStats::unregistered());
         let (r, hit) = c.get_or_compute("a", || async { Ok(Bytes::from_static(b"123456")) }).await;
         assert_eq!((r.unwrap().len(), hit), (6, false));
         let (_, hit) = c.get_or_compute("a", || async { Err(ApiError::internal("not called")) }).await;
         assert!(hit);
         let _ = c.get_or_compute("b", || async { Ok(Bytes::from_static(b"123456")) }).await;
         assert_eq!(c.usage(), (1, 6));
-        assert_eq!(c.stats.evictions.load(Ordering::Relaxed), 1);
+        assert_eq!(c.stats.evictions.get(), 1);
     }
 }

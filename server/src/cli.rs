@@ -28,6 +28,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Print the header of an analysis file.
     Info(InfoArgs),
+    /// Load-test a running textile server on this machine with scripted request patterns.
+    Loadtest(LoadtestArgs),
 }
 
 /// Options shared by commands that read the configuration.
@@ -136,4 +138,40 @@ pub struct RenderArgs {
 pub struct InfoArgs {
     /// Analysis file.
     pub file: PathBuf,
+}
+
+/// `textile loadtest`.
+#[derive(Debug, Args)]
+pub struct LoadtestArgs {
+    /// Base URL of the server (loopback addresses only).
+    #[arg(long, default_value = "http://127.0.0.1:8080")]
+    pub url: String,
+    /// Texture id.
+    #[arg(long, default_value = "gravel")]
+    pub texture: String,
+    /// Request pattern: pan (viewport dragged across the plane), zoom (in and out), random
+    /// (uniform tiles), hot (one tile), replay (the URLs of --file, cycled).
+    #[arg(long, default_value = "pan", value_parser = ["pan", "zoom", "random", "hot", "replay"])]
+    pub pattern: String,
+    /// URL list for `--pattern replay`: one URL or /path per line.
+    #[arg(long, value_name = "FILE")]
+    pub file: Option<PathBuf>,
+    /// Concurrent connections (1-1024).
+    #[arg(long, default_value_t = 8)]
+    pub concurrency: usize,
+    /// Stop after this many requests (1-10000000).
+    #[arg(long, default_value_t = 1000)]
+    pub requests: u64,
+    /// Stop after this many seconds (at most 3600).
+    #[arg(long, default_value_t = 30.0)]
+    pub duration: f64,
+    /// Query string added to every tile URL, e.g. "mode=mosaic&seed=3".
+    #[arg(long, default_value = "")]
+    pub query: String,
+    /// Seed of the random pattern.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -15,6 +15,8 @@ pub mod commands;
 pub mod config;
 pub mod encode;
 pub mod http;
+pub mod loadtest;
+pub mod metrics;
 pub mod render;
 pub mod serve;
 pub mod textures;
@@ -30,6 +32,7 @@ pub fn run() -> std::process::ExitCode {
         Some(cli::Command::Analyze(a)) => commands::analyze(a),
         Some(cli::Command::Render(a)) => commands::render(a),
         Some(cli::Command::Info(a)) => commands::info(a),
+        Some(cli::Command::Loadtest(a)) => loadtest::run(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -26,11 +26,11 @@ pub(crate) fn path_error(e: PathRejection) -> ApiError {
 }
 
 /// Bytes for a key from the cache, or from `make` on the synthesis pool (single-flight).
-pub(crate) async fn cached<F>(st: &Arc<AppState>, etag: &str, make: F) -> (Result<Bytes, ApiError>, bool)
+pub(crate) async fn cached<F>(st: &Arc<AppState>, etag: &str, mode: &str, make: F) -> (Result<Bytes, ApiError>, bool)
 where
     F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
 {
-    st.cache.get_or_compute(etag, || st.synthesize(make)).await
+    st.cache.get_or_compute(etag, || st.synthesize(mode, make)).await
 }
 
 /// The cache key of a tile.
@@ -58,7 +58,8 @@ pub(crate) async fn tile_bytes(
 ) -> Result<Bytes, ApiError> {
     let (tex, p) = (tex.clone(), p.clone());
     let etag = etag_for(&tile_key(&tex, &p, &spec));
-    cached(st, &etag, move || encode_window(render_tile(&tex, &p, &spec)?, spec.format)).await.0
+    let mode = p.mode();
+    cached(st, &etag, mode, move || encode_window(render_tile(&tex, &p, &spec)?, spec.format)).await.0
 }
 
 fn encode_window(img: textile_core::RgbWindow, fmt: Format) -> Result<Vec<u8>, ApiError> {
@@ -69,6 +70,7 @@ async fn answer<F>(
     st: &Arc<AppState>,
     headers: &HeaderMap,
     key: String,
+    mode: &str,
     fmt: Format,
     job: F,
 ) -> Result<Response, ApiError>
@@ -80,7 +82,7 @@ where
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
-    let (bytes, hit) = cached(st, &etag, move || encode_window(job()?, fmt)).await;
+    let (bytes, hit) = cached(st, &etag, mode, move || encode_window(job()?, fmt)).await;
     Ok(image(bytes?, fmt.content_type(), &etag, cc, hit))
 }
 
@@ -112,7 +114,7 @@ pub async fn tile(
     let q = parse_query(q.as_deref(), PARAM_KEYS)?;
     let p = render_params(&tex, &q)?;
     let key = tile_key(&tex, &p, &spec);
-    answer(&st, &headers, key, spec.format, move || render_tile(&tex, &p, &spec)).await
+    answer(&st, &headers, key, p.mode(), spec.format, move || render_tile(&tex, &p, &spec)).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -154,5 +156,5 @@ pub async fn window(
         spec.h,
         fmt.ext()
     );
-    answer(&st, &headers, key, fmt, move || render_window(&tex, &p, &spec)).await
+    answer(&st, &headers, key, p.mode(), fmt, move || render_window(&tex, &p, &spec)).await
 }

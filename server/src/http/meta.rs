@@ -1,7 +1,6 @@
 //! Descriptive endpoints: health and readiness, the catalog, texture metadata and exemplar,
 //! TileJSON 3.0.0, the OpenAPI document and the viewer page.
 
-use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 use axum::extract::rejection::PathRejection;
@@ -43,13 +42,13 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
         "engine": engine_version(),
         "ready": st.registry.get().is_some(),
         "textures": st.registry.get().map(|r| r.list.len()).unwrap_or(0),
-        "tiles_synthesized": st.syntheses.load(Ordering::Relaxed),
-        "shed": st.shed.load(Ordering::Relaxed),
+        "tiles_synthesized": st.syntheses(),
+        "shed": st.metrics.shed.get(),
         "cache": {
             "entries": entries, "bytes": bytes, "limit_bytes": st.config.cache_mib << 20,
-            "hits": st.cache.stats.hits.load(Ordering::Relaxed),
-            "misses": st.cache.stats.misses.load(Ordering::Relaxed),
-            "evictions": st.cache.stats.evictions.load(Ordering::Relaxed),
+            "hits": st.cache.stats.hits.get(),
+            "misses": st.cache.stats.misses.get(),
+            "evictions": st.cache.stats.evictions.get(),
         },
     }))
 }
@@ -204,6 +203,7 @@ pub async fn tilejson(
         crate::http::images::tile,
         crate::http::images::window,
         crate::http::meta::openapi,
+        crate::http::meta::metrics,
         crate::http::static_files::index,
         crate::http::static_files::world,
         crate::http::models::gltf_tile,
@@ -217,6 +217,14 @@ pub struct ApiDoc;
 #[utoipa::path(get, path = "/openapi.json", tag = "service", responses((status = 200, description = "OpenAPI 3")))]
 pub async fn openapi() -> Json<utoipa::openapi::OpenApi> {
     Json(ApiDoc::openapi())
+}
+
+/// Prometheus metrics in the text exposition format.
+#[utoipa::path(get, path = "/metrics", tag = "service", responses((status = 200, description = "Prometheus text format")))]
+pub async fn metrics(State(st): State<Arc<AppState>>) -> Response {
+    let mut r = st.metrics.render().into_response();
+    r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/plain; version=0.0.4; charset=utf-8"));
+    r
 }
 
 /// 404 for unknown routes.

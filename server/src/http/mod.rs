@@ -11,8 +11,10 @@ pub mod static_files;
 
 use std::sync::Arc;
 
+use axum::extract::{MatchedPath, Request, State};
 use axum::http::{header, HeaderValue, Method};
-use axum::response::IntoResponse;
+use axum::middleware::{self, Next};
+use axum::response::{IntoResponse, Response};
 use axum::routing::get;
 use axum::Router;
 use tower_http::catch_panic::CatchPanicLayer;
@@ -21,6 +23,17 @@ use tower_http::cors::{AllowOrigin, CorsLayer};
 
 use self::error::ApiError;
 use self::state::AppState;
+
+/// Count every routed request by route template and status, and time it.
+async fn track(State(st): State<Arc<AppState>>, req: Request, next: Next) -> Response {
+    let route =
+        req.extensions().get::<MatchedPath>().map(|m| m.as_str().to_owned()).unwrap_or_else(|| "unmatched".into());
+    let started = std::time::Instant::now();
+    let resp = next.run(req).await;
+    st.metrics.latency.with_label_values(&[&route]).observe(started.elapsed().as_secs_f64());
+    st.metrics.requests.with_label_values(&[&route, resp.status().as_str()]).inc();
+    resp
+}
 
 /// Build the router for a state.
 pub fn router(state: Arc<AppState>) -> Router {
@@ -41,6 +54,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/ready", get(meta::ready))
         .route("/catalog", get(meta::catalog))
         .route("/openapi.json", get(meta::openapi))
+        .route("/metrics", get(meta::metrics))
         .route("/textures/{id}", get(meta::texture_meta))
         .route("/textures/{id}/exemplar.png", get(meta::exemplar))
         .route("/tiles/{id}/tilejson.json", get(meta::tilejson))
@@ -51,6 +65,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile))
         .fallback(meta::not_found)
         .method_not_allowed_fallback(meta::method_not_allowed)
+        .layer(middleware::from_fn_with_state(state.clone(), track))
         .with_state(state)
         .layer(CompressionLayer::new())
         .layer(cors)

@@ -168,7 +168,8 @@ pub async fn gltf_tile(
     }
     let png = tile_bytes(&st, &r.tex, &r.params, r.spec).await?;
     let q = quad(&r.tex, &r.spec);
-    let (bytes, hit) = cached(&st, &etag, move || Ok(glb(&[q], &[(png.to_vec(), "image/png")], &generator()))).await;
+    let (bytes, hit) =
+        cached(&st, &etag, "gltf", move || Ok(glb(&[q], &[(png.to_vec(), "image/png")], &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
@@ -230,7 +231,7 @@ pub async fn gltf_patch(
             quads.push(quad(&tex, &spec));
         }
     }
-    let (bytes, hit) = cached(&st, &etag, move || Ok(glb(&quads, &images, &generator()))).await;
+    let (bytes, hit) = cached(&st, &etag, "gltf", move || Ok(glb(&quads, &images, &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 

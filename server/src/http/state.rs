@@ -3,16 +3,16 @@
 //! the synthesis thread pool.
 
 use std::panic::AssertUnwindSafe;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use axum::body::Bytes;
 use tokio::sync::Semaphore;
 
-use crate::cache::TileCache;
+use crate::cache::{CacheStats, TileCache};
 use crate::config::Config;
 use crate::http::error::ApiError;
+use crate::metrics::Metrics;
 use crate::textures::Registry;
 
 /// State shared by all handlers.
@@ -23,25 +23,40 @@ pub struct AppState {
     pub registry: OnceLock<Arc<Registry>>,
     /// Encoded images.
     pub cache: TileCache,
-    /// Permits for syntheses in flight.
+    /// Permits for syntheses in flight (running or waiting); beyond them requests are shed.
     pub admission: Arc<Semaphore>,
-    /// Syntheses started.
-    pub syntheses: AtomicU64,
-    /// Requests shed with 503 because of the in-flight limit.
-    pub shed: AtomicU64,
+    /// Permits to run on the synthesis pool: one per pool thread, handed out first come first
+    /// served. Without it, rayon workers waiting inside one synthesis steal other queued
+    /// syntheses and unlucky requests stack up behind many others (seconds of tail latency).
+    pub running: Arc<Semaphore>,
+    /// Prometheus metrics.
+    pub metrics: Metrics,
 }
 
 impl AppState {
     /// New state for a configuration.
     pub fn new(config: Config) -> Self {
+        let metrics = Metrics::new();
+        let stats = CacheStats {
+            hits: metrics.cache_hits.clone(),
+            misses: metrics.cache_misses.clone(),
+            evictions: metrics.cache_evictions.clone(),
+            bytes: metrics.cache_bytes.clone(),
+            entries: metrics.cache_entries.clone(),
+        };
         AppState {
-            cache: TileCache::new(config.cache_mib << 20),
+            cache: TileCache::new(config.cache_mib << 20, stats),
             admission: Arc::new(Semaphore::new(config.max_in_flight)),
+            running: Arc::new(Semaphore::new(rayon::current_num_threads().max(1))),
             config,
             registry: OnceLock::new(),
-            syntheses: AtomicU64::new(0),
-            shed: AtomicU64::new(0),
+            metrics,
         }
+    }
+
+    /// Syntheses started so far (all modes).
+    pub fn syntheses(&self) -> u64 {
+        ["synth", "mosaic", "gltf"].iter().map(|m| self.metrics.syntheses.with_label_values(&[m]).get()).sum()
     }
 
     /// The registry, or 503 while loading.
@@ -49,31 +64,55 @@ impl AppState {
         self.registry.get().ok_or_else(ApiError::not_ready)
     }
 
-    /// Run a synthesis job on the rayon pool (never on a tokio worker), within the in-flight
-    /// limit and the request timeout. A panic in the job becomes a 500.
-    pub async fn synthesize<F>(&self, job: F) -> Result<Bytes, ApiError>
+    /// Run a synthesis job (counted under `mode`) on the rayon pool (never on a tokio worker),
+    /// within the in-flight limit and the request timeout. A panic in the job becomes a 500.
+    pub async fn synthesize<F>(&self, mode: &str, job: F) -> Result<Bytes, ApiError>
     where
         F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
     {
-        let permit = self.admission.clone().try_acquire_owned().map_err(|_| {
-            self.shed.fetch_add(1, Ordering::Relaxed);
+        let admitted = self.admission.clone().try_acquire_owned().map_err(|_| {
+            self.metrics.shed.inc();
             ApiError::overloaded()
         })?;
-        self.syntheses.fetch_add(1, Ordering::Relaxed);
-        let (tx, rx) = tokio::sync::oneshot::channel();
-        rayon::spawn(move || {
-            let r = std::panic::catch_unwind(AssertUnwindSafe(job));
-            drop(permit);
-            let _ = tx.send(r);
-        });
+        // Everything the job holds until it ends, released on drop even if it never starts.
+        let guard = (admitted, InFlight::new(&self.metrics.in_flight));
+        let work = async {
+            let run = self.running.clone().acquire_owned().await.map_err(|_| ApiError::internal("pool closed"))?;
+            let timer = self.metrics.synthesis_timer(mode).start_timer();
+            let (tx, rx) = tokio::sync::oneshot::channel();
+            rayon::spawn(move || {
+                let r = std::panic::catch_unwind(AssertUnwindSafe(job));
+                drop((guard, run));
+                timer.observe_duration();
+                let _ = tx.send(r);
+            });
+            match rx.await {
+                Ok(Ok(r)) => r.map(Bytes::from),
+                _ => Err(ApiError::internal("synthesis failed unexpectedly")),
+            }
+        };
         let wait = Duration::from_secs(self.config.request_timeout_secs);
-        match tokio::time::timeout(wait, rx).await {
-            Err(_) => Err(ApiError {
+        tokio::time::timeout(wait, work).await.unwrap_or_else(|_| {
+            Err(ApiError {
                 retry_after: Some(5),
                 ..ApiError::new(axum::http::StatusCode::SERVICE_UNAVAILABLE, "timeout", "synthesis took too long")
-            }),
-            Ok(Err(_)) | Ok(Ok(Err(_))) => Err(ApiError::internal("synthesis failed unexpectedly")),
-            Ok(Ok(Ok(r))) => r.map(Bytes::from),
-        }
+            })
+        })
+    }
+}
+
+/// Counts a synthesis in the in-flight gauge for as long as it lives.
+struct InFlight(prometheus::IntGauge);
+
+impl InFlight {
+    fn new(g: &prometheus::IntGauge) -> Self {
+        g.inc();
+        InFlight(g.clone())
+    }
+}
+
+impl Drop for InFlight {
+    fn drop(&mut self) {
+        self.0.dec();
     }
 }

@@ -1,0 +1,230 @@
+//! `textile loadtest`: drive a running textile server on this machine with scripted request
+//! patterns — `pan` (a 1920×1080 viewport dragged across the plane), `zoom` (in and out around a
+//! drifting centre), `random` (uniform tiles and zooms), `hot` (one tile) and `replay FILE` — at a
+//! fixed concurrency, bounded by a request count and a duration; then print throughput,
+//! latency percentiles, status counts, bytes and the server's cache hit ratio (from /metrics).
+//! Loopback targets only.
+
+use std::collections::BTreeMap;
+use std::net::IpAddr;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use serde_json::json;
+
+use crate::cli::LoadtestArgs;
+use crate::serve::CliResult;
+
+type Paths = Box<dyn Iterator<Item = String> + Send>;
+
+/// Tiles of a `w × h` viewport whose top-left is texel-at-zoom `(x, y)`.
+fn viewport(x: i64, y: i64, w: i64, h: i64) -> impl Iterator<Item = (i64, i64)> {
+    let (tx0, ty0) = (x.div_euclid(256), y.div_euclid(256));
+    let (tx1, ty1) = ((x + w - 1).div_euclid(256), (y + h - 1).div_euclid(256));
+    (ty0..=ty1).flat_map(move |ty| (tx0..=tx1).map(move |tx| (tx, ty)))
+}
+
+/// SplitMix64, for reproducible random patterns.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        textile_core::hash::mix(self.0)
+    }
+    fn range(&mut self, lo: i64, hi: i64) -> i64 {
+        lo + (self.next() % (hi - lo + 1) as u64) as i64
+    }
+}
+
+/// The request paths of a pattern (endless except `replay`, which cycles its file).
+pub fn pattern(name: &str, id: &str, native: u32, minzoom: u32, query: &str, lines: Vec<String>, seed: u64) -> Paths {
+    let q = if query.is_empty() { String::new() } else { format!("?{query}") };
+    let id = id.to_string();
+    let tile = move |z: u32, x: i64, y: i64| format!("/tiles/{id}/{z}/{x}/{y}.png{q}");
+    let tile = Arc::new(tile);
+    match name {
+        "hot" => {
+            let t = tile.clone();
+            Box::new(std::iter::repeat_with(move || t(native, 0, 0)))
+        }
+        "random" => {
+            let mut rng = Rng(seed);
+            let t = tile.clone();
+            Box::new(std::iter::repeat_with(move || {
+                let z = rng.range(minzoom as i64, native as i64) as u32;
+                t(z, rng.range(-(1 << 20), 1 << 20), rng.range(-(1 << 20), 1 << 20))
+            }))
+        }
+        "zoom" => {
+            // Zoom out from native to minzoom and back in, centred on a point that drifts by
+            // three screens per cycle; every step requests the visible tiles.
+            let t = tile.clone();
+            let zooms: Vec<u32> = (minzoom..=native).rev().chain(minzoom + 1..native).collect();
+            Box::new((0i64..).flat_map(move |cycle| {
+                let t = t.clone();
+                let (cx, cy) = (cycle * 3 * 1920, cycle * 1080);
+                zooms.clone().into_iter().flat_map(move |z| {
+                    let t = t.clone();
+                    let k = native - z;
+                    let (x, y) = ((cx >> k) - 960, (cy >> k) - 540);
+                    viewport(x, y, 1920, 1080).map(move |(tx, ty)| t(z, tx, ty))
+                })
+            }))
+        }
+        "replay" => Box::new(lines.into_iter().cycle()),
+        _ => {
+            // pan: drag a 1920×1080 viewport right and slightly down, 64 px per frame; request
+            // each tile the first time it becomes visible (a browser caches the rest).
+            let t = tile.clone();
+            let mut seen = std::collections::HashSet::new();
+            Box::new((0i64..).flat_map(move |f| {
+                let (x, y) = (64 * f - 960, 16 * f - 540);
+                viewport(x, y, 1920, 1080)
+                    .filter(|c| seen.insert(*c))
+                    .map(|(tx, ty)| t(native, tx, ty))
+                    .collect::<Vec<_>>()
+            }))
+        }
+    }
+}
+
+fn loopback(url: &reqwest::Url) -> bool {
+    match url.host() {
+        Some(url::Host::Domain(d)) => d == "localhost",
+        Some(url::Host::Ipv4(ip)) => IpAddr::V4(ip).is_loopback(),
+        Some(url::Host::Ipv6(ip)) => IpAddr::V6(ip).is_loopback(),
+        None => false,
+    }
+}
+
+fn scrape(text: &str, name: &str) -> f64 {
+    text.lines().find_map(|l| l.strip_prefix(name).and_then(|r| r.trim().parse().ok())).unwrap_or(0.0)
+}
+
+/// Run the load test.
+pub fn run(a: LoadtestArgs) -> CliResult {
+    let base = reqwest::Url::parse(&a.url).map_err(|e| format!("--url {}: {e}", a.url))?;
+    if !loopback(&base) {
+        return Err(
+            format!("--url {}: loadtest only targets this machine (localhost, 127.0.0.0/8 or ::1)", a.url).into()
+        );
+    }
+    if !(1..=1024).contains(&a.concurrency) {
+        return Err("--concurrency must be 1..=1024".into());
+    }
+    if !((1..=10_000_000).contains(&a.requests) && a.duration > 0.0 && a.duration <= 3600.0) {
+        return Err("--requests must be 1..=10000000 and --duration 0..=3600 seconds".into());
+    }
+    let lines = match (&a.pattern[..], &a.file) {
+        ("replay", Some(f)) => {
+            let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}", f.display()))?;
+            let mut v = Vec::new();
+            for l in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
+                let path = match reqwest::Url::parse(l) {
+                    Ok(u) => format!("{}{}", u.path(), u.query().map(|q| format!("?{q}")).unwrap_or_default()),
+                    Err(_) if l.starts_with('/') => l.to_string(),
+                    Err(_) => return Err(format!("{}: '{l}' is neither a URL nor a /path", f.display()).into()),
+                };
+                v.push(path);
+            }
+            if v.is_empty() {
+                return Err(format!("{}: no URLs", f.display()).into());
+            }
+            v
+        }
+        ("replay", None) => return Err("--pattern replay needs --file".into()),
+        _ => Vec::new(),
+    };
+    let rt = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
+    rt.block_on(async move {
+        let client = reqwest::Client::builder().pool_max_idle_per_host(a.concurrency).build()?;
+        let root = a.url.trim_end_matches('/').to_string();
+        let meta: serde_json::Value = client
+            .get(format!("{root}/textures/{}", a.texture))
+            .send()
+            .await
+            .map_err(|e| format!("cannot reach {root}: {e}"))?
+            .json()
+            .await?;
+        let native = meta["native_zoom"].as_u64().ok_or_else(|| format!("no texture '{}' at {root}", a.texture))? as u32;
+        let minzoom = meta["minzoom"].as_u64().unwrap_or(0) as u32;
+        let metrics_before = client.get(format!("{root}/metrics")).send().await?.text().await?;
+        let paths = Arc::new(Mutex::new(pattern(&a.pattern, &a.texture, native, minzoom, &a.query, lines, a.seed)));
+        let issued = Arc::new(std::sync::atomic::AtomicU64::new(0));
+        let started = Instant::now();
+        let deadline = started + Duration::from_secs_f64(a.duration);
+        let mut tasks = Vec::new();
+        for _ in 0..a.concurrency {
+            let (client, paths, issued, root) = (client.clone(), paths.clone(), issued.clone(), root.clone());
+            let max = a.requests;
+            tasks.push(tokio::spawn(async move {
+                let mut out = Vec::new();
+                while Instant::now() < deadline && issued.fetch_add(1, std::sync::atomic::Ordering::Relaxed) < max {
+                    let Some(path) = paths.lock().unwrap_or_else(|e| e.into_inner()).next() else { break };
+                    let t = Instant::now();
+                    let left = deadline.saturating_duration_since(t).max(Duration::from_millis(1));
+                    let r = tokio::time::timeout(left, async {
+                        let resp = client.get(format!("{root}{path}")).send().await?;
+                        let status = resp.status().as_u16();
+                        let n = resp.bytes().await?.len();
+                        Ok::<_, reqwest::Error>((status, n))
+                    })
+                    .await;
+                    match r {
+                        Ok(Ok((status, n))) => out.push((t.elapsed(), status, n)),
+                        Ok(Err(_)) => out.push((t.elapsed(), 0, 0)),
+                        Err(_) => break,
+                    }
+                }
+                out
+            }));
+        }
+        let mut all = Vec::new();
+        for t in tasks {
+            all.extend(t.await?);
+        }
+        let elapsed = started.elapsed().as_secs_f64();
+        let metrics_after = client.get(format!("{root}/metrics")).send().await?.text().await?;
+        let d = |n: &str| scrape(&metrics_after, n) - scrape(&metrics_before, n);
+        let (hits, misses) = (d("textile_cache_hits_total"), d("textile_cache_misses_total"));
+        let mut lat: Vec<f64> = all.iter().map(|r| r.0.as_secs_f64() * 1e3).collect();
+        lat.sort_by(f64::total_cmp);
+        let q = |p: f64| if lat.is_empty() { 0.0 } else { lat[((lat.len() - 1) as f64 * p).round() as usize] };
+        let mut statuses = BTreeMap::new();
+        for r in &all {
+            *statuses.entry(if r.1 == 0 { "error".to_string() } else { r.1.to_string() }).or_insert(0u64) += 1;
+        }
+        let bytes: u64 = all.iter().map(|r| r.2 as u64).sum();
+        let report = json!({
+            "pattern": a.pattern, "texture": a.texture, "concurrency": a.concurrency,
+            "requests": all.len(), "seconds": elapsed, "requests_per_second": all.len() as f64 / elapsed,
+            "latency_ms": { "p50": q(0.5), "p90": q(0.9), "p99": q(0.99), "max": q(1.0) },
+            "status": statuses, "bytes": bytes,
+            "server_cache_hit_ratio": if hits + misses > 0.0 { hits / (hits + misses) } else { 0.0 },
+            "server_syntheses": d("textile_syntheses_total{mode=\"synth\"}") + d("textile_syntheses_total{mode=\"mosaic\"}"),
+        });
+        if a.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            println!(
+                "{} × {} on '{}' for {:.2}s: {} requests, {:.1} req/s, {:.1} MiB",
+                a.pattern,
+                a.concurrency,
+                a.texture,
+                elapsed,
+                all.len(),
+                all.len() as f64 / elapsed,
+                bytes as f64 / 1048576.0
+            );
+            println!("latency ms: p50 {:.2}  p90 {:.2}  p99 {:.2}  max {:.2}", q(0.5), q(0.9), q(0.99), q(1.0));
+            println!("status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
+            println!(
+                "server: cache hit ratio {:.3} ({hits} hits, {misses} misses), {} syntheses",
+                report["server_cache_hit_ratio"].as_f64().unwrap_or(0.0),
+                report["server_syntheses"]
+            );
+        }
+        Ok::<(), Box<dyn std::error::Error>>(())
+    })
+}

@@ -1,0 +1,108 @@
+//! Prometheus metrics (the `prometheus` crate): requests by route and status, latency
+//! histograms, tile-cache hits/misses/evictions/bytes, syntheses by mode, in-flight and shed
+//! syntheses. One registry per server; `/metrics` renders it in the text format.
+
+use prometheus::{
+    Encoder, Histogram, HistogramOpts, HistogramVec, IntCounter, IntCounterVec, IntGauge, Opts, Registry, TextEncoder,
+};
+
+/// Every metric of the service.
+pub struct Metrics {
+    registry: Registry,
+    /// HTTP requests by route template and status.
+    pub requests: IntCounterVec,
+    /// Request latency by route template.
+    pub latency: HistogramVec,
+    /// Cache answers served from memory.
+    pub cache_hits: IntCounter,
+    /// Cache lookups that missed.
+    pub cache_misses: IntCounter,
+    /// Cache entries evicted to stay within the byte limit.
+    pub cache_evictions: IntCounter,
+    /// Bytes held by the cache.
+    pub cache_bytes: IntGauge,
+    /// Entries held by the cache.
+    pub cache_entries: IntGauge,
+    /// Syntheses started, by mode.
+    pub syntheses: IntCounterVec,
+    /// Synthesis time by mode.
+    pub synthesis_seconds: HistogramVec,
+    /// Syntheses running or queued.
+    pub in_flight: IntGauge,
+    /// Requests shed with 503 because of the in-flight limit.
+    pub shed: IntCounter,
+}
+
+fn must<T>(r: prometheus::Result<T>) -> T {
+    // Metric definitions are static; an error here is a programming error caught by tests.
+    r.unwrap_or_else(|e| panic!("metric definition: {e}"))
+}
+
+impl Metrics {
+    /// A fresh registry with every metric registered.
+    pub fn new() -> Metrics {
+        let registry = Registry::new_custom(Some("textile".into()), None).unwrap_or_default();
+        let buckets = vec![0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0];
+        let m = Metrics {
+            requests: must(IntCounterVec::new(
+                Opts::new("http_requests_total", "HTTP requests by route and status"),
+                &["route", "status"],
+            )),
+            latency: must(HistogramVec::new(
+                HistogramOpts::new("http_request_duration_seconds", "HTTP request latency by route")
+                    .buckets(buckets.clone()),
+                &["route"],
+            )),
+            cache_hits: must(IntCounter::new("cache_hits_total", "tile cache hits")),
+            cache_misses: must(IntCounter::new("cache_misses_total", "tile cache misses")),
+            cache_evictions: must(IntCounter::new("cache_evictions_total", "tile cache evictions")),
+            cache_bytes: must(IntGauge::new("cache_bytes", "bytes held by the tile cache")),
+            cache_entries: must(IntGauge::new("cache_entries", "entries held by the tile cache")),
+            syntheses: must(IntCounterVec::new(Opts::new("syntheses_total", "syntheses started, by mode"), &["mode"])),
+            synthesis_seconds: must(HistogramVec::new(
+                HistogramOpts::new("synthesis_duration_seconds", "synthesis and encoding time, by mode")
+                    .buckets(buckets),
+                &["mode"],
+            )),
+            in_flight: must(IntGauge::new("syntheses_in_flight", "syntheses running or queued")),
+            shed: must(IntCounter::new("shed_total", "requests answered 503 because of the in-flight limit")),
+            registry,
+        };
+        let all: Vec<Box<dyn prometheus::core::Collector>> = vec![
+            Box::new(m.requests.clone()),
+            Box::new(m.latency.clone()),
+            Box::new(m.cache_hits.clone()),
+            Box::new(m.cache_misses.clone()),
+            Box::new(m.cache_evictions.clone()),
+            Box::new(m.cache_bytes.clone()),
+            Box::new(m.cache_entries.clone()),
+            Box::new(m.syntheses.clone()),
+            Box::new(m.synthesis_seconds.clone()),
+            Box::new(m.in_flight.clone()),
+            Box::new(m.shed.clone()),
+        ];
+        for c in all {
+            must(m.registry.register(c));
+        }
+        m
+    }
+
+    /// The registry in the Prometheus text format.
+    pub fn render(&self) -> String {
+        let mut buf = Vec::new();
+        let _ = TextEncoder::new().encode(&self.registry.gather(), &mut buf);
+        String::from_utf8(buf).unwrap_or_default()
+    }
+
+    /// A synthesis timer for a mode.
+    pub fn synthesis_timer(&self, mode: &str) -> Histogram {
+        self.syntheses.with_label_values(&[mode]).inc();
+        self.synthesis_seconds.with_label_values(&[mode])
+    }
+}
+
+impl Default for Metrics {
+    fn default() -> Self {
+        Self::new()
+    }
+}

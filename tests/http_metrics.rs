@@ -1,0 +1,79 @@
+//! `/metrics` in the Prometheus text format and the `textile loadtest` tool against the real
+//! server: every pattern runs, reports statuses and the server's cache hit ratio, and refuses
+//! non-loopback targets.
+
+mod support;
+
+use std::process::Command;
+
+use support::{binary, Server};
+
+fn value(text: &str, series: &str) -> f64 {
+    text.lines()
+        .find_map(|l| l.strip_prefix(series).and_then(|r| r.trim().parse().ok()))
+        .unwrap_or_else(|| panic!("no series {series} in\n{text}"))
+}
+
+#[tokio::test]
+async fn metrics_count_requests_cache_and_syntheses() {
+    let s = Server::start(&[]);
+    for _ in 0..3 {
+        assert_eq!(s.get("/tiles/gravel/7/4/4.png?mode=mosaic").await.status(), 200);
+    }
+    assert_eq!(s.get("/tiles/gravel/7/4/5.png").await.status(), 200);
+    assert_eq!(s.get("/tiles/gravel/7/x/5.png").await.status(), 400);
+    let r = s.get("/metrics").await;
+    assert_eq!(r.status(), 200);
+    assert!(r.headers()["content-type"].to_str().unwrap().starts_with("text/plain; version=0.0.4"));
+    let text = r.text().await.unwrap();
+    assert_eq!(value(&text, r#"textile_http_requests_total{route="/tiles/{id}/{z}/{x}/{y}",status="200"}"#), 4.0);
+    assert_eq!(value(&text, r#"textile_http_requests_total{route="/tiles/{id}/{z}/{x}/{y}",status="400"}"#), 1.0);
+    assert_eq!(value(&text, "textile_cache_hits_total"), 2.0);
+    assert_eq!(value(&text, "textile_cache_misses_total"), 2.0);
+    assert_eq!(value(&text, r#"textile_syntheses_total{mode="mosaic"}"#), 1.0);
+    assert_eq!(value(&text, r#"textile_syntheses_total{mode="synth"}"#), 1.0);
+    assert!(value(&text, "textile_cache_bytes") > 0.0);
+    assert_eq!(value(&text, "textile_syntheses_in_flight"), 0.0);
+    assert!(text.contains("textile_http_request_duration_seconds_bucket"));
+    assert!(text.contains("textile_shed_total"));
+    assert!(text.contains("textile_cache_evictions_total"));
+}
+
+#[test]
+fn loadtest_runs_every_pattern_and_reports() {
+    let s = Server::start(&[]);
+    let dir = tempfile::tempdir().unwrap();
+    let replay = dir.path().join("urls.txt");
+    std::fs::write(&replay, format!("# recorded\n/tiles/grass/7/0/0.png\n{}/tiles/grass/6/1/1.png?seed=2\n", s.base))
+        .unwrap();
+    for pattern in ["pan", "zoom", "random", "hot", "replay"] {
+        let out = Command::new(binary())
+            .args(["loadtest", "--url", &s.base, "--texture", "grass", "--pattern", pattern, "--requests", "40"])
+            .args(["--concurrency", "4", "--duration", "60", "--json", "--file"])
+            .arg(&replay)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{pattern}: {}", String::from_utf8_lossy(&out.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON report");
+        assert_eq!(report["requests"], 40, "{pattern}: {report}");
+        assert_eq!(report["status"]["200"], 40, "{pattern}: {report}");
+        assert!(report["latency_ms"]["p99"].as_f64().unwrap() >= report["latency_ms"]["p50"].as_f64().unwrap());
+        let ratio = report["server_cache_hit_ratio"].as_f64().unwrap();
+        if pattern == "hot" || pattern == "replay" {
+            // Concurrent first requests of a URL are coalesced and count as misses.
+            assert!(ratio >= 0.85, "{pattern}: hit ratio {ratio}");
+        }
+        if pattern == "pan" {
+            assert!(ratio < 0.5, "pan requests new tiles: {ratio}");
+        }
+    }
+    let text = Command::new(binary())
+        .args(["loadtest", "--url", &s.base, "--texture", "grass", "--pattern", "hot", "--requests", "5"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&text.stdout);
+    assert!(stdout.contains("req/s") && stdout.contains("p99") && stdout.contains("cache hit ratio"), "{stdout}");
+    let far = Command::new(binary()).args(["loadtest", "--url", "http://192.168.1.1:8080"]).output().unwrap();
+    assert!(!far.status.success());
+    assert!(String::from_utf8_lossy(&far.stderr).contains("only targets this machine"));
+}
