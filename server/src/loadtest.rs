@@ -188,9 +188,15 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let metrics_after = client.get(format!("{root}/metrics")).send().await?.text().await?;
         let d = |n: &str| scrape(&metrics_after, n) - scrape(&metrics_before, n);
         let (hits, misses) = (d("textile_cache_hits_total"), d("textile_cache_misses_total"));
-        let mut lat: Vec<f64> = all.iter().map(|r| r.0.as_secs_f64() * 1e3).collect();
-        lat.sort_by(f64::total_cmp);
-        let q = |p: f64| if lat.is_empty() { 0.0 } else { lat[((lat.len() - 1) as f64 * p).round() as usize] };
+        let sorted = |ok_only: bool| {
+            let mut v: Vec<f64> =
+                all.iter().filter(|r| !ok_only || r.1 == 200).map(|r| r.0.as_secs_f64() * 1e3).collect();
+            v.sort_by(f64::total_cmp);
+            v
+        };
+        let pct = |v: &[f64], p: f64| if v.is_empty() { 0.0 } else { v[((v.len() - 1) as f64 * p).round() as usize] };
+        let (lat, ok) = (sorted(false), sorted(true));
+        let q = |p: f64| pct(&lat, p);
         let mut statuses = BTreeMap::new();
         for r in &all {
             *statuses.entry(if r.1 == 0 { "error".to_string() } else { r.1.to_string() }).or_insert(0u64) += 1;
@@ -200,6 +206,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             "pattern": a.pattern, "texture": a.texture, "concurrency": a.concurrency,
             "requests": all.len(), "seconds": elapsed, "requests_per_second": all.len() as f64 / elapsed,
             "latency_ms": { "p50": q(0.5), "p90": q(0.9), "p99": q(0.99), "max": q(1.0) },
+            "latency_ms_200": { "p50": pct(&ok, 0.5), "p90": pct(&ok, 0.9), "p99": pct(&ok, 0.99), "max": pct(&ok, 1.0) },
             "status": statuses, "bytes": bytes,
             "server_cache_hit_ratio": if hits + misses > 0.0 { hits / (hits + misses) } else { 0.0 },
             "server_syntheses": d("textile_syntheses_total{mode=\"synth\"}") + d("textile_syntheses_total{mode=\"mosaic\"}"),
@@ -218,6 +225,10 @@ pub fn run(a: LoadtestArgs) -> CliResult {
                 bytes as f64 / 1048576.0
             );
             println!("latency ms: p50 {:.2}  p90 {:.2}  p99 {:.2}  max {:.2}", q(0.5), q(0.9), q(0.99), q(1.0));
+            if ok.len() != lat.len() {
+                let o = |p| pct(&ok, p);
+                println!("  200 only: p50 {:.2}  p90 {:.2}  p99 {:.2}  max {:.2}", o(0.5), o(0.9), o(0.99), o(1.0));
+            }
             println!("status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
             println!(
                 "server: cache hit ratio {:.3} ({hits} hits, {misses} misses), {} syntheses",
