@@ -33,20 +33,15 @@ where
     st.cache.get_or_compute(etag, || st.synthesize(mode, make)).await
 }
 
+/// A cache key (and, hashed, the ETag): everything that determines an answer's bytes — engine
+/// version, texture and analysis, canonical parameters — then `what` (the kind and address).
+pub(crate) fn cache_key(tex: &Texture, p: &RenderParams, what: std::fmt::Arguments) -> String {
+    format!("{}|{}|{}|{}|{what}", engine_version(), tex.config.id, tex.file_hash, p.canonical())
+}
+
 /// The cache key of a tile.
-pub(crate) fn tile_key(tex: &Texture, p: &RenderParams, spec: &TileSpec) -> String {
-    format!(
-        "{}|{}|{}|{}|tile|{}|{}|{}|{}|{}",
-        engine_version(),
-        tex.config.id,
-        tex.file_hash,
-        p.canonical(),
-        spec.z,
-        spec.x,
-        spec.y,
-        spec.scale,
-        spec.format.ext()
-    )
+pub(crate) fn tile_key(tex: &Texture, p: &RenderParams, t: &TileSpec) -> String {
+    cache_key(tex, p, format_args!("tile|{}|{}|{}|{}|{}", t.z, t.x, t.y, t.scale, t.format.ext()))
 }
 
 /// The encoded bytes of a tile, through the cache.
@@ -143,18 +138,10 @@ pub async fn window(
     let params: crate::tile_request::Query =
         q.iter().filter(|(k, _)| PARAM_KEYS.contains(&k.as_str())).map(|(k, v)| (k.clone(), v.clone())).collect();
     let p = render_params(&tex, &params)?;
-    let key = format!(
-        "{}|{}|{}|{}|window|{}|{}|{}|{}|{}|{}",
-        engine_version(),
-        tex.config.id,
-        tex.file_hash,
-        p.canonical(),
-        spec.z,
-        spec.x,
-        spec.y,
-        spec.w,
-        spec.h,
-        fmt.ext()
+    let key = cache_key(
+        &tex,
+        &p,
+        format_args!("window|{}|{}|{}|{}|{}|{}", spec.z, spec.x, spec.y, spec.w, spec.h, fmt.ext()),
     );
     answer(&st, &headers, key, p.mode(), fmt, move || render_window(&tex, &p, &spec)).await
 }

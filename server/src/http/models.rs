@@ -14,7 +14,7 @@ use crate::assets::{glb, gltf_json, x3d, Quad};
 use crate::encode::Format;
 use crate::http::content::{engine_version, etag_for, if_none_match, image, not_modified};
 use crate::http::error::ApiError;
-use crate::http::images::{cached, path_error, tile_bytes, tile_key};
+use crate::http::images::{cache_key, cached, path_error, tile_bytes, tile_key};
 use crate::http::meta::{base_url, texture};
 use crate::http::state::AppState;
 use crate::textures::Texture;
@@ -102,16 +102,7 @@ fn tile_request(
 }
 
 fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
-    format!(
-        "{}|{}|{}|{}|{kind}|{}|{}|{}|{extra}",
-        engine_version(),
-        r.tex.config.id,
-        r.tex.file_hash,
-        r.params.canonical(),
-        r.spec.z,
-        r.spec.x,
-        r.spec.y
-    )
+    cache_key(&r.tex, &r.params, format_args!("{kind}|{}|{}|{}|{extra}", r.spec.z, r.spec.x, r.spec.y))
 }
 
 /// A tile as a glTF 2.0 ground quad: `.glb` embeds the PNG tile, `.gltf` references the tile
