@@ -37,16 +37,7 @@ async fn track(State(st): State<Arc<AppState>>, req: Request, next: Next) -> Res
 
 /// Build the router for a state.
 pub fn router(state: Arc<AppState>) -> Router {
-    let cors = CorsLayer::new()
-        .allow_methods([Method::GET, Method::HEAD])
-        .allow_headers([header::IF_NONE_MATCH])
-        .expose_headers([header::ETAG, header::HeaderName::from_static("x-cache")])
-        .allow_origin(if state.config.cors_origins.iter().any(|o| o == "*") {
-            AllowOrigin::any()
-        } else {
-            AllowOrigin::list(state.config.cors_origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()))
-        });
-    Router::new()
+    let routes = Router::new()
         .route("/", get(static_files::index))
         .route("/world.html", get(static_files::world))
         .route("/static/{*path}", get(static_files::static_file))
@@ -62,7 +53,23 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/windows/{file}", get(images::window))
         .route("/gltf/{id}/patch.glb", get(models::gltf_patch))
         .route("/gltf/{id}/{z}/{x}/{y}", get(models::gltf_tile))
-        .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile))
+        .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile));
+    with_middleware(routes, state)
+}
+
+/// The service's fallbacks and middleware around a set of routes: JSON 404/405, request
+/// metrics, JSON compression, CORS, and panics turned into a 500 JSON error.
+fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Router {
+    let cors = CorsLayer::new()
+        .allow_methods([Method::GET, Method::HEAD])
+        .allow_headers([header::IF_NONE_MATCH])
+        .expose_headers([header::ETAG, header::HeaderName::from_static("x-cache")])
+        .allow_origin(if state.config.cors_origins.iter().any(|o| o == "*") {
+            AllowOrigin::any()
+        } else {
+            AllowOrigin::list(state.config.cors_origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()))
+        });
+    routes
         .fallback(meta::not_found)
         .method_not_allowed_fallback(meta::method_not_allowed)
         .layer(middleware::from_fn_with_state(state.clone(), track))
@@ -70,4 +77,38 @@ pub fn router(state: Arc<AppState>) -> Router {
         .layer(CompressionLayer::new())
         .layer(cors)
         .layer(CatchPanicLayer::custom(|_| ApiError::internal("the request handler panicked").into_response()))
+}
+
+#[cfg(test)]
+mod tests {
+    use axum::body::Body;
+    use axum::http::{Request, StatusCode};
+    use tower::ServiceExt;
+
+    use super::*;
+
+    #[tokio::test]
+    async fn a_panicking_handler_becomes_a_500_json_error_and_service_goes_on() {
+        let cfg = crate::config::Config::load(None, &Default::default()).unwrap();
+        let state = Arc::new(AppState::new(cfg));
+        let routes = Router::new()
+            .route(
+                "/boom",
+                get(|| async {
+                    if std::hint::black_box(true) {
+                        panic!("deliberate");
+                    }
+                    "unreachable"
+                }),
+            )
+            .route("/ok", get(|| async { "ok" }));
+        let app = with_middleware(routes, state);
+        let r = app.clone().oneshot(Request::get("/boom").body(Body::empty()).unwrap()).await.unwrap();
+        assert_eq!(r.status(), StatusCode::INTERNAL_SERVER_ERROR);
+        let body = axum::body::to_bytes(r.into_body(), 1 << 16).await.unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&body).unwrap();
+        assert_eq!(v["error"], "internal");
+        let r = app.oneshot(Request::get("/ok").body(Body::empty()).unwrap()).await.unwrap();
+        assert_eq!(r.status(), StatusCode::OK);
+    }
 }
