@@ -54,3 +54,29 @@ async fn overload_sheds_with_503_and_retry_after() {
     assert!(statuses.iter().filter(|(s, _)| *s == 503).all(|(_, ra)| *ra));
     assert!(s.json("/health").await["shed"].as_u64().unwrap() > 0);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 4)]
+async fn bytes_do_not_depend_on_the_cache_or_the_order() {
+    // A: the default cache, forward order. B: a 1 MiB cache (about a dozen tiles) that evicts
+    // constantly, reverse order, twice (the second pass re-synthesizes evicted tiles).
+    let a = Server::start(&[]);
+    let b = Server::start(&["--cache-mib", "1"]);
+    let paths: Vec<String> = (0..30)
+        .map(|i| {
+            let mode = if i % 3 == 0 { "&mode=mosaic" } else { "" };
+            format!("/tiles/gravel/{}/{}/{}.png?seed=6{mode}", 5 + i % 3, i * 7 - 100, 50 - i * 3)
+        })
+        .collect();
+    let mut want = Vec::new();
+    for p in &paths {
+        want.push(a.get_bytes(p).await);
+    }
+    for _ in 0..2 {
+        for (p, w) in paths.iter().zip(&want).rev() {
+            assert_eq!(&b.get_bytes(p).await, w, "{p}");
+        }
+    }
+    let h = b.json("/health").await;
+    assert!(h["cache"]["evictions"].as_u64().unwrap() > 0, "the small cache evicted: {h}");
+    assert!(h["cache"]["bytes"].as_u64().unwrap() <= 1 << 20);
+}

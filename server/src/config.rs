@@ -20,6 +20,7 @@ const ENV_KEYS: &[&str] = &[
     "worker_threads",
     "request_timeout_secs",
     "max_in_flight",
+    "max_queue_wait_ms",
     "max_exemplar_side",
 ];
 
@@ -102,6 +103,8 @@ pub struct Config {
     pub request_timeout_secs: u64,
     /// Syntheses in flight before shedding with 503.
     pub max_in_flight: usize,
+    /// Longest wait for a pool thread before shedding with 503, in milliseconds.
+    pub max_queue_wait_ms: u64,
     /// Largest exemplar side accepted.
     pub max_exemplar_side: u32,
     /// Served textures.
@@ -178,6 +181,9 @@ impl Config {
         }
         if !(1..=100_000).contains(&self.max_in_flight) {
             return bad("max_in_flight", format!("{} is outside 1..=100000", self.max_in_flight));
+        }
+        if !(1..=600_000).contains(&self.max_queue_wait_ms) {
+            return bad("max_queue_wait_ms", format!("{} is outside 1..=600000", self.max_queue_wait_ms));
         }
         if !(16..=8192).contains(&self.max_exemplar_side) {
             return bad("max_exemplar_side", format!("{} is outside 16..=8192", self.max_exemplar_side));

@@ -10,6 +10,8 @@ use std::net::IpAddr;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use std::io::Write;
+
 use serde_json::json;
 
 use crate::cli::LoadtestArgs;
@@ -211,10 +213,13 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             "server_cache_hit_ratio": if hits + misses > 0.0 { hits / (hits + misses) } else { 0.0 },
             "server_syntheses": d("textile_syntheses_total{mode=\"synth\"}") + d("textile_syntheses_total{mode=\"mosaic\"}"),
         });
+        // Write the report; a reader that went away (a closed pipe) is not an error worth a panic.
+        let mut out = std::io::stdout().lock();
         if a.json {
-            println!("{}", serde_json::to_string_pretty(&report)?);
+            let _ = writeln!(out, "{}", serde_json::to_string_pretty(&report)?);
         } else {
-            println!(
+            let _ = writeln!(
+                out,
                 "{} × {} on '{}' for {:.2}s: {} requests, {:.1} req/s, {:.1} MiB",
                 a.pattern,
                 a.concurrency,
@@ -224,13 +229,16 @@ pub fn run(a: LoadtestArgs) -> CliResult {
                 all.len() as f64 / elapsed,
                 bytes as f64 / 1048576.0
             );
-            println!("latency ms: p50 {:.2}  p90 {:.2}  p99 {:.2}  max {:.2}", q(0.5), q(0.9), q(0.99), q(1.0));
+            let _ = writeln!(out, "latency ms: p50 {:.2}  p90 {:.2}  p99 {:.2}  max {:.2}", q(0.5), q(0.9), q(0.99), q(1.0));
             if ok.len() != lat.len() {
                 let o = |p| pct(&ok, p);
-                println!("  200 only: p50 {:.2}  p90 {:.2}  p99 {:.2}  max {:.2}", o(0.5), o(0.9), o(0.99), o(1.0));
+                let _ =
+                    writeln!(out, "  200 only: p50 {:.2}  p90 {:.2}  p99 {:.2}  max {:.2}", o(0.5), o(0.9), o(0.99), o(1.0));
             }
-            println!("status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
-            println!(
+            let _ =
+                writeln!(out, "status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
+            let _ = writeln!(
+                out,
                 "server: cache hit ratio {:.3} ({hits} hits, {misses} misses), {} syntheses",
                 report["server_cache_hit_ratio"].as_f64().unwrap_or(0.0),
                 report["server_syntheses"]

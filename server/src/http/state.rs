@@ -65,7 +65,8 @@ impl AppState {
     }
 
     /// Run a synthesis job (counted under `mode`) on the rayon pool (never on a tokio worker),
-    /// within the in-flight limit and the request timeout. A panic in the job becomes a 500.
+    /// within the in-flight limit, the queue-wait bound and the request timeout (503s beyond
+    /// them). A panic in the job becomes a 500.
     pub async fn synthesize<F>(&self, mode: &str, job: F) -> Result<Bytes, ApiError>
     where
         F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
@@ -76,8 +77,16 @@ impl AppState {
         })?;
         // Everything the job holds until it ends, released on drop even if it never starts.
         let guard = (admitted, InFlight::new(&self.metrics.in_flight));
+        let queue_wait = Duration::from_millis(self.config.max_queue_wait_ms);
         let work = async {
-            let run = self.running.clone().acquire_owned().await.map_err(|_| ApiError::internal("pool closed"))?;
+            let run = match tokio::time::timeout(queue_wait, self.running.clone().acquire_owned()).await {
+                Ok(Ok(run)) => run,
+                Ok(Err(_)) => return Err(ApiError::internal("pool closed")),
+                Err(_) => {
+                    self.metrics.shed.inc();
+                    return Err(ApiError::overloaded());
+                }
+            };
             let timer = self.metrics.synthesis_timer(mode).start_timer();
             let (tx, rx) = tokio::sync::oneshot::channel();
             rayon::spawn(move || {

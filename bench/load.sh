@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Load benchmark (issue: under load), one command: starts the server on a free loopback port,
+# runs the scripted loads with `textile loadtest`, and writes bench/out/load.md (a markdown table)
+# so later changes can be compared. Loader and server share the machine.
+# Usage: bench/load.sh [SECONDS per cold run, default 15]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SECS=${1:-15}
+cargo build --release -q -p textile-server
+BIN=target/release/textile
+DATA=$(mktemp -d)
+OUT=bench/out/load.md
+mkdir -p bench/out
+$BIN serve --bind 127.0.0.1:0 --data-dir "$DATA" > "$DATA/out" 2>/dev/null &
+PID=$!
+trap 'kill $PID 2>/dev/null; rm -rf "$DATA"' EXIT
+until grep -q "textile ready" "$DATA/out" 2>/dev/null; do sleep 0.2; done
+URL=$(sed -n 's/^textile ready: viewer at \(http[^ ]*\)\/ .*/\1/p' "$DATA/out")
+run() { # name, loadtest args...
+  local name=$1; shift
+  $BIN loadtest --url "$URL" --json "$@" | python3 bench/load_row.py "$name"
+}
+{
+  echo "| run | conns | requests | req/s | p50 ms | p99 ms | p99 ms (200s) | statuses | server hit ratio |"
+  echo "|---|---|---|---|---|---|---|---|---|"
+  run "hot (cached tile)" --pattern hot --concurrency 64 --requests 200000 --duration "$SECS"
+  run "pan, synth (cold)" --pattern pan --concurrency 8 --requests 100000 --duration "$SECS"
+  run "pan, mosaic (cold)" --pattern pan --query mode=mosaic --seed 2 --concurrency 8 --requests 100000 --duration "$SECS"
+  run "zoom, synth" --pattern zoom --concurrency 8 --requests 100000 --duration "$SECS" --query seed=3
+  run "random, synth" --pattern random --concurrency 8 --requests 100000 --duration "$SECS" --seed 9
+  run "random ×10 (overload)" --pattern random --concurrency 80 --requests 10000000 --duration "$SECS" --seed 10
+} | tee "$OUT"
+echo "wrote $OUT"
