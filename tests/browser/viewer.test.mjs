@@ -77,7 +77,10 @@ test('the viewer loads with no console errors and shows texture tiles', async ()
     return !(e.labels && e.labels.length) && !e.getAttribute('aria-label') && !(e.tagName === 'BUTTON' && e.textContent.trim()) && id;
   }).map((e) => e.id));
   assert.deepEqual(labels, [], 'every control has a label');
-  if (SHOT) await page.screenshot({ path: SHOT });
+  if (SHOT) {
+    await page.waitForTimeout(600); // let Leaflet's tile fade-in finish
+    await page.screenshot({ path: SHOT });
+  }
   assert.deepEqual(errors, []);
   await page.close();
 });
