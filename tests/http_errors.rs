@@ -114,3 +114,12 @@ async fn sigterm_exits_cleanly() {
     assert_eq!(s.get("/health").await.status(), 200);
     assert_eq!(s.terminate(), Some(0));
 }
+
+#[tokio::test]
+async fn bare_binary_serves_with_environment_configuration() {
+    // `textile` with no sub-command is `textile serve`; configured here only through TEXTILE_*.
+    let data = support::shared_data_dir();
+    let s = Server::spawn(&[], &[("TEXTILE_BIND", "127.0.0.1:0"), ("TEXTILE_DATA_DIR", data.to_str().unwrap())]);
+    assert_eq!(s.json("/ready").await["status"], "ready");
+    assert_eq!(s.get("/tiles/brick/7/0/0.png").await.status(), 200);
+}

@@ -36,9 +36,16 @@ impl Server {
 
     /// Start with a given data dir, extra arguments and environment.
     pub fn start_in(data_dir: &Path, extra: &[&str], env: &[(&str, &str)]) -> Server {
+        let mut args: Vec<std::ffi::OsString> = vec!["serve".into(), "--bind".into(), "127.0.0.1:0".into()];
+        args.extend(["--data-dir".into(), data_dir.as_os_str().to_owned()]);
+        args.extend(extra.iter().map(|a| a.into()));
+        Self::spawn(&args, env)
+    }
+
+    /// Start the binary with exactly these arguments and environment (it must bind a free port).
+    pub fn spawn(args: &[std::ffi::OsString], env: &[(&str, &str)]) -> Server {
         let mut cmd = Command::new(binary());
-        cmd.arg("serve").arg("--bind").arg("127.0.0.1:0").arg("--data-dir").arg(data_dir);
-        cmd.args(extra).envs(env.iter().copied()).stdout(Stdio::piped()).stderr(Stdio::null()).stdin(Stdio::null());
+        cmd.args(args).envs(env.iter().copied()).stdout(Stdio::piped()).stderr(Stdio::null()).stdin(Stdio::null());
         let mut child = cmd.spawn().expect("start textile");
         let stdout = child.stdout.take().expect("stdout");
         let (tx, rx) = mpsc::channel();
