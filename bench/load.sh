@@ -21,8 +21,8 @@ run() { # name, loadtest args...
   $BIN loadtest --url "$URL" --json "$@" | python3 bench/load_row.py "$name"
 }
 {
-  echo "| run | conns | requests | req/s | p50 ms | p99 ms | p99 ms (200s) | statuses | server hit ratio |"
-  echo "|---|---|---|---|---|---|---|---|---|"
+  echo "| run | conns | requests | req/s | p50 ms | p99 ms | p99 ms (200s) | statuses | server hit ratio | computation ratio |"
+  echo "|---|---|---|---|---|---|---|---|---|---|"
   run "hot (cached tile)" --pattern hot --concurrency 64 --requests 200000 --duration "$SECS"
   run "pan, synth (cold)" --pattern pan --concurrency 8 --requests 100000 --duration "$SECS"
   run "pan, mosaic (cold)" --pattern pan --query mode=mosaic --seed 2 --concurrency 8 --requests 100000 --duration "$SECS"

@@ -37,6 +37,14 @@ async fn metrics_count_requests_cache_and_syntheses() {
     assert!(text.contains("textile_http_request_duration_seconds_bucket"));
     assert!(text.contains("textile_shed_total"));
     assert!(text.contains("textile_cache_evictions_total"));
+    // Computation ratio parts. One native synth tile at even coordinates (m = 128) computes the
+    // padded pyramid of design note §1.6: 275×277 + 157×161 + 97×101 + 69×73 + 53×57 + 27×29 +
+    // 14×15 + 8×8 = 120 364 pixels for 65 536 delivered (ratio 1.84). One mosaic tile evaluates
+    // its tile grown by the 4-pixel smoothing margin, 264² = 69 696.
+    assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#), 120_364.0);
+    assert_eq!(value(&text, r#"textile_pixels_delivered_total{mode="synth"}"#), 65_536.0);
+    assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="mosaic"}"#), 69_696.0);
+    assert_eq!(value(&text, r#"textile_pixels_delivered_total{mode="mosaic"}"#), 65_536.0);
 }
 
 #[test]
@@ -58,6 +66,11 @@ fn loadtest_runs_every_pattern_and_reports() {
         assert_eq!(report["requests"], 40, "{pattern}: {report}");
         assert_eq!(report["status"]["200"], 40, "{pattern}: {report}");
         assert!(report["latency_ms"]["p99"].as_f64().unwrap() >= report["latency_ms"]["p50"].as_f64().unwrap());
+        if pattern == "pan" {
+            // Native tiles without any pyramidal sharing: ≈ 1.84 (design note §1.6).
+            let ratio = report["server_computation_ratio"].as_f64().unwrap();
+            assert!((1.8..1.9).contains(&ratio), "pan computation ratio {ratio}");
+        }
         let ratio = report["server_cache_hit_ratio"].as_f64().unwrap();
         if pattern == "hot" || pattern == "replay" {
             // Concurrent first requests of a URL are coalesced and count as misses.

@@ -54,5 +54,5 @@ pub use exemplar::{Exemplar, ExemplarOptions};
 pub use geom::Rect;
 pub use mosaic::MosaicParams;
 pub use params::{Randomness, SynthParams};
-pub use render::{render, RgbWindow};
+pub use render::{render, render_cost, RgbWindow};
 pub use synth::{synthesize, CoordWindow};

@@ -236,6 +236,18 @@ fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) ->
     Paint { label, src }
 }
 
+/// Texels [`render`] evaluates for this view (with the smoothing margin), for computation ratios.
+pub fn render_cost(zoom_out: u32, rect: Rect) -> u64 {
+    match zoom_out {
+        0 => rect.grow(4).area() as u64,
+        k if k <= 3 => {
+            let f = 1i64 << k;
+            Rect { x0: rect.x0 * f, y0: rect.y0 * f, x1: rect.x1 * f, y1: rect.y1 * f }.grow(4).area() as u64
+        }
+        _ => rect.area() as u64,
+    }
+}
+
 /// Render `rect` of the mosaic viewed `zoom_out` steps coarser than native.
 pub fn render(an: &Analysis, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
     p.validate_for(an)?;

@@ -7,7 +7,7 @@ use crate::analysis::Analysis;
 use crate::error::Result;
 use crate::geom::Rect;
 use crate::params::SynthParams;
-use crate::synth::synthesize;
+use crate::synth::{synthesis_cost, synthesize};
 
 /// An RGB8 image of a window.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -25,6 +25,16 @@ impl RgbWindow {
     pub fn pixel(&self, x: u32, y: u32) -> [u8; 3] {
         let i = 3 * (y as usize * self.width as usize + x as usize);
         [self.pixels[i], self.pixels[i + 1], self.pixels[i + 2]]
+    }
+}
+
+/// Pixels [`render`] synthesizes at all levels for this view (for computation ratios).
+pub fn render_cost(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) -> u64 {
+    let levels = an.levels();
+    match zoom_out {
+        0 => synthesis_cost(an, params, levels, rect),
+        k if k <= levels => synthesis_cost(an, params, levels - k + 1, rect.children()),
+        _ => 0,
     }
 }
 

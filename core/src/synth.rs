@@ -83,6 +83,14 @@ pub fn synthesize(an: &Analysis, params: &SynthParams, level: u32, rect: Rect) -
     Ok(CoordWindow { level, rect, coords: out.s })
 }
 
+/// Pixels a call to [`synthesize`] computes at all levels (padding included), from its plan.
+pub fn synthesis_cost(an: &Analysis, params: &SynthParams, level: u32, rect: Rect) -> u64 {
+    plan_window(level.min(an.levels()), rect, &schedule(params.passes, params.subpasses))
+        .iter()
+        .map(|lp| lp.padded.area() as u64)
+        .sum()
+}
+
 struct Ctx<'a> {
     an: &'a Analysis,
     seed: u64,

@@ -204,6 +204,12 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             *statuses.entry(if r.1 == 0 { "error".to_string() } else { r.1.to_string() }).or_insert(0u64) += 1;
         }
         let bytes: u64 = all.iter().map(|r| r.2 as u64).sum();
+        // Pixels synthesized at all levels ÷ pixels delivered, over the syntheses of this run.
+        let px = |kind: &str| {
+            ["synth", "mosaic"].iter().map(|m| d(&format!("textile_pixels_{kind}_total{{mode=\"{m}\"}}"))).sum::<f64>()
+        };
+        let (synthesized, delivered) = (px("synthesized"), px("delivered"));
+        let ratio = if delivered > 0.0 { synthesized / delivered } else { 0.0 };
         let report = json!({
             "pattern": a.pattern, "texture": a.texture, "concurrency": a.concurrency,
             "requests": all.len(), "seconds": elapsed, "requests_per_second": all.len() as f64 / elapsed,
@@ -212,6 +218,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             "status": statuses, "bytes": bytes,
             "server_cache_hit_ratio": if hits + misses > 0.0 { hits / (hits + misses) } else { 0.0 },
             "server_syntheses": d("textile_syntheses_total{mode=\"synth\"}") + d("textile_syntheses_total{mode=\"mosaic\"}"),
+            "server_computation_ratio": ratio,
         });
         // Write the report; a reader that went away (a closed pipe) is not an error worth a panic.
         let mut out = std::io::stdout().lock();
@@ -239,9 +246,10 @@ pub fn run(a: LoadtestArgs) -> CliResult {
                 writeln!(out, "status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
             let _ = writeln!(
                 out,
-                "server: cache hit ratio {:.3} ({hits} hits, {misses} misses), {} syntheses",
+                "server: cache hit ratio {:.3} ({hits} hits, {misses} misses), {} syntheses, computation ratio {:.3}",
                 report["server_cache_hit_ratio"].as_f64().unwrap_or(0.0),
-                report["server_syntheses"]
+                report["server_syntheses"],
+                report["server_computation_ratio"].as_f64().unwrap_or(0.0)
             );
         }
         Ok::<(), Box<dyn std::error::Error>>(())

@@ -31,6 +31,11 @@ pub struct Metrics {
     pub in_flight: IntGauge,
     /// Requests shed with 503 because of the in-flight limit.
     pub shed: IntCounter,
+    /// Pixels synthesized at all levels (padding included), by mode.
+    pub pixels_synthesized: IntCounterVec,
+    /// Pixels delivered by those syntheses, by mode: the computation ratio is
+    /// synthesized ÷ delivered.
+    pub pixels_delivered: IntCounterVec,
 }
 
 fn must<T>(r: prometheus::Result<T>) -> T {
@@ -66,6 +71,14 @@ impl Metrics {
             )),
             in_flight: must(IntGauge::new("syntheses_in_flight", "syntheses running or queued")),
             shed: must(IntCounter::new("shed_total", "requests answered 503 because of the in-flight limit")),
+            pixels_synthesized: must(IntCounterVec::new(
+                Opts::new("pixels_synthesized_total", "pixels synthesized at all levels, padding included, by mode"),
+                &["mode"],
+            )),
+            pixels_delivered: must(IntCounterVec::new(
+                Opts::new("pixels_delivered_total", "pixels delivered by syntheses, by mode"),
+                &["mode"],
+            )),
             registry,
         };
         let all: Vec<Box<dyn prometheus::core::Collector>> = vec![
@@ -80,6 +93,8 @@ impl Metrics {
             Box::new(m.synthesis_seconds.clone()),
             Box::new(m.in_flight.clone()),
             Box::new(m.shed.clone()),
+            Box::new(m.pixels_synthesized.clone()),
+            Box::new(m.pixels_delivered.clone()),
         ];
         for c in all {
             must(m.registry.register(c));

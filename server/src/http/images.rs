@@ -15,7 +15,7 @@ use crate::http::content::{engine_version, etag_for, if_none_match, image, not_m
 use crate::http::error::ApiError;
 use crate::http::meta::texture;
 use crate::http::state::AppState;
-use crate::render::{render_tile, render_window};
+use crate::render::{render_tile, render_window, tile_cost, window_cost, Cost};
 use crate::textures::Texture;
 use crate::tile_request::{
     parse_query, parse_tile, parse_window, render_params, split_format, RenderParams, TileSpec, PARAM_KEYS, WINDOW_KEYS,
@@ -31,6 +31,29 @@ where
     F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
 {
     st.cache.get_or_compute(etag, || st.synthesize(mode, make)).await
+}
+
+/// [`cached`] for an image render: the job renders and encodes, and counts its pixels
+/// (synthesized and delivered) when it actually runs.
+async fn cached_render<F>(
+    st: &Arc<AppState>,
+    etag: &str,
+    mode: &'static str,
+    cost: Cost,
+    fmt: Format,
+    render: F,
+) -> (Result<Bytes, ApiError>, bool)
+where
+    F: FnOnce() -> Result<textile_core::RgbWindow, textile_core::CoreError> + Send + 'static,
+{
+    let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
+    cached(st, etag, mode, move || {
+        let img = render()?;
+        synthesized.with_label_values(&[mode]).inc_by(cost.synthesized);
+        delivered.with_label_values(&[mode]).inc_by(cost.delivered);
+        encode_window(img, fmt)
+    })
+    .await
 }
 
 /// A cache key (and, hashed, the ETag): everything that determines an answer's bytes — engine
@@ -53,8 +76,8 @@ pub(crate) async fn tile_bytes(
 ) -> Result<Bytes, ApiError> {
     let (tex, p) = (tex.clone(), p.clone());
     let etag = etag_for(&tile_key(&tex, &p, &spec));
-    let mode = p.mode();
-    cached(st, &etag, mode, move || encode_window(render_tile(&tex, &p, &spec)?, spec.format)).await.0
+    let cost = tile_cost(&tex, &p, &spec);
+    cached_render(st, &etag, p.mode(), cost, spec.format, move || render_tile(&tex, &p, &spec)).await.0
 }
 
 fn encode_window(img: textile_core::RgbWindow, fmt: Format) -> Result<Vec<u8>, ApiError> {
@@ -65,7 +88,8 @@ async fn answer<F>(
     st: &Arc<AppState>,
     headers: &HeaderMap,
     key: String,
-    mode: &str,
+    mode: &'static str,
+    cost: Cost,
     fmt: Format,
     job: F,
 ) -> Result<Response, ApiError>
@@ -77,7 +101,7 @@ where
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
-    let (bytes, hit) = cached(st, &etag, mode, move || encode_window(job()?, fmt)).await;
+    let (bytes, hit) = cached_render(st, &etag, mode, cost, fmt, job).await;
     Ok(image(bytes?, fmt.content_type(), &etag, cc, hit))
 }
 
@@ -109,7 +133,8 @@ pub async fn tile(
     let q = parse_query(q.as_deref(), PARAM_KEYS)?;
     let p = render_params(&tex, &q)?;
     let key = tile_key(&tex, &p, &spec);
-    answer(&st, &headers, key, p.mode(), spec.format, move || render_tile(&tex, &p, &spec)).await
+    let cost = tile_cost(&tex, &p, &spec);
+    answer(&st, &headers, key, p.mode(), cost, spec.format, move || render_tile(&tex, &p, &spec)).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -143,5 +168,6 @@ pub async fn window(
         &p,
         format_args!("window|{}|{}|{}|{}|{}|{}", spec.z, spec.x, spec.y, spec.w, spec.h, fmt.ext()),
     );
-    answer(&st, &headers, key, p.mode(), fmt, move || render_window(&tex, &p, &spec)).await
+    let cost = window_cost(&tex, &p, &spec);
+    answer(&st, &headers, key, p.mode(), cost, fmt, move || render_window(&tex, &p, &spec)).await
 }
