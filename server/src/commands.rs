@@ -2,7 +2,7 @@
 //! image file, for scripts) and `info` (an analysis file's header).
 
 use std::path::Path;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use textile_core::{Analysis, Exemplar, ExemplarOptions, Progress, Randomness, SynthParams};
@@ -91,10 +91,10 @@ pub fn info(a: InfoArgs) -> CliResult {
 
 /// `textile render`.
 pub fn render(a: RenderArgs) -> CliResult {
-    let tex = if let Some(path) = &a.exemplar {
+    let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
         let ex = read_exemplar(path, &ExemplarOptions::default())?;
         let an = Analysis::build(&ex, &textile_core::NoProgress);
-        texture_from(an)
+        Arc::new(texture_from(an))
     } else {
         let id = a.texture.clone().unwrap_or_default();
         let overrides = Overrides { data_dir: a.config.data_dir.clone(), ..Default::default() };
@@ -107,7 +107,7 @@ pub fn render(a: RenderArgs) -> CliResult {
         }
         let _ = exemplar_bytes(&only, &only.textures[0])?;
         let reg = load_registry(&only, &|s| eprintln!("{s}"), &textile_core::NoProgress)?;
-        std::sync::Arc::try_unwrap(reg.list[0].clone()).unwrap_or_else(|arc| clone_texture(&arc))
+        reg.list[0].clone()
     };
     let mut synth = tex.defaults.clone();
     if let Some(s) = a.seed {
@@ -199,19 +199,9 @@ fn texture_from(an: Analysis) -> Texture {
             default_randomness: String::new(),
             attribution: String::new(),
         },
-        analysis: std::sync::Arc::new(an),
+        analysis: Arc::new(an),
         file_hash,
         exemplar_png: Vec::new(),
         defaults: SynthParams::default(),
-    }
-}
-
-fn clone_texture(t: &Texture) -> Texture {
-    Texture {
-        config: t.config.clone(),
-        analysis: t.analysis.clone(),
-        file_hash: t.file_hash.clone(),
-        exemplar_png: t.exemplar_png.clone(),
-        defaults: t.defaults.clone(),
     }
 }
