@@ -56,17 +56,24 @@ async fn overload_sheds_with_503_and_retry_after() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
-async fn bytes_do_not_depend_on_the_cache_or_the_order() {
-    // A: the default cache, forward order. B: a 1 MiB cache (about a dozen tiles) that evicts
-    // constantly, reverse order, twice (the second pass re-synthesizes evicted tiles).
+async fn bytes_do_not_depend_on_the_caches_or_the_order() {
+    // A: the default caches, forward order. B: a 1 MiB tile cache (about a dozen tiles) and a
+    // 1 MiB pyramidal cache (under a hundred blocks), both evicting constantly, reverse order,
+    // twice (the second pass re-synthesizes evicted tiles from partly evicted levels). C: no
+    // pyramidal cache, requests all at once.
     let a = Server::start(&[]);
-    let b = Server::start(&["--cache-mib", "1"]);
-    let paths: Vec<String> = (0..30)
+    let b = Server::start(&["--cache-mib", "1", "--level-cache-mib", "1"]);
+    let c = Server::start(&["--level-cache-mib", "0"]);
+    let mut paths: Vec<String> = (0..30)
         .map(|i| {
             let mode = if i % 3 == 0 { "&mode=mosaic" } else { "" };
             format!("/tiles/gravel/{}/{}/{}.png?seed=6{mode}", 5 + i % 3, i * 7 - 100, 50 - i * 3)
         })
         .collect();
+    // Neighbours at native zoom and one step out: they share padding and coarse levels.
+    for (z, x, y) in [(7, -1, -1), (7, 0, -1), (7, -1, 0), (7, 0, 0), (6, 0, 0), (6, -1, -1), (7, 1, 0), (7, 1, 1)] {
+        paths.push(format!("/tiles/gravel/{z}/{x}/{y}.png?seed=6"));
+    }
     let mut want = Vec::new();
     for p in &paths {
         want.push(a.get_bytes(p).await);
@@ -76,7 +83,24 @@ async fn bytes_do_not_depend_on_the_cache_or_the_order() {
             assert_eq!(&b.get_bytes(p).await, w, "{p}");
         }
     }
+    let all: Vec<_> = paths
+        .iter()
+        .map(|p| {
+            let (client, url) = (c.client.clone(), c.url(p));
+            tokio::spawn(
+                async move { client.get(url).send().await.expect("request").bytes().await.expect("body").to_vec() },
+            )
+        })
+        .collect();
+    for ((p, w), t) in paths.iter().zip(&want).zip(all) {
+        assert_eq!(t.await.unwrap(), w.1, "{p} without the pyramidal cache");
+    }
+    let h = a.json("/health").await;
+    assert!(h["level_cache"]["hits"].as_u64().unwrap() > 0, "neighbours shared levels: {h}");
     let h = b.json("/health").await;
     assert!(h["cache"]["evictions"].as_u64().unwrap() > 0, "the small cache evicted: {h}");
     assert!(h["cache"]["bytes"].as_u64().unwrap() <= 1 << 20);
+    assert!(h["level_cache"]["evictions"].as_u64().unwrap() > 0, "the small level cache evicted: {h}");
+    assert!(h["level_cache"]["bytes"].as_u64().unwrap() <= 1 << 20);
+    assert_eq!(c.json("/health").await["level_cache"]["blocks"], 0);
 }

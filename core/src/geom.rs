@@ -68,6 +68,16 @@ impl Rect {
         Rect { x0: self.x0.min(o.x0), y0: self.y0.min(o.y0), x1: self.x1.max(o.x1), y1: self.y1.max(o.y1) }
     }
 
+    /// The pixels in both (empty when they do not overlap).
+    pub fn intersect(&self, o: &Rect) -> Self {
+        let r = Rect { x0: self.x0.max(o.x0), y0: self.y0.max(o.y0), x1: self.x1.min(o.x1), y1: self.y1.min(o.y1) };
+        if r.is_empty() {
+            Rect::new(r.x0, r.y0, 0, 0)
+        } else {
+            r
+        }
+    }
+
     /// True when `o` lies inside `self`.
     pub fn contains_rect(&self, o: &Rect) -> bool {
         o.x0 >= self.x0 && o.y0 >= self.y0 && o.x1 <= self.x1 && o.y1 <= self.y1

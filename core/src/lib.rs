@@ -11,7 +11,8 @@
 //! 2. [`analysis`] — Gaussian [`stack`], PCA [`features`], k-coherence [`candidates`], computed
 //!    once and stored with [`analysis_file`];
 //! 3. [`plan`] — which padded rectangle each level must compute for a window to be exact;
-//! 4. [`synth`] — upsample, jitter by a [`hash`] of absolute coordinates, correct;
+//! 4. [`synth`] — upsample, jitter by a [`hash`] of absolute coordinates, correct; the
+//!    [`pyramid`] cache lets neighbouring windows share coarse levels and padding;
 //! 5. [`render`] — exemplar coordinates to colours, at native or zoomed-out scale.
 //!
 //! The cheap mode, [`mosaic`], is Xu, Guo & Shum's chaos mosaic: the tiled exemplar with blocks
@@ -44,6 +45,7 @@ pub mod kdtree;
 pub mod mosaic;
 pub mod params;
 pub mod plan;
+pub mod pyramid;
 pub mod render;
 pub mod stack;
 pub mod synth;
@@ -54,5 +56,6 @@ pub use exemplar::{Exemplar, ExemplarOptions};
 pub use geom::Rect;
 pub use mosaic::MosaicParams;
 pub use params::{Randomness, SynthParams};
-pub use render::{render, render_cost, RgbWindow};
-pub use synth::{synthesize, CoordWindow};
+pub use pyramid::{Pyramid, PyramidStats};
+pub use render::{render, render_with, Rendered, RgbWindow};
+pub use synth::{synthesize, synthesize_with, CoordWindow, Synthesized};

@@ -7,7 +7,8 @@ use crate::analysis::Analysis;
 use crate::error::Result;
 use crate::geom::Rect;
 use crate::params::SynthParams;
-use crate::synth::{synthesis_cost, synthesize};
+use crate::pyramid::Pyramid;
+use crate::synth::synthesize_with;
 
 /// An RGB8 image of a window.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -28,31 +29,40 @@ impl RgbWindow {
     }
 }
 
-/// Pixels [`render`] synthesizes at all levels for this view (for computation ratios).
-pub fn render_cost(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) -> u64 {
-    let levels = an.levels();
-    match zoom_out {
-        0 => synthesis_cost(an, params, levels, rect),
-        k if k <= levels => synthesis_cost(an, params, levels - k + 1, rect.children()),
-        _ => 0,
-    }
-}
-
 /// Render `rect` of the texture viewed `zoom_out` steps coarser than native (0 = native: one
 /// pixel per exemplar texel; `k`: one pixel covers `2^k × 2^k` texels).
 pub fn render(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    render_with(&Pyramid::off(), an, params, zoom_out, rect).map(|r| r.image)
+}
+
+/// A rendered window and the work it took.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rendered {
+    /// The image.
+    pub image: RgbWindow,
+    /// Pixels synthesized at all levels for it (see [`crate::synth::Synthesized`]).
+    pub synthesized: u64,
+}
+
+/// [`render`] through a pyramidal cache (same pixels, shared work).
+pub fn render_with(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) -> Result<Rendered> {
     let levels = an.levels();
+    let mut synthesized = 0;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let m = an.side() as usize;
     let mut pixels = Vec::with_capacity(3 * w * h);
     if zoom_out == 0 {
-        let cw = synthesize(an, params, levels, rect)?;
+        let sw = synthesize_with(pyr, an, params, levels, rect)?;
+        synthesized = sw.synthesized;
+        let cw = sw.window;
         for &v in &cw.coords {
             pixels.extend_from_slice(&an.exemplar[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
         }
     } else if zoom_out <= levels {
         let l = levels - zoom_out + 1;
-        let cw = synthesize(an, params, l, rect.children())?;
+        let sw = synthesize_with(pyr, an, params, l, rect.children())?;
+        synthesized = sw.synthesized;
+        let cw = sw.window;
         let stack = &an.stack[l as usize];
         let cwid = 2 * w;
         let at = |i: usize, j: usize| {
@@ -75,5 +85,5 @@ pub fn render(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) ->
             pixels.extend_from_slice(&mean);
         }
     }
-    Ok(RgbWindow { width: w as u32, height: h as u32, pixels })
+    Ok(Rendered { image: RgbWindow { width: w as u32, height: h as u32, pixels }, synthesized })
 }

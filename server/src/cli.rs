@@ -54,6 +54,9 @@ pub struct ServeArgs {
     /// Tile cache size in MiB [env TEXTILE_CACHE_MIB].
     #[arg(long, value_name = "MIB")]
     pub cache_mib: Option<u64>,
+    /// Pyramidal cache size in MiB, 0 = off [env TEXTILE_LEVEL_CACHE_MIB].
+    #[arg(long, value_name = "MIB")]
+    pub level_cache_mib: Option<u64>,
     /// Synthesis threads, 0 = one per core [env TEXTILE_WORKER_THREADS].
     #[arg(long, value_name = "N")]
     pub workers: Option<usize>,

@@ -10,6 +10,8 @@ use textile_core::{Analysis, Exemplar, ExemplarOptions, Progress, Randomness, Sy
 use crate::cli::{AnalyzeArgs, InfoArgs, RenderArgs};
 use crate::config::{Config, Overrides};
 use crate::encode::{encode, Format};
+use textile_core::Pyramid;
+
 use crate::render::{render_tile, render_window};
 use crate::serve::CliResult;
 use crate::textures::{exemplar_bytes, load_registry, Texture};
@@ -164,13 +166,13 @@ pub fn render(a: RenderArgs) -> CliResult {
         if !(1..=MAX_WINDOW_SIDE).contains(&w) || !(1..=MAX_WINDOW_SIDE).contains(&h) {
             return Err(format!("--window width and height must be 1..={MAX_WINDOW_SIDE}").into());
         }
-        render_window(&tex, &p, &WindowSpec { z, x, y, w, h, format: fmt })?
+        render_window(&Pyramid::off(), &tex, &p, &WindowSpec { z, x, y, w, h, format: fmt })?.image
     } else {
         let (x, y) = (a.x.unwrap_or(0), a.y.unwrap_or(0));
         if !(COORD_MIN..=COORD_MAX).contains(&x) || !(COORD_MIN..=COORD_MAX).contains(&y) {
             return Err("--x and --y must be in [-2^31, 2^31-1]".into());
         }
-        render_tile(&tex, &p, &TileSpec { z, x, y, scale: 1, format: fmt })?
+        render_tile(&Pyramid::off(), &tex, &p, &TileSpec { z, x, y, scale: 1, format: fmt })?.image
     };
     let bytes = encode(&img.pixels, img.width, img.height, fmt)?;
     write_atomic(&a.output, &bytes)?;

@@ -16,6 +16,7 @@ const ENV_KEYS: &[&str] = &[
     "bind",
     "data_dir",
     "cache_mib",
+    "level_cache_mib",
     "cache_control",
     "worker_threads",
     "request_timeout_secs",
@@ -93,6 +94,8 @@ pub struct Config {
     pub data_dir: String,
     /// Tile cache size in MiB.
     pub cache_mib: u64,
+    /// Pyramidal (synthesis level) cache size in MiB; 0 turns it off.
+    pub level_cache_mib: u64,
     /// Cache-Control of tiles.
     pub cache_control: String,
     /// CORS origins (`*` = any).
@@ -126,6 +129,9 @@ pub struct Overrides {
     /// `--cache-mib`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cache_mib: Option<u64>,
+    /// `--level-cache-mib`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub level_cache_mib: Option<u64>,
     /// `--workers`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub worker_threads: Option<usize>,
@@ -172,6 +178,9 @@ impl Config {
         }
         if !(1..=65536).contains(&self.cache_mib) {
             return bad("cache_mib", format!("{} is outside 1..=65536", self.cache_mib));
+        }
+        if self.level_cache_mib > 65536 {
+            return bad("level_cache_mib", format!("{} is outside 0..=65536 (0 = off)", self.level_cache_mib));
         }
         if self.worker_threads > 1024 {
             return bad("worker_threads", format!("{} is outside 0..=1024 (0 = one per core)", self.worker_threads));

@@ -1,10 +1,12 @@
 //! Prometheus metrics (the `prometheus` crate): requests by route and status, latency
 //! histograms, tile-cache hits/misses/evictions/bytes, syntheses by mode, in-flight and shed
-//! syntheses. One registry per server; `/metrics` renders it in the text format.
+//! syntheses, pyramidal (level) cache blocks. One registry per server; `/metrics` renders it in
+//! the text format.
 
 use prometheus::{
     Encoder, Histogram, HistogramOpts, HistogramVec, IntCounter, IntCounterVec, IntGauge, Opts, Registry, TextEncoder,
 };
+use textile_core::PyramidStats;
 
 /// Every metric of the service.
 pub struct Metrics {
@@ -36,6 +38,16 @@ pub struct Metrics {
     /// Pixels delivered by those syntheses, by mode: the computation ratio is
     /// synthesized ÷ delivered.
     pub pixels_delivered: IntCounterVec,
+    /// Pyramidal cache block lookups answered.
+    pub level_cache_hits: IntCounter,
+    /// Pyramidal cache block lookups that found nothing.
+    pub level_cache_misses: IntCounter,
+    /// Pyramidal cache blocks evicted.
+    pub level_cache_evictions: IntCounter,
+    /// Bytes held by the pyramidal cache.
+    pub level_cache_bytes: IntGauge,
+    /// Blocks held by the pyramidal cache.
+    pub level_cache_blocks: IntGauge,
 }
 
 fn must<T>(r: prometheus::Result<T>) -> T {
@@ -75,6 +87,17 @@ impl Metrics {
                 Opts::new("pixels_synthesized_total", "pixels synthesized at all levels, padding included, by mode"),
                 &["mode"],
             )),
+            level_cache_hits: must(IntCounter::new("level_cache_hits_total", "pyramidal cache block lookups answered")),
+            level_cache_misses: must(IntCounter::new(
+                "level_cache_misses_total",
+                "pyramidal cache block lookups that found nothing",
+            )),
+            level_cache_evictions: must(IntCounter::new(
+                "level_cache_evictions_total",
+                "pyramidal cache blocks evicted",
+            )),
+            level_cache_bytes: must(IntGauge::new("level_cache_bytes", "bytes held by the pyramidal cache")),
+            level_cache_blocks: must(IntGauge::new("level_cache_blocks", "blocks held by the pyramidal cache")),
             pixels_delivered: must(IntCounterVec::new(
                 Opts::new("pixels_delivered_total", "pixels delivered by syntheses, by mode"),
                 &["mode"],
@@ -95,6 +118,11 @@ impl Metrics {
             Box::new(m.shed.clone()),
             Box::new(m.pixels_synthesized.clone()),
             Box::new(m.pixels_delivered.clone()),
+            Box::new(m.level_cache_hits.clone()),
+            Box::new(m.level_cache_misses.clone()),
+            Box::new(m.level_cache_evictions.clone()),
+            Box::new(m.level_cache_bytes.clone()),
+            Box::new(m.level_cache_blocks.clone()),
         ];
         for c in all {
             must(m.registry.register(c));
@@ -107,6 +135,16 @@ impl Metrics {
         let mut buf = Vec::new();
         let _ = TextEncoder::new().encode(&self.registry.gather(), &mut buf);
         String::from_utf8(buf).unwrap_or_default()
+    }
+
+    /// Bring the pyramidal cache figures up to date (its counters live in the core).
+    pub fn observe_pyramid(&self, s: &PyramidStats) {
+        let catch_up = |c: &IntCounter, v: u64| c.inc_by(v.saturating_sub(c.get()));
+        catch_up(&self.level_cache_hits, s.hits);
+        catch_up(&self.level_cache_misses, s.misses);
+        catch_up(&self.level_cache_evictions, s.evictions);
+        self.level_cache_bytes.set(s.bytes as i64);
+        self.level_cache_blocks.set(s.blocks as i64);
     }
 
     /// A synthesis timer for a mode.

@@ -29,6 +29,7 @@ pub fn run(args: ServeArgs) -> CliResult {
         bind: args.bind.clone(),
         data_dir: args.config.data_dir.clone(),
         cache_mib: args.cache_mib,
+        level_cache_mib: args.level_cache_mib,
         worker_threads: args.workers,
         max_in_flight: args.max_in_flight,
     };

@@ -11,11 +11,13 @@ use axum::http::HeaderMap;
 use axum::response::Response;
 
 use crate::encode::{encode, Format};
+use textile_core::{Pyramid, Rendered};
+
 use crate::http::content::{engine_version, etag_for, if_none_match, image, not_modified};
 use crate::http::error::ApiError;
 use crate::http::meta::texture;
 use crate::http::state::AppState;
-use crate::render::{render_tile, render_window, tile_cost, window_cost, Cost};
+use crate::render::{render_tile, render_window};
 use crate::textures::Texture;
 use crate::tile_request::{
     parse_query, parse_tile, parse_window, render_params, split_format, RenderParams, TileSpec, PARAM_KEYS, WINDOW_KEYS,
@@ -33,25 +35,25 @@ where
     st.cache.get_or_compute(etag, || st.synthesize(mode, make)).await
 }
 
-/// [`cached`] for an image render: the job renders and encodes, and counts its pixels
-/// (synthesized and delivered) when it actually runs.
+/// [`cached`] for an image render: the job renders (through the pyramidal cache) and encodes,
+/// and counts its pixels (synthesized and delivered) when it actually runs.
 async fn cached_render<F>(
     st: &Arc<AppState>,
     etag: &str,
     mode: &'static str,
-    cost: Cost,
     fmt: Format,
     render: F,
 ) -> (Result<Bytes, ApiError>, bool)
 where
-    F: FnOnce() -> Result<textile_core::RgbWindow, textile_core::CoreError> + Send + 'static,
+    F: FnOnce(&Pyramid) -> Result<Rendered, textile_core::CoreError> + Send + 'static,
 {
     let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
+    let pyramid = st.pyramid.clone();
     cached(st, etag, mode, move || {
-        let img = render()?;
-        synthesized.with_label_values(&[mode]).inc_by(cost.synthesized);
-        delivered.with_label_values(&[mode]).inc_by(cost.delivered);
-        encode_window(img, fmt)
+        let r = render(&pyramid)?;
+        synthesized.with_label_values(&[mode]).inc_by(r.synthesized);
+        delivered.with_label_values(&[mode]).inc_by(r.image.width as u64 * r.image.height as u64);
+        encode_window(r.image, fmt)
     })
     .await
 }
@@ -76,8 +78,7 @@ pub(crate) async fn tile_bytes(
 ) -> Result<Bytes, ApiError> {
     let (tex, p) = (tex.clone(), p.clone());
     let etag = etag_for(&tile_key(&tex, &p, &spec));
-    let cost = tile_cost(&tex, &p, &spec);
-    cached_render(st, &etag, p.mode(), cost, spec.format, move || render_tile(&tex, &p, &spec)).await.0
+    cached_render(st, &etag, p.mode(), spec.format, move |pyr| render_tile(pyr, &tex, &p, &spec)).await.0
 }
 
 fn encode_window(img: textile_core::RgbWindow, fmt: Format) -> Result<Vec<u8>, ApiError> {
@@ -89,19 +90,18 @@ async fn answer<F>(
     headers: &HeaderMap,
     key: String,
     mode: &'static str,
-    cost: Cost,
     fmt: Format,
     job: F,
 ) -> Result<Response, ApiError>
 where
-    F: FnOnce() -> Result<textile_core::RgbWindow, textile_core::CoreError> + Send + 'static,
+    F: FnOnce(&Pyramid) -> Result<Rendered, textile_core::CoreError> + Send + 'static,
 {
     let etag = etag_for(&key);
     let cc = &st.config.cache_control;
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
-    let (bytes, hit) = cached_render(st, &etag, mode, cost, fmt, job).await;
+    let (bytes, hit) = cached_render(st, &etag, mode, fmt, job).await;
     Ok(image(bytes?, fmt.content_type(), &etag, cc, hit))
 }
 
@@ -133,8 +133,7 @@ pub async fn tile(
     let q = parse_query(q.as_deref(), PARAM_KEYS)?;
     let p = render_params(&tex, &q)?;
     let key = tile_key(&tex, &p, &spec);
-    let cost = tile_cost(&tex, &p, &spec);
-    answer(&st, &headers, key, p.mode(), cost, spec.format, move || render_tile(&tex, &p, &spec)).await
+    answer(&st, &headers, key, p.mode(), spec.format, move |pyr| render_tile(pyr, &tex, &p, &spec)).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -168,6 +167,5 @@ pub async fn window(
         &p,
         format_args!("window|{}|{}|{}|{}|{}|{}", spec.z, spec.x, spec.y, spec.w, spec.h, fmt.ext()),
     );
-    let cost = window_cost(&tex, &p, &spec);
-    answer(&st, &headers, key, p.mode(), cost, fmt, move || render_window(&tex, &p, &spec)).await
+    answer(&st, &headers, key, p.mode(), fmt, move |pyr| render_window(pyr, &tex, &p, &spec)).await
 }

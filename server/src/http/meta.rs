@@ -36,6 +36,7 @@ pub(crate) fn base_url(st: &AppState, headers: &HeaderMap) -> String {
 #[utoipa::path(get, path = "/health", tag = "service", responses((status = 200, description = "alive")))]
 pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
     let (entries, bytes) = st.cache.usage();
+    let pyr = st.pyramid.stats();
     Json(json!({
         "status": "ok",
         "version": env!("CARGO_PKG_VERSION"),
@@ -49,6 +50,10 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
             "hits": st.cache.stats.hits.get(),
             "misses": st.cache.stats.misses.get(),
             "evictions": st.cache.stats.evictions.get(),
+        },
+        "level_cache": {
+            "blocks": pyr.blocks, "bytes": pyr.bytes, "limit_bytes": st.config.level_cache_mib << 20,
+            "hits": pyr.hits, "misses": pyr.misses, "evictions": pyr.evictions,
         },
     }))
 }
@@ -222,6 +227,7 @@ pub async fn openapi() -> Json<utoipa::openapi::OpenApi> {
 /// Prometheus metrics in the text exposition format.
 #[utoipa::path(get, path = "/metrics", tag = "service", responses((status = 200, description = "Prometheus text format")))]
 pub async fn metrics(State(st): State<Arc<AppState>>) -> Response {
+    st.metrics.observe_pyramid(&st.pyramid.stats());
     let mut r = st.metrics.render().into_response();
     r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/plain; version=0.0.4; charset=utf-8"));
     r

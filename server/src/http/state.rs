@@ -7,6 +7,7 @@ use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use axum::body::Bytes;
+use textile_core::Pyramid;
 use tokio::sync::Semaphore;
 
 use crate::cache::{CacheStats, TileCache};
@@ -29,6 +30,8 @@ pub struct AppState {
     /// served. Without it, rayon workers waiting inside one synthesis steal other queued
     /// syntheses and unlucky requests stack up behind many others (seconds of tail latency).
     pub running: Arc<Semaphore>,
+    /// Synthesized levels shared between requests (Wei & Levoy's pyramidal cache).
+    pub pyramid: Arc<Pyramid>,
     /// Prometheus metrics.
     pub metrics: Metrics,
 }
@@ -48,6 +51,7 @@ impl AppState {
             cache: TileCache::new(config.cache_mib << 20, stats),
             admission: Arc::new(Semaphore::new(config.max_in_flight)),
             running: Arc::new(Semaphore::new(rayon::current_num_threads().max(1))),
+            pyramid: Arc::new(Pyramid::new(config.level_cache_mib << 20)),
             config,
             registry: OnceLock::new(),
             metrics,
