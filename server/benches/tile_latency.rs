@@ -14,7 +14,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use textile_core::{render, Analysis, Exemplar, ExemplarOptions, NoProgress, Rect, SynthParams};
-use textile_server::encode::{encode, Format};
+use textile_server::encode::{encode, Effort, Format};
 
 fn summary(name: &str, mut v: Vec<Duration>) {
     v.sort();
@@ -42,15 +42,20 @@ fn main() {
         synth.push(t.elapsed());
     }
     summary("synthesis 256² (in process)", synth);
-    for fmt in [Format::Png, Format::Jpeg, Format::Webp] {
+    for (fmt, effort) in [
+        (Format::Png, Effort::Tight),
+        (Format::Png, Effort::Quick),
+        (Format::Jpeg, Effort::Tight),
+        (Format::Webp, Effort::Tight),
+    ] {
         let mut v = Vec::new();
         let mut size = 0;
         for _ in 0..100 {
             let t = Instant::now();
-            size = encode(&tile.pixels, 256, 256, fmt).unwrap().len();
+            size = encode(&tile.pixels, 256, 256, fmt, effort).unwrap().len();
             v.push(t.elapsed());
         }
-        summary(&format!("encode {} ({} KiB)", fmt.ext(), size / 1024), v);
+        summary(&format!("encode {} {effort:?} ({} KiB)", fmt.ext(), size / 1024), v);
     }
 
     // The real server over HTTP.

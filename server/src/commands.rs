@@ -174,7 +174,7 @@ pub fn render(a: RenderArgs) -> CliResult {
         }
         render_tile(&Pyramid::off(), &tex, &p, &TileSpec { z, x, y, scale: 1, format: fmt })?.image
     };
-    let bytes = encode(&img.pixels, img.width, img.height, fmt)?;
+    let bytes = encode(&img.pixels, img.width, img.height, fmt, p.effort())?;
     write_atomic(&a.output, &bytes)?;
     println!("wrote {} ({}x{})", a.output.display(), img.width, img.height);
     Ok(())

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use textile_core::{MosaicParams, Randomness, SynthParams};
 
-use crate::encode::Format;
+use crate::encode::{Effort, Format};
 use crate::http::error::ApiError;
 use crate::textures::Texture;
 
@@ -69,6 +69,14 @@ impl RenderParams {
         match self {
             RenderParams::Synth(_) => "synth",
             RenderParams::Mosaic(_) => "mosaic",
+        }
+    }
+
+    /// How hard to compress this engine's images (see [`Effort`]).
+    pub fn effort(&self) -> Effort {
+        match self {
+            RenderParams::Synth(_) => Effort::Tight,
+            RenderParams::Mosaic(_) => Effort::Quick,
         }
     }
 }

@@ -10,7 +10,7 @@ use axum::extract::{Path, RawQuery, State};
 use axum::http::HeaderMap;
 use axum::response::Response;
 
-use crate::encode::{encode, Format};
+use crate::encode::{encode, Effort, Format};
 use textile_core::{Pyramid, Rendered};
 
 use crate::http::content::{engine_version, etag_for, if_none_match, image, not_modified};
@@ -42,6 +42,7 @@ async fn cached_render<F>(
     etag: &str,
     mode: &'static str,
     fmt: Format,
+    effort: Effort,
     render: F,
 ) -> (Result<Bytes, ApiError>, bool)
 where
@@ -53,7 +54,7 @@ where
         let r = render(&pyramid)?;
         synthesized.with_label_values(&[mode]).inc_by(r.synthesized);
         delivered.with_label_values(&[mode]).inc_by(r.image.width as u64 * r.image.height as u64);
-        encode_window(r.image, fmt)
+        encode_window(r.image, fmt, effort)
     })
     .await
 }
@@ -78,11 +79,11 @@ pub(crate) async fn tile_bytes(
 ) -> Result<Bytes, ApiError> {
     let (tex, p) = (tex.clone(), p.clone());
     let etag = etag_for(&tile_key(&tex, &p, &spec));
-    cached_render(st, &etag, p.mode(), spec.format, move |pyr| render_tile(pyr, &tex, &p, &spec)).await.0
+    cached_render(st, &etag, p.mode(), spec.format, p.effort(), move |pyr| render_tile(pyr, &tex, &p, &spec)).await.0
 }
 
-fn encode_window(img: textile_core::RgbWindow, fmt: Format) -> Result<Vec<u8>, ApiError> {
-    encode(&img.pixels, img.width, img.height, fmt).map_err(|e| ApiError::internal(format!("encoding: {e}")))
+fn encode_window(img: textile_core::RgbWindow, fmt: Format, effort: Effort) -> Result<Vec<u8>, ApiError> {
+    encode(&img.pixels, img.width, img.height, fmt, effort).map_err(|e| ApiError::internal(format!("encoding: {e}")))
 }
 
 async fn answer<F>(
@@ -91,6 +92,7 @@ async fn answer<F>(
     key: String,
     mode: &'static str,
     fmt: Format,
+    effort: Effort,
     job: F,
 ) -> Result<Response, ApiError>
 where
@@ -101,7 +103,7 @@ where
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
-    let (bytes, hit) = cached_render(st, &etag, mode, fmt, job).await;
+    let (bytes, hit) = cached_render(st, &etag, mode, fmt, effort, job).await;
     Ok(image(bytes?, fmt.content_type(), &etag, cc, hit))
 }
 
@@ -133,7 +135,7 @@ pub async fn tile(
     let q = parse_query(q.as_deref(), PARAM_KEYS)?;
     let p = render_params(&tex, &q)?;
     let key = tile_key(&tex, &p, &spec);
-    answer(&st, &headers, key, p.mode(), spec.format, move |pyr| render_tile(pyr, &tex, &p, &spec)).await
+    answer(&st, &headers, key, p.mode(), spec.format, p.effort(), move |pyr| render_tile(pyr, &tex, &p, &spec)).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -167,5 +169,5 @@ pub async fn window(
         &p,
         format_args!("window|{}|{}|{}|{}|{}|{}", spec.z, spec.x, spec.y, spec.w, spec.h, fmt.ext()),
     );
-    answer(&st, &headers, key, p.mode(), fmt, move |pyr| render_window(pyr, &tex, &p, &spec)).await
+    answer(&st, &headers, key, p.mode(), fmt, p.effort(), move |pyr| render_window(pyr, &tex, &p, &spec)).await
 }
