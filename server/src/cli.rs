@@ -174,6 +174,10 @@ pub struct LoadtestArgs {
     /// Seed of the random pattern.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Behave like a polite client: after a 503, a connection waits the advised Retry-After
+    /// before its next request (by default it asks again at once, the harder test).
+    #[arg(long)]
+    pub honor_retry_after: bool,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,

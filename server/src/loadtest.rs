@@ -159,7 +159,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let mut tasks = Vec::new();
         for _ in 0..a.concurrency {
             let (client, paths, issued, root) = (client.clone(), paths.clone(), issued.clone(), root.clone());
-            let max = a.requests;
+            let (max, polite) = (a.requests, a.honor_retry_after);
             tasks.push(tokio::spawn(async move {
                 let mut out = Vec::new();
                 while Instant::now() < deadline && issued.fetch_add(1, std::sync::atomic::Ordering::Relaxed) < max {
@@ -169,12 +169,19 @@ pub fn run(a: LoadtestArgs) -> CliResult {
                     let r = tokio::time::timeout(left, async {
                         let resp = client.get(format!("{root}{path}")).send().await?;
                         let status = resp.status().as_u16();
+                        let retry = resp.headers().get("retry-after").and_then(|v| v.to_str().ok()?.parse::<u64>().ok());
                         let n = resp.bytes().await?.len();
-                        Ok::<_, reqwest::Error>((status, n))
+                        Ok::<_, reqwest::Error>((status, n, retry))
                     })
                     .await;
                     match r {
-                        Ok(Ok((status, n))) => out.push((t.elapsed(), status, n)),
+                        Ok(Ok((status, n, retry))) => {
+                            out.push((t.elapsed(), status, n));
+                            if let Some(secs) = retry.filter(|_| polite && status == 503) {
+                                let wait = Duration::from_secs(secs.min(60));
+                                tokio::time::sleep(wait.min(deadline.saturating_duration_since(Instant::now()))).await;
+                            }
+                        }
                         Ok(Err(_)) => out.push((t.elapsed(), 0, 0)),
                         Err(_) => break,
                     }

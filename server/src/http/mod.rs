@@ -6,6 +6,7 @@ pub mod error;
 pub mod images;
 pub mod meta;
 pub mod models;
+pub mod queue;
 pub mod state;
 pub mod static_files;
 

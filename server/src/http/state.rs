@@ -10,11 +10,16 @@ use axum::body::Bytes;
 use textile_core::Pyramid;
 use tokio::sync::Semaphore;
 
+use crate::http::queue::RunQueue;
+
 use crate::cache::{CacheStats, TileCache};
 use crate::config::Config;
 use crate::http::error::ApiError;
 use crate::metrics::Metrics;
 use crate::textures::Registry;
+
+/// Waiters per pool thread beyond which the synthesis queue serves the newest first.
+const LIFO_ABOVE_PER_THREAD: usize = 4;
 
 /// State shared by all handlers.
 pub struct AppState {
@@ -26,10 +31,11 @@ pub struct AppState {
     pub cache: TileCache,
     /// Permits for syntheses in flight (running or waiting); beyond them requests are shed.
     pub admission: Arc<Semaphore>,
-    /// Permits to run on the synthesis pool: one per pool thread, handed out first come first
-    /// served. Without it, rayon workers waiting inside one synthesis steal other queued
-    /// syntheses and unlucky requests stack up behind many others (seconds of tail latency).
-    pub running: Arc<Semaphore>,
+    /// Permits to run on the synthesis pool: one per pool thread, first come first served
+    /// while the queue is short, newest first when it is long (see [`RunQueue`]). Without it,
+    /// rayon workers waiting inside one synthesis steal other queued syntheses and unlucky
+    /// requests stack up behind many others (seconds of tail latency).
+    pub running: Arc<RunQueue>,
     /// Synthesized levels shared between requests (Wei & Levoy's pyramidal cache).
     pub pyramid: Arc<Pyramid>,
     /// Prometheus metrics.
@@ -50,7 +56,10 @@ impl AppState {
         AppState {
             cache: TileCache::new(config.cache_mib << 20, stats),
             admission: Arc::new(Semaphore::new(config.max_in_flight)),
-            running: Arc::new(Semaphore::new(rayon::current_num_threads().max(1))),
+            running: RunQueue::new(
+                rayon::current_num_threads().max(1),
+                LIFO_ABOVE_PER_THREAD * rayon::current_num_threads().max(1),
+            ),
             pyramid: Arc::new(Pyramid::new(config.level_cache_mib << 20)),
             config,
             registry: OnceLock::new(),
@@ -83,13 +92,9 @@ impl AppState {
         let guard = (admitted, InFlight::new(&self.metrics.in_flight));
         let queue_wait = Duration::from_millis(self.config.max_queue_wait_ms);
         let work = async {
-            let run = match tokio::time::timeout(queue_wait, self.running.clone().acquire_owned()).await {
-                Ok(Ok(run)) => run,
-                Ok(Err(_)) => return Err(ApiError::internal("pool closed")),
-                Err(_) => {
-                    self.metrics.shed.inc();
-                    return Err(ApiError::overloaded());
-                }
+            let Some(run) = self.running.acquire(queue_wait).await else {
+                self.metrics.shed.inc();
+                return Err(ApiError::overloaded());
             };
             let timer = self.metrics.synthesis_timer(mode).start_timer();
             let (tx, rx) = tokio::sync::oneshot::channel();

@@ -1,0 +1,130 @@
+//! The synthesis queue: permits to run on the pool, one per pool thread, handed out first come
+//! first served while the queue is short and newest first once it is long (adaptive LIFO).
+//!
+//! A short queue is a burst (a viewer opening a view) and drains in order. A long queue means
+//! sustained overload: serving the newest waiter keeps admitted requests fast while the oldest
+//! ones run out of their queue-wait budget and are shed with a 503, instead of every admitted
+//! request waiting out the whole queue.
+
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use tokio::sync::oneshot;
+
+/// The queue of one pool.
+pub struct RunQueue {
+    inner: Mutex<Inner>,
+    /// Waiters beyond which the newest is served first.
+    lifo_above: usize,
+}
+
+struct Inner {
+    free: usize,
+    waiting: VecDeque<oneshot::Sender<()>>,
+}
+
+/// Leave to run; gives the thread back to the queue when dropped.
+pub struct RunPermit(Arc<RunQueue>);
+
+impl Drop for RunPermit {
+    fn drop(&mut self) {
+        self.0.release();
+    }
+}
+
+impl RunQueue {
+    /// A queue for `threads` pool threads, serving newest first beyond `lifo_above` waiters.
+    pub fn new(threads: usize, lifo_above: usize) -> Arc<Self> {
+        Arc::new(RunQueue { inner: Mutex::new(Inner { free: threads, waiting: VecDeque::new() }), lifo_above })
+    }
+
+    fn lock(&self) -> MutexGuard<'_, Inner> {
+        // Every critical section leaves `Inner` consistent, so a poisoned lock is still usable.
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Wait at most `budget` for a thread; `None` when the budget ran out.
+    pub async fn acquire(self: &Arc<Self>, budget: Duration) -> Option<RunPermit> {
+        let rx = {
+            let mut g = self.lock();
+            if g.free > 0 {
+                g.free -= 1;
+                return Some(RunPermit(self.clone()));
+            }
+            let (tx, rx) = oneshot::channel();
+            g.waiting.push_back(tx);
+            rx
+        };
+        match tokio::time::timeout(budget, rx).await {
+            Ok(Ok(())) => Some(RunPermit(self.clone())),
+            // Timed out: our sender is dropped with the receiver, so `release` skips it. A thread
+            // handed over in the instant before the timeout is given back by that skip too.
+            _ => None,
+        }
+    }
+
+    /// Hand a thread to the next live waiter (oldest, or newest when the queue is long), or
+    /// keep it free.
+    fn release(&self) {
+        let mut g = self.lock();
+        loop {
+            let next = if g.waiting.len() > self.lifo_above { g.waiting.pop_back() } else { g.waiting.pop_front() };
+            match next {
+                Some(tx) => {
+                    if tx.send(()).is_ok() {
+                        return;
+                    }
+                }
+                None => {
+                    g.free += 1;
+                    return;
+                }
+            }
+        }
+    }
+
+    /// Requests waiting for a thread.
+    pub fn waiting(&self) -> usize {
+        self.lock().waiting.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[tokio::test]
+    async fn short_queues_are_fifo_and_long_ones_serve_the_newest() {
+        let q = RunQueue::new(1, 2);
+        let running = q.acquire(Duration::from_secs(1)).await.expect("free thread");
+        let order = Arc::new(Mutex::new(Vec::new()));
+        let mut tasks = Vec::new();
+        for i in 0..4 {
+            let (q, order) = (q.clone(), order.clone());
+            tasks.push(tokio::spawn(async move {
+                let p = q.acquire(Duration::from_secs(5)).await.expect("served");
+                order.lock().unwrap().push(i);
+                tokio::time::sleep(Duration::from_millis(5)).await;
+                drop(p);
+            }));
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+        assert_eq!(q.waiting(), 4);
+        drop(running);
+        for t in tasks {
+            t.await.unwrap();
+        }
+        // 4 waiting > 2: newest (3); then 3 waiting > 2: newest (2); then FIFO: 0, 1.
+        assert_eq!(*order.lock().unwrap(), vec![3, 2, 0, 1]);
+    }
+
+    #[tokio::test]
+    async fn a_timed_out_waiter_does_not_swallow_the_thread() {
+        let q = RunQueue::new(1, 8);
+        let running = q.acquire(Duration::from_secs(1)).await.expect("free thread");
+        assert!(q.acquire(Duration::from_millis(20)).await.is_none());
+        drop(running);
+        assert!(q.acquire(Duration::from_millis(20)).await.is_some());
+    }
+}
