@@ -21,13 +21,14 @@ run() { # name, loadtest args...
   $BIN loadtest --url "$URL" --json "$@" | python3 bench/load_row.py "$name"
 }
 {
-  echo "| run | conns | requests | req/s | p50 ms | p99 ms | p99 ms (200s) | statuses | server hit ratio | computation ratio |"
-  echo "|---|---|---|---|---|---|---|---|---|---|"
+  echo "| run | conns | requests | req/s | p50 ms | p99 ms | p50 ms (200s) | p99 ms (200s) | statuses | server hit ratio | computation ratio |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
   run "hot (cached tile)" --pattern hot --concurrency 64 --requests 200000 --duration "$SECS"
   run "pan, synth (cold)" --pattern pan --concurrency 8 --requests 100000 --duration "$SECS"
   run "pan, mosaic (cold)" --pattern pan --query mode=mosaic --seed 2 --concurrency 8 --requests 100000 --duration "$SECS"
   run "zoom, synth" --pattern zoom --concurrency 8 --requests 100000 --duration "$SECS" --query seed=3
   run "random, synth" --pattern random --concurrency 8 --requests 100000 --duration "$SECS" --seed 9
-  run "random ×10 (overload)" --pattern random --concurrency 80 --requests 10000000 --duration "$SECS" --seed 10
+  run "random ×10 (overload, clients retry at once)" --pattern random --concurrency 80 --requests 10000000 --duration "$SECS" --seed 10
+  run "random ×10 (overload, clients honour Retry-After)" --pattern random --concurrency 80 --requests 10000000 --duration "$SECS" --seed 11 --honor-retry-after
 } | tee "$OUT"
 echo "wrote $OUT"

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# Soak (issue: under load): run the server with a 64 MiB tile cache, drive it for SECONDS
-# (default 300) with cold random and panning traffic, and print its resident memory every 30 s.
-# Target: resident memory stays within the cache size + 150 MiB.
+# Soak (issue: under load): run the server with a 64 MiB tile cache and a 64 MiB pyramidal
+# cache, drive it for SECONDS (default 300) with cold random, panning (synth) and panning
+# (mosaic) traffic, and print its resident memory every 30 s.
+# Target: resident memory stays within the cache sizes + 150 MiB.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_TOTAL=${1:-300}
 cargo build --release -q -p textile-server
 BIN=target/release/textile
 DATA=$(mktemp -d)
-$BIN serve --bind 127.0.0.1:18099 --data-dir "$DATA" --cache-mib 64 > "$DATA/out" 2>/dev/null &
+$BIN serve --bind 127.0.0.1:18099 --data-dir "$DATA" --cache-mib 64 --level-cache-mib 64 > "$DATA/out" 2>/dev/null &
 PID=$!
 trap 'kill $PID 2>/dev/null; rm -rf "$DATA"' EXIT
 until grep -q "textile ready" "$DATA/out" 2>/dev/null; do sleep 0.2; done
@@ -16,11 +17,13 @@ $BIN loadtest --url http://127.0.0.1:18099 --pattern random --concurrency 4 --re
 L1=$!
 $BIN loadtest --url http://127.0.0.1:18099 --pattern pan --query mode=mosaic --concurrency 4 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/pan" &
 L2=$!
+$BIN loadtest --url http://127.0.0.1:18099 --pattern pan --texture grass --concurrency 2 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/pan_synth" &
+L3=$!
 for ((t = 0; t <= SECONDS_TOTAL; t += 30)); do
   printf 't=%4ss  rss=%6s MiB\n' "$t" "$(( $(awk '/VmRSS/ {print $2}' /proc/$PID/status) / 1024 ))"
   sleep 30
 done
-wait $L1 $L2
-cat "$DATA/random" "$DATA/pan"
-curl -s http://127.0.0.1:18099/metrics | grep -E '^textile_cache_(bytes|entries|evictions_total) '
-printf 'final rss=%s MiB (cache limit 64 MiB)\n' "$(( $(awk '/VmRSS/ {print $2}' /proc/$PID/status) / 1024 ))"
+wait $L1 $L2 $L3
+cat "$DATA/random" "$DATA/pan" "$DATA/pan_synth"
+curl -s http://127.0.0.1:18099/metrics | grep -E '^textile_(level_)?cache_(bytes|entries|blocks|evictions_total) '
+printf 'final rss=%s MiB (cache limits 64 + 64 MiB)\n' "$(( $(awk '/VmRSS/ {print $2}' /proc/$PID/status) / 1024 ))"

@@ -21,15 +21,18 @@ pub struct RunQueue {
 
 struct Inner {
     free: usize,
-    waiting: VecDeque<oneshot::Sender<()>>,
+    waiting: VecDeque<oneshot::Sender<RunPermit>>,
 }
 
-/// Leave to run; gives the thread back to the queue when dropped.
-pub struct RunPermit(Arc<RunQueue>);
+/// Leave to run; gives the thread back to the queue when dropped — also when it is dropped
+/// unseen, inside the channel of a waiter that gave up at the moment it was handed over.
+pub struct RunPermit(Option<Arc<RunQueue>>);
 
 impl Drop for RunPermit {
     fn drop(&mut self) {
-        self.0.release();
+        if let Some(q) = self.0.take() {
+            RunQueue::release(&q);
+        }
     }
 }
 
@@ -50,34 +53,33 @@ impl RunQueue {
             let mut g = self.lock();
             if g.free > 0 {
                 g.free -= 1;
-                return Some(RunPermit(self.clone()));
+                return Some(RunPermit(Some(self.clone())));
             }
             let (tx, rx) = oneshot::channel();
             g.waiting.push_back(tx);
             rx
         };
-        match tokio::time::timeout(budget, rx).await {
-            Ok(Ok(())) => Some(RunPermit(self.clone())),
-            // Timed out: our sender is dropped with the receiver, so `release` skips it. A thread
-            // handed over in the instant before the timeout is given back by that skip too.
-            _ => None,
-        }
+        // On timeout (or if this future is dropped) the receiver goes, and with it any permit
+        // that was just handed over, which then releases itself to the next waiter.
+        tokio::time::timeout(budget, rx).await.ok()?.ok()
     }
 
-    /// Hand a thread to the next live waiter (oldest, or newest when the queue is long), or
+    /// Hand the thread to the next live waiter (oldest, or newest when the queue is long), or
     /// keep it free.
-    fn release(&self) {
-        let mut g = self.lock();
+    fn release(this: &Arc<RunQueue>) {
+        let mut g = this.lock();
+        let mut permit = RunPermit(Some(this.clone()));
         loop {
-            let next = if g.waiting.len() > self.lifo_above { g.waiting.pop_back() } else { g.waiting.pop_front() };
+            let next = if g.waiting.len() > this.lifo_above { g.waiting.pop_back() } else { g.waiting.pop_front() };
             match next {
-                Some(tx) => {
-                    if tx.send(()).is_ok() {
-                        return;
-                    }
-                }
+                Some(tx) => match tx.send(permit) {
+                    Ok(()) => return,
+                    Err(back) => permit = back,
+                },
                 None => {
                     g.free += 1;
+                    // Disarm: this permit's thread is now counted as free.
+                    permit.0 = None;
                     return;
                 }
             }
@@ -117,6 +119,25 @@ mod tests {
         }
         // 4 waiting > 2: newest (3); then 3 waiting > 2: newest (2); then FIFO: 0, 1.
         assert_eq!(*order.lock().unwrap(), vec![3, 2, 0, 1]);
+    }
+
+    #[tokio::test]
+    async fn a_permit_handed_to_a_waiter_that_gave_up_comes_back() {
+        let q = RunQueue::new(1, 8);
+        let running = q.acquire(Duration::from_secs(1)).await.expect("free thread");
+        // A waiter that is dropped right after the thread is handed to it, before it looks.
+        let waiter = {
+            let q = q.clone();
+            tokio::spawn(async move { q.acquire(Duration::from_secs(5)).await.map(|_| ()) })
+        };
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        // Hand the thread over, then cancel the waiter before it runs again to look.
+        drop(running);
+        waiter.abort();
+        let _ = waiter.await;
+        for _ in 0..3 {
+            assert!(q.acquire(Duration::from_millis(50)).await.is_some(), "the thread was lost");
+        }
     }
 
     #[tokio::test]
