@@ -16,6 +16,7 @@ pub mod config;
 pub mod encode;
 pub mod http;
 pub mod loadtest;
+pub mod memory;
 pub mod metrics;
 pub mod render;
 pub mod serve;

@@ -53,6 +53,7 @@ pub fn run(args: ServeArgs) -> CliResult {
 async fn serve(cfg: Config) -> CliResult {
     let listener = TcpListener::bind(&cfg.bind).await.map_err(|e| format!("cannot listen on {}: {e}", cfg.bind))?;
     let addr = listener.local_addr()?;
+    crate::memory::tune_allocator();
     let state = Arc::new(AppState::new(cfg));
     let app = crate::http::router(state.clone());
     info!("listening on http://{addr}/ (loading textures)");
@@ -67,6 +68,7 @@ async fn serve(cfg: Config) -> CliResult {
     };
     let server =
         tokio::spawn(async move { axum::serve(listener, app).with_graceful_shutdown(shutdown_signal()).await });
+    tokio::spawn(crate::memory::return_freed_memory());
     match loader.await? {
         Ok(()) => {
             let n = state.registry.get().map(|r| r.list.len()).unwrap_or(0);
