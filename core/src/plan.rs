@@ -53,27 +53,48 @@ fn snap(r: Rect, cx: i64, cy: i64) -> Rect {
     Rect { x0, y0, x1: x1.max(x0), y1: y1.max(y0) }
 }
 
-/// The exact padding of `w` for a subpass schedule (§1.5): returns the padded rect and each
-/// subpass's rect.
-pub fn pad_for_correction(w: Rect, sched: &[Class]) -> (Rect, Vec<(Class, Rect)>) {
-    // need[c]: pixels of parity class c (index px + 2·py) whose value is still needed.
+/// The backward cone of a window through a subpass schedule (§1.5).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Cone {
+    /// For each generation `k = 0..=K` (values after `k` subpasses), the pixels of each parity
+    /// class (index `px + 2·py`) whose generation-`k` value is needed; nested, growing as `k`
+    /// falls.
+    pub needs: Vec<[Rect; 4]>,
+    /// For each subpass, its class and the rectangle of class pixels it corrects.
+    pub subpasses: Vec<(Class, Rect)>,
+    /// Everything generation 0 must hold: the padded window.
+    pub padded: Rect,
+}
+
+/// The cone of `w` for a schedule: needs are propagated backwards through the subpasses, a
+/// corrected pixel needing its 5×5 neighbourhood one generation earlier.
+pub fn correction_cone(w: Rect, sched: &[Class]) -> Cone {
     let mut need = [w; 4];
-    let mut plan = vec![(Class::All, Rect::new(0, 0, 0, 0)); sched.len()];
+    let mut needs = vec![need; sched.len() + 1];
+    let mut subpasses = vec![(Class::All, Rect::new(0, 0, 0, 0)); sched.len()];
     for (k, &class) in sched.iter().enumerate().rev() {
         let r = match class {
             Class::All => need.iter().fold(Rect::new(0, 0, 0, 0), |a, b| a.union(b)),
             Class::Parity(px, py) => snap(need[(px + 2 * py) as usize], px, py),
         };
-        plan[k] = (class, r);
+        subpasses[k] = (class, r);
         if !r.is_empty() {
             let g = r.grow(2);
             for n in need.iter_mut() {
                 *n = n.union(&g);
             }
         }
+        needs[k] = need;
     }
     let padded = need.iter().fold(w, |a, b| a.union(b));
-    (padded, plan)
+    Cone { needs, subpasses, padded }
+}
+
+/// The exact padding of `w` for a subpass schedule (§1.5): returns the padded rect and each
+/// subpass's rect.
+pub fn pad_for_correction(w: Rect, sched: &[Class]) -> (Rect, Vec<(Class, Rect)>) {
+    let cone = correction_cone(w, sched);
+    (cone.padded, cone.subpasses)
 }
 
 /// Plan the synthesis of `rect` at `target` level: one entry per level `0..=target`, coarse first.
