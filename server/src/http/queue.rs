@@ -56,6 +56,7 @@ impl RunQueue {
                 return Some(RunPermit(Some(self.clone())));
             }
             let (tx, rx) = oneshot::channel();
+            g.waiting.retain(|tx| !tx.is_closed());
             g.waiting.push_back(tx);
             rx
         };
@@ -68,6 +69,9 @@ impl RunQueue {
     /// keep it free.
     fn release(this: &Arc<RunQueue>) {
         let mut g = this.lock();
+        // Waiters that gave up (timed out, or their request was dropped) must not count towards
+        // the queue's length, or a few of them would keep it "long" and newest-first for good.
+        g.waiting.retain(|tx| !tx.is_closed());
         let mut permit = RunPermit(Some(this.clone()));
         loop {
             let next = if g.waiting.len() > this.lifo_above { g.waiting.pop_back() } else { g.waiting.pop_front() };
@@ -88,7 +92,7 @@ impl RunQueue {
 
     /// Requests waiting for a thread.
     pub fn waiting(&self) -> usize {
-        self.lock().waiting.len()
+        self.lock().waiting.iter().filter(|tx| !tx.is_closed()).count()
     }
 }
 
@@ -138,6 +142,34 @@ mod tests {
         for _ in 0..3 {
             assert!(q.acquire(Duration::from_millis(50)).await.is_some(), "the thread was lost");
         }
+    }
+
+    #[tokio::test]
+    async fn waiters_that_gave_up_do_not_keep_the_queue_long() {
+        // Three waiters give up; afterwards two live ones must be served oldest first, as a
+        // short queue is (lifo above 2: counting the dead, the queue would look long).
+        let q = RunQueue::new(1, 2);
+        let running = q.acquire(Duration::from_secs(1)).await.expect("free thread");
+        for _ in 0..3 {
+            assert!(q.acquire(Duration::from_millis(5)).await.is_none());
+        }
+        let order = Arc::new(Mutex::new(Vec::new()));
+        let mut tasks = Vec::new();
+        for i in 0..2 {
+            let (q, order) = (q.clone(), order.clone());
+            tasks.push(tokio::spawn(async move {
+                let p = q.acquire(Duration::from_secs(5)).await.expect("served");
+                order.lock().unwrap().push(i);
+                drop(p);
+            }));
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        }
+        assert_eq!(q.waiting(), 2);
+        drop(running);
+        for t in tasks {
+            t.await.unwrap();
+        }
+        assert_eq!(*order.lock().unwrap(), vec![0, 1]);
     }
 
     #[tokio::test]
