@@ -24,11 +24,14 @@ fn viewer_in_headless_chromium() {
         return;
     }
     let server = Server::start(&[]);
+    // A server that sheds almost everything a viewer asks for at once.
+    let shedding = Server::start(&["--max-in-flight", "2", "--workers", "1"]);
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("viewer.png");
     let status = Command::new("node")
         .args(["--test", "--test-concurrency=1", "viewer.test.mjs"])
         .current_dir(&dir)
         .env("TEXTILE_URL", &server.base)
+        .env("TEXTILE_URL_SHEDDING", &shedding.base)
         .env("TEXTILE_SCREENSHOT", &shot)
         .env("CHROMIUM", &chromium)
         .status()

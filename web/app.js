@@ -47,6 +47,21 @@ function tileUrl() {
   return `/tiles/${encodeURIComponent(state.t)}/{z}/{x}/{y}.png?` + q.toString();
 }
 
+// A tile the server shed under load (503 + Retry-After) is asked for again after a growing,
+// jittered delay (about 1, 2, 4, 8 s; at most 4 times) instead of leaving a hole. `v` is the
+// API's cache-busting parameter: same tile, same bytes, a new request for the browser.
+function retryShedTile(e) {
+  const img = e.tile;
+  const n = Number(img.dataset.retries || 0) + 1;
+  if (n > 4) return;
+  img.dataset.retries = String(n);
+  const delay = 1000 * 2 ** (n - 1) * (0.5 + Math.random());
+  setTimeout(() => {
+    if (!img.isConnected || !layer) return;
+    img.src = `${layer.getTileUrl(e.coords)}&v=retry${n}`;
+  }, delay);
+}
+
 function refreshLayer() {
   const url = tileUrl();
   if (!layer) {
@@ -55,6 +70,7 @@ function refreshLayer() {
       minNativeZoom: meta.minzoom, maxNativeZoom: meta.maxzoom, keepBuffer: 1,
       attribution: meta.attribution || '',
     }).addTo(map);
+    layer.on('tileerror', retryShedTile);
   } else if (layer._url !== url) {
     layer.setUrl(url);
   }

@@ -85,6 +85,22 @@ test('the viewer loads with no console errors and shows texture tiles', async ()
   await page.close();
 });
 
+test('tiles shed with 503 under load are retried until the view is complete', async () => {
+  const shedding = process.env.TEXTILE_URL_SHEDDING;
+  assert.ok(shedding, 'TEXTILE_URL_SHEDDING must name a server with a tiny in-flight limit');
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const tiles = [];
+  page.on('response', (r) => { if (r.url().includes('/tiles/')) tiles.push({ url: r.url(), status: r.status() }); });
+  await page.goto(shedding + '/#t=grass&z=7&x=5000&y=-3000');
+  await page.waitForSelector('body[data-ready="1"]', { timeout: 20000 });
+  await settled(page, 12);
+  assertTexture(await tileStats(page));
+  assert.ok(tiles.some((t) => t.status === 503), 'the server shed some tiles');
+  assert.ok(tiles.some((t) => t.status === 200 && /[?&]v=retry\d/.test(t.url)), 'shed tiles were retried');
+  assert.ok(tiles.every((t) => t.status === 200 || t.status === 503), JSON.stringify(tiles.filter((t) => t.status !== 200 && t.status !== 503)));
+  await page.close();
+});
+
 test('panning requests negative tile coordinates and they render', async () => {
   const { page, errors, tiles } = await open('/#t=gravel&z=7&x=0&y=0');
   await settled(page);
