@@ -136,6 +136,11 @@ impl Pyramid {
         Pyramid::new(0)
     }
 
+    /// Bytes it may hold.
+    pub fn limit(&self) -> u64 {
+        self.limit
+    }
+
     /// True when blocks are kept.
     pub fn is_on(&self) -> bool {
         self.limit > 0

@@ -406,6 +406,9 @@ impl<'a> Ctx<'a> {
     ) -> Vec<Pending> {
         let (w, bs) = (ext.width() as usize, BLOCK as usize);
         let mut out = Vec::new();
+        // Never gather more than half the cache could keep (a huge window would otherwise
+        // hold its whole history in memory only to see most of it evicted).
+        let (mut bytes, budget) = (0u64, self.pyr.limit() / 2);
         for (n, old) in blocks.iter().enumerate() {
             let rect = grid.rect(n % grid.nbx, n / grid.nbx);
             let inner = rect.intersect(&ext);
@@ -430,6 +433,10 @@ impl<'a> Ctx<'a> {
             if let Some(b) = old {
                 let n = b.data.len().min(data.len());
                 data[..n].copy_from_slice(&b.data[..n]);
+            }
+            bytes += 4 * data.len() as u64 + lo.len() as u64;
+            if bytes > budget {
+                break;
             }
             out.push(Pending { rect, inner, top: most, lo, data });
         }
