@@ -91,6 +91,12 @@ fn invalid_configuration_stops_start_up_naming_the_key() {
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
     assert!(err.contains("cache_mib"), "{err}");
+    let (code, err) = run(&["serve", "--level-cache-mib", "70000"], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("level_cache_mib") && err.contains("0 = off"), "{err}");
+    let (code, err) = run(&["serve", "--bind", "127.0.0.1:0"], &[("TEXTILE_LEVEL_CACHE_MIB", "lots")]);
+    assert_ne!(code, Some(0));
+    assert!(err.to_lowercase().contains("level_cache_mib"), "{err}");
     std::fs::write(&cfg, "cache_mb = 10\n").unwrap();
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
