@@ -13,7 +13,7 @@
 //! 3. [`plan`] — which padded rectangle each level must compute for a window to be exact;
 //! 4. [`synth`] — upsample, jitter by a [`hash`] of absolute coordinates, correct; the
 //!    [`pyramid`] cache lets neighbouring windows share coarse levels and padding;
-//! 5. [`render`] — exemplar coordinates to colours, at native or zoomed-out scale.
+//! 5. [`mod@render`] — exemplar coordinates to colours, at native or zoomed-out scale.
 //!
 //! The cheap mode, [`mosaic`], is Xu, Guo & Shum's chaos mosaic: the tiled exemplar with blocks
 //! moved by the cat map, evaluated lazily for any window.
@@ -39,9 +39,12 @@ pub mod candidates;
 pub mod error;
 pub mod exemplar;
 pub mod features;
+mod generations;
 pub mod geom;
 pub mod hash;
+mod history;
 pub mod kdtree;
+mod kernel;
 pub mod mosaic;
 pub mod params;
 pub mod plan;
