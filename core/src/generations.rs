@@ -7,15 +7,28 @@
 use crate::geom::Rect;
 use crate::plan::{correction_cone, Class};
 
+/// Where a subpass class lies in a rectangle: its first row and first column (relative to the
+/// rectangle) and the step between its rows and between its columns.
+pub(crate) fn class_origin(class: Class, r: Rect) -> (usize, usize, usize) {
+    match class {
+        Class::All => (0, 0, 1),
+        Class::Parity(px, py) => ((py - r.y0).rem_euclid(2) as usize, (px - r.x0).rem_euclid(2) as usize, 2),
+    }
+}
+
+/// How many class columns a row `width` wide holds, the first at `c0`, `step` apart.
+pub(crate) fn class_cols(width: usize, c0: usize, step: usize) -> usize {
+    if width > c0 {
+        (width - c0).div_ceil(step)
+    } else {
+        0
+    }
+}
+
 /// Rows, first column and column step of a subpass class within a rectangle.
 pub(crate) fn class_layout(class: Class, r: Rect) -> (Vec<usize>, usize, usize) {
-    match class {
-        Class::All => ((0..r.height() as usize).collect(), 0, 1),
-        Class::Parity(px, py) => {
-            let j0 = (py - r.y0).rem_euclid(2) as usize;
-            ((j0..r.height() as usize).step_by(2).collect(), (px - r.x0).rem_euclid(2) as usize, 2)
-        }
-    }
+    let (j0, c0, step) = class_origin(class, r);
+    ((j0..r.height().max(0) as usize).step_by(step).collect(), c0, step)
 }
 
 /// For each pixel of `ext`, the highest generation a call needing `need` at the last
@@ -46,15 +59,13 @@ pub(crate) fn needed_generations(
     let mut dil = vec![0u8; w * h];
     let mut acc = vec![0u8; w];
     for (k, &class) in gens.iter().enumerate().rev().map(|(i, c)| (i as i8 + 1, c)) {
-        let (rows, c0, step) = class_layout(class, ext);
-        let row_step = if step == 1 { 1 } else { 2 };
-        let j0 = rows.first().copied().unwrap_or(0);
+        let (j0, c0, step) = class_origin(class, ext);
         // Per row: the first and last computed column, if any. Sequential: these passes are
         // short, and forking for them cost more than they do.
         let mut spans: Vec<Option<(usize, usize)>> = vec![None; h];
         let mut src = vec![0u8; w + 4];
         for (j, d) in dil.chunks_mut(w).enumerate() {
-            if j < j0 || (j - j0) % row_step != 0 {
+            if j < j0 || (j - j0) % step != 0 {
                 continue;
             }
             let (t, o) = (&top[j * w..(j + 1) * w], &lo[j * w..(j + 1) * w]);

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use crate::generations::{class_cols, class_origin};
 use crate::geom::Rect;
 use crate::plan::Class;
 use crate::pyramid::{Block, BlockGrid, Pyramid, BLOCK};
@@ -52,11 +53,8 @@ pub(crate) fn for_rows(r: Rect, mut f: impl FnMut(i64, i64, i64)) {
 /// pixel in `ext` and its offset in the block's class array.
 fn class_rows(ext: Rect, r: Rect, class: Class) -> (usize, usize, impl Iterator<Item = (usize, usize)>) {
     let w = ext.width() as usize;
-    let (j0, c0, step) = match class {
-        Class::All => (0, 0, 1),
-        Class::Parity(px, py) => ((py - r.y0).rem_euclid(2) as usize, (px - r.x0).rem_euclid(2) as usize, 2),
-    };
-    let n = if r.width() as usize > c0 { (r.width() as usize - c0).div_ceil(step) } else { 0 };
+    let (j0, c0, step) = class_origin(class, r);
+    let n = class_cols(r.width() as usize, c0, step);
     let rows = (j0..r.height().max(0) as usize).step_by(step).map(move |j| {
         let (x, y) = (r.x0 + c0 as i64, r.y0 + j as i64);
         ((y - ext.y0) as usize * w + (x - ext.x0) as usize, class_index(class, x, y))

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use crate::analysis::{Analysis, CorrectionLevel};
 use crate::error::{CoreError, Result};
 use crate::features::TAPS5;
-use crate::generations::{class_layout, needed_generations};
+use crate::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash, TAG_JITTER};
 use crate::history::{block_index, capture, for_rows, overlay, pending};
@@ -233,8 +233,7 @@ impl<'a> Ctx<'a> {
                 let bx = boxes[k - 1].intersect(&ext);
                 let (rows, c0, step) = class_layout(class, bx);
                 let (ox, oy) = ((bx.x0 - ext.x0).max(0) as usize, (bx.y0 - ext.y0).max(0) as usize);
-                let bw = bx.width().max(0) as usize;
-                let cols = if bw > c0 { (bw - c0).div_ceil(step) } else { 0 };
+                let cols = class_cols(bx.width() as usize, c0, step);
                 let mut out = vec![0u32; rows.len() * cols];
                 let (sr, colr) = (&s, &col);
                 out.par_chunks_mut(cols.max(1)).zip(rows.par_iter()).with_min_len(4).for_each(|(orow, &j)| {
