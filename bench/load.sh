@@ -6,16 +6,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECS=${1:-15}
-cargo build --release -q -p textile-server
-BIN=target/release/textile
-DATA=$(mktemp -d)
+source bench/server.sh
+start_server
 OUT=bench/out/load.md
 mkdir -p bench/out
-$BIN serve --bind 127.0.0.1:0 --data-dir "$DATA" > "$DATA/out" 2>/dev/null &
-PID=$!
-trap 'kill $PID 2>/dev/null; rm -rf "$DATA"' EXIT
-until grep -q "textile ready" "$DATA/out" 2>/dev/null; do sleep 0.2; done
-URL=$(sed -n 's/^textile ready: viewer at \(http[^ ]*\)\/ .*/\1/p' "$DATA/out")
 run() { # name, loadtest args...
   local name=$1; shift
   $BIN loadtest --url "$URL" --json "$@" | python3 bench/load_row.py "$name"

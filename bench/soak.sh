@@ -6,18 +6,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_TOTAL=${1:-300}
-cargo build --release -q -p textile-server
-BIN=target/release/textile
-DATA=$(mktemp -d)
-$BIN serve --bind 127.0.0.1:18099 --data-dir "$DATA" --cache-mib 64 --level-cache-mib 64 > "$DATA/out" 2>/dev/null &
-PID=$!
-trap 'kill $PID 2>/dev/null; rm -rf "$DATA"' EXIT
-until grep -q "textile ready" "$DATA/out" 2>/dev/null; do sleep 0.2; done
-$BIN loadtest --url http://127.0.0.1:18099 --pattern random --concurrency 4 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/random" &
+source bench/server.sh
+start_server --cache-mib 64 --level-cache-mib 64
+$BIN loadtest --url "$URL" --pattern random --concurrency 4 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/random" &
 L1=$!
-$BIN loadtest --url http://127.0.0.1:18099 --pattern pan --query mode=mosaic --concurrency 4 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/pan" &
+$BIN loadtest --url "$URL" --pattern pan --query mode=mosaic --concurrency 4 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/pan" &
 L2=$!
-$BIN loadtest --url http://127.0.0.1:18099 --pattern pan --texture grass --concurrency 2 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/pan_synth" &
+$BIN loadtest --url "$URL" --pattern pan --texture grass --concurrency 2 --requests 10000000 --duration "$SECONDS_TOTAL" > "$DATA/pan_synth" &
 L3=$!
 for ((t = 0; t <= SECONDS_TOTAL; t += 30)); do
   printf 't=%4ss  rss=%6s MiB\n' "$t" "$(( $(awk '/VmRSS/ {print $2}' /proc/$PID/status) / 1024 ))"
@@ -25,5 +20,5 @@ for ((t = 0; t <= SECONDS_TOTAL; t += 30)); do
 done
 wait $L1 $L2 $L3
 cat "$DATA/random" "$DATA/pan" "$DATA/pan_synth"
-curl -s http://127.0.0.1:18099/metrics | grep -E '^textile_(level_)?cache_(bytes|entries|blocks|evictions_total) '
+curl -s "$URL/metrics" | grep -E '^textile_(level_)?cache_(bytes|entries|blocks|evictions_total) '
 printf 'final rss=%s MiB (cache limits 64 + 64 MiB)\n' "$(( $(awk '/VmRSS/ {print $2}' /proc/$PID/status) / 1024 ))"
