@@ -23,8 +23,10 @@ pub struct Server {
     child: Child,
     /// `http://127.0.0.1:PORT`.
     pub base: String,
-    /// Lines the server wrote to stderr (collected after exit only).
+    /// A client with its own connection pool.
     pub client: reqwest::Client,
+    /// Where the server's stderr (its log) goes; shown if the server died during the test.
+    log: PathBuf,
 }
 
 impl Server {
@@ -44,8 +46,14 @@ impl Server {
 
     /// Start the binary with exactly these arguments and environment (it must bind a free port).
     pub fn spawn(args: &[std::ffi::OsString], env: &[(&str, &str)]) -> Server {
+        let log_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("server-logs");
+        std::fs::create_dir_all(&log_dir).expect("log dir");
+        static STARTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = STARTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let log = log_dir.join(format!("{}-{n}.log", std::process::id()));
+        let stderr = std::fs::File::create(&log).expect("log file");
         let mut cmd = Command::new(binary());
-        cmd.args(args).envs(env.iter().copied()).stdout(Stdio::piped()).stderr(Stdio::null()).stdin(Stdio::null());
+        cmd.args(args).envs(env.iter().copied()).stdout(Stdio::piped()).stderr(stderr).stdin(Stdio::null());
         let mut child = cmd.spawn().expect("start textile");
         let stdout = child.stdout.take().expect("stdout");
         let (tx, rx) = mpsc::channel();
@@ -61,13 +69,14 @@ impl Server {
                 Ok(line) => {
                     if let Some(rest) = line.strip_prefix("textile ready: viewer at ") {
                         let url = rest.split_whitespace().next().unwrap_or_default().trim_end_matches('/');
-                        return Server { child, base: url.to_string(), client: reqwest::Client::new() };
+                        return Server { child, base: url.to_string(), client: reqwest::Client::new(), log };
                     }
                 }
                 Err(_) => {
                     let _ = child.kill();
                     let _ = child.wait();
-                    panic!("textile did not report ready within 180 s");
+                    let log = std::fs::read_to_string(&log).unwrap_or_default();
+                    panic!("textile did not report ready within 180 s (or exited); its log:\n{log}");
                 }
             }
         }
@@ -108,6 +117,7 @@ impl Server {
     pub fn terminate(mut self) -> Option<i32> {
         let _ = Command::new("kill").arg("-TERM").arg(self.child.id().to_string()).status();
         let code = self.child.wait().ok().and_then(|s| s.code());
+        let _ = std::fs::remove_file(&self.log);
         std::mem::forget(self);
         code
     }
@@ -115,6 +125,14 @@ impl Server {
 
 impl Drop for Server {
     fn drop(&mut self) {
+        // A server that exited before the test stopped it crashed: say how, with its last words.
+        if let Ok(Some(status)) = self.child.try_wait() {
+            let log = std::fs::read_to_string(&self.log).unwrap_or_default();
+            let tail: Vec<&str> = log.lines().rev().take(40).collect();
+            let tail: Vec<&str> = tail.into_iter().rev().collect();
+            eprintln!("textile at {} exited early ({status}); its last log lines:\n{}", self.base, tail.join("\n"));
+        }
+        let _ = std::fs::remove_file(&self.log);
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
