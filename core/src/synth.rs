@@ -16,7 +16,7 @@ use crate::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash, TAG_JITTER};
 use crate::history::{block_index, capture, for_rows, overlay, pending};
-use crate::kernel::Kernel;
+use crate::kernel::{projection_pairs, Kernel};
 use crate::params::SynthParams;
 use crate::plan::{pad_for_correction, plan_window, schedule, Class};
 use crate::pyramid::{Block, BlockGrid, BlockKey, Pyramid, StreamId, BLOCK};
@@ -348,6 +348,7 @@ impl<'a> Ctx<'a> {
             taps: taps.try_into().unwrap_or([0; TAPS5]),
             nb_off: nb_off.try_into().unwrap_or([(0, 0, 0); 9]),
             proj,
+            pairs: projection_pairs(&cl.proj),
             cands: &cl.cands,
             m,
             mask: (m - 1) as u32,
