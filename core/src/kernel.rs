@@ -57,10 +57,15 @@ impl Kernel<'_> {
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
             let mut acc = _mm256_setzero_si256();
-            for (t, &off) in self.taps.iter().enumerate() {
-                let c = _mm256_set1_epi32(col[(idx as isize + off) as usize] as i32);
-                acc = _mm256_add_epi32(acc, _mm256_madd_epi16(_mm256_shuffle_epi8(c, rg), w[2 * t]));
-                acc = _mm256_add_epi32(acc, _mm256_madd_epi16(_mm256_shuffle_epi8(c, b0), w[2 * t + 1]));
+            // The 5×5 taps are five runs of five adjacent pixels: one bounds check per run.
+            for (r, wr) in w.chunks_exact(10).enumerate() {
+                let at = (idx as isize + self.taps[5 * r]) as usize;
+                let run: &[u32; 5] = col[at..at + 5].try_into().unwrap_or(&[0; 5]);
+                for (&c, wt) in run.iter().zip(wr.chunks_exact(2)) {
+                    let c = _mm256_set1_epi32(c as i32);
+                    acc = _mm256_add_epi32(acc, _mm256_madd_epi16(_mm256_shuffle_epi8(c, rg), wt[0]));
+                    acc = _mm256_add_epi32(acc, _mm256_madd_epi16(_mm256_shuffle_epi8(c, b0), wt[1]));
+                }
             }
             *o = self.best_avx2(idx, s, _mm256_srai_epi32(acc, FEAT_SHIFT as i32));
         }
