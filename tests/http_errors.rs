@@ -106,6 +106,10 @@ fn invalid_configuration_stops_start_up_naming_the_key() {
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
     assert!(err.contains("default_mode") && err.contains("synth"), "{err}");
+    std::fs::write(&cfg, "[[textures]]\nid = \"x\"\nname = \"X\"\nexemplar = \"e.png\"\nkappa = 1.5\n").unwrap();
+    let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("textures[0].kappa") && err.contains("[0, 1]"), "{err}");
     let (code, err) = run(&["serve"], &[("TEXTILE_BIND", "not-an-address")]);
     assert_ne!(code, Some(0));
     assert!(err.contains("bind"), "{err}");

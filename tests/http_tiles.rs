@@ -1,9 +1,10 @@
 //! Tiles, metadata and HTTP semantics of the real server: sizes and formats, TileJSON 3.0.0,
-//! catalog consistency, ETag/304, X-Cache, HEAD, CORS and the OpenAPI document.
+//! catalog consistency, ETag/304, X-Cache, HEAD, CORS, the OpenAPI document, and a texture's
+//! configured κ.
 
 mod support;
 
-use support::Server;
+use support::{binary, shared_data_dir, Server};
 
 #[tokio::test]
 async fn tiles_decode_to_the_right_size_in_every_format() {
@@ -144,4 +145,42 @@ async fn health_ready_viewer_and_openapi() {
     ] {
         assert!(paths.contains_key(p), "openapi lacks {p}");
     }
+}
+
+#[tokio::test]
+async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("textile.toml");
+    std::fs::write(
+        &cfg,
+        "[[textures]]\nid = \"plain\"\nname = \"Plain\"\nexemplar = \"embedded:gravel.png\"\n\n\
+         [[textures]]\nid = \"coherent\"\nname = \"Coherent\"\nexemplar = \"embedded:gravel.png\"\nkappa = 1.0\n",
+    )
+    .unwrap();
+    let data = shared_data_dir();
+    let s = Server::start(&["--config", cfg.to_str().unwrap()]);
+    let k = |v: &serde_json::Value| v["synthesis"]["kappa"].as_f64().unwrap();
+    assert!((k(&s.json("/textures/plain").await) - 0.2).abs() < 1e-4);
+    assert_eq!(k(&s.json("/textures/coherent").await), 1.0);
+    let (plain, coherent) = (s.get("/tiles/plain/7/1/2.png").await, s.get("/tiles/coherent/7/1/2.png").await);
+    assert_ne!(plain.headers()["etag"], coherent.headers()["etag"]);
+    let coherent = coherent.bytes().await.unwrap();
+    assert_ne!(plain.bytes().await.unwrap(), coherent, "κ changes the synthesis");
+    // The cheap mode has no κ: same bytes for both.
+    assert_eq!(
+        s.get_bytes("/tiles/plain/7/1/2.png?mode=mosaic").await,
+        s.get_bytes("/tiles/coherent/7/1/2.png?mode=mosaic").await
+    );
+    // `textile render --texture` uses the texture's κ too.
+    let out = dir.path().join("tile.png");
+    let status = std::process::Command::new(binary())
+        .args(["render", "--config", cfg.to_str().unwrap(), "--data-dir", data.to_str().unwrap()])
+        .args(["--texture", "coherent", "--x", "1", "--y", "2", "-o", out.to_str().unwrap()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert_eq!(std::fs::read(&out).unwrap(), coherent);
+    // The shipped configuration gives gravel κ = 0.5.
+    let d = Server::start(&[]);
+    assert_eq!(k(&d.json("/textures/gravel").await), 0.5);
 }

@@ -199,6 +199,7 @@ fn texture_from(an: Analysis) -> Texture {
             default_mode: "synth".into(),
             default_seed: 0,
             default_randomness: String::new(),
+            kappa: None,
             attribution: String::new(),
         },
         analysis: Arc::new(an),

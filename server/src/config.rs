@@ -71,6 +71,11 @@ pub struct TextureConfig {
     /// engine's default schedule.
     #[serde(default)]
     pub default_randomness: String,
+    /// κ of this texture's synthesis (`[0, 1]`, design note §1.3: the penalty on jumps to a
+    /// pixel's second candidate; higher keeps patches more coherent); absent = 0.2. Not a
+    /// request parameter: it is part of the texture, like its exemplar.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kappa: Option<f64>,
     /// Attribution shown in TileJSON.
     #[serde(default)]
     pub attribution: String,
@@ -220,6 +225,11 @@ impl Config {
             if !t.default_randomness.is_empty() {
                 if let Err(e) = textile_core::Randomness::parse(&t.default_randomness) {
                     return bad(&format!("textures[{i}].default_randomness"), e.to_string());
+                }
+            }
+            if let Some(k) = t.kappa {
+                if let Err(e) = textile_core::SynthParams::parse_kappa(&k.to_string()) {
+                    return bad(&format!("textures[{i}].kappa"), e.to_string());
                 }
             }
         }

@@ -158,6 +158,9 @@ pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress
         if !t.default_randomness.is_empty() {
             defaults.randomness = Randomness::parse(&t.default_randomness).map_err(core)?;
         }
+        if let Some(k) = t.kappa {
+            defaults.kappa = SynthParams::parse_kappa(&k.to_string()).map_err(core)?;
+        }
         defaults.validate_for(&analysis).map_err(core)?;
         list.push(Arc::new(Texture {
             config: t.clone(),

@@ -115,6 +115,12 @@ pub async fn texture_meta(
         "maxzoom": t.max_zoom(),
         "tile_size": crate::tile_request::TILE_SIZE,
         "levels": levels + 1,
+        "synthesis": {
+            "kappa": t.defaults.kappa as f64 / 65536.0,
+            "passes": t.defaults.passes,
+            "subpasses": t.defaults.subpasses,
+            "description": "fixed settings of this texture's synth mode (set in the configuration, not per request)",
+        },
         "parameters": {
             "seed": { "default": t.defaults.seed, "min": 0, "max": u64::MAX },
             "randomness": {
