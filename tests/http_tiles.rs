@@ -166,6 +166,10 @@ async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     assert_ne!(plain.headers()["etag"], coherent.headers()["etag"]);
     let coherent = coherent.bytes().await.unwrap();
     assert_ne!(plain.bytes().await.unwrap(), coherent, "κ changes the synthesis");
+    // Same exemplar, other κ: the TileJSON version parameter differs too, so immutable cached
+    // copies of one are never taken for the other.
+    let v = |t: serde_json::Value| t["tiles"][0].as_str().unwrap().split("v=").nth(1).unwrap()[..12].to_string();
+    assert_ne!(v(s.json("/tiles/plain/tilejson.json").await), v(s.json("/tiles/coherent/tilejson.json").await));
     // The cheap mode has no κ: same bytes for both.
     assert_eq!(
         s.get_bytes("/tiles/plain/7/1/2.png?mode=mosaic").await,

@@ -176,7 +176,12 @@ pub async fn tilejson(
     let t = texture(reg, &id)?;
     let q = parse_query(raw.as_deref(), PARAM_KEYS)?;
     render_params(&t, &q)?;
-    let version = &blake3::hash(format!("{}|{}", engine_version(), t.file_hash).as_bytes()).to_hex()[..12];
+    // Everything that decides a tile's bytes besides its own request: engine, analysis, and the
+    // texture's configured defaults (a changed default seed or κ must not hit stale immutable copies).
+    let version = &blake3::hash(
+        format!("{}|{}|{}|{}", engine_version(), t.file_hash, t.config.default_mode, t.defaults.canonical()).as_bytes(),
+    )
+    .to_hex()[..12];
     let mut qs = form_urlencoded::Serializer::new(String::new());
     qs.append_pair("v", version);
     for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
