@@ -11,6 +11,13 @@ use std::time::Duration;
 /// at 128 KiB, mapping and faulting them in halved mosaic throughput (1 117 → 616 tiles/s).
 const MMAP_THRESHOLD: i32 = 1024 * 1024;
 
+/// Free memory at the top of a heap is kept up to this size instead of being handed back at
+/// once (glibc's default: 128 KiB): every request allocates and frees ~2 MB of buffers, and
+/// handing them back after each one made the next request fault them in again. Measured on the
+/// mosaic pan load: 900–990 → 960–1 080 tiles/s; soak resident memory 259–269 MiB against
+/// 258–267 without (8 MiB: 263–278). [`return_freed_memory`] still trims every few seconds.
+const TRIM_THRESHOLD: i32 = 4 * 1024 * 1024;
+
 /// Fix the mmap threshold (glibc otherwise raises it after large frees, keeping big request
 /// buffers on the heap). Call once at start-up.
 pub fn tune_allocator() {
@@ -18,6 +25,7 @@ pub fn tune_allocator() {
     // SAFETY: mallopt only changes allocator parameters; called before request threads start.
     unsafe {
         libc::mallopt(libc::M_MMAP_THRESHOLD, MMAP_THRESHOLD);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, TRIM_THRESHOLD);
     }
 }
 
