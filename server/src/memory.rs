@@ -14,7 +14,7 @@ const MMAP_THRESHOLD: i32 = 1024 * 1024;
 /// Free memory at the top of a heap is kept up to this size instead of being handed back at
 /// once (glibc's default: 128 KiB): every request allocates and frees ~2 MB of buffers, and
 /// handing them back after each one made the next request fault them in again. Measured on the
-/// mosaic pan load: 900–990 → 960–1 080 tiles/s; soak resident memory 259–269 MiB against
+/// mosaic pan load: 900–990 → 956–1 079 tiles/s; soak resident memory 259–269 MiB against
 /// 258–267 without (8 MiB: 263–278). [`return_freed_memory`] still trims every few seconds.
 const TRIM_THRESHOLD: i32 = 4 * 1024 * 1024;
 
