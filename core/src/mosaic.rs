@@ -318,8 +318,8 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
         }
     });
     // Horizontal tent (1,2,3,4,3,2,1) = two 4-wide boxes, as running sums, over e's rows and
-    // rect's columns.
-    let mut th = vec![[0u32; 3]; w * eh];
+    // rect's columns (at most 16 · 255 = 4 080: u16).
+    let mut th = vec![[0u16; 3]; w * eh];
     th.par_chunks_mut(w).enumerate().with_min_len(16).for_each_init(
         || vec![[0u32; 3]; w + 3],
         |bx, (j, out)| {
@@ -344,12 +344,12 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
                     acc[c] += b[c];
                 }
             }
-            out[0] = acc;
+            out[0] = acc.map(|v| v as u16);
             for i in 1..w {
                 for c in 0..3 {
                     acc[c] = acc[c] + bx[i + 3][c] - bx[i - 1][c];
                 }
-                out[i] = acc;
+                out[i] = acc.map(|v| v as u16);
             }
         },
     );
@@ -379,7 +379,7 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
                 for (k, &wt) in TENT.iter().enumerate() {
                     let r = th[(j + k) * w + i];
                     for (acc, v) in t.iter_mut().zip(r) {
-                        *acc += wt * v;
+                        *acc += wt * v as u32;
                     }
                 }
                 for ((o, c), &tc) in o.iter_mut().zip(&c0).zip(&t) {
