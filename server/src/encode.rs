@@ -67,8 +67,15 @@ pub enum Effort {
     Quick,
 }
 
-/// Encode RGB8 pixels.
+/// Encode RGB8 pixels. The result holds no spare capacity: the tile cache counts a tile by its
+/// length, and an encoder's output buffer grows by doubling (up to twice the length held).
 pub fn encode(rgb: &[u8], w: u32, h: u32, fmt: Format, effort: Effort) -> Result<Vec<u8>, ImageError> {
+    let mut out = encode_into_vec(rgb, w, h, fmt, effort)?;
+    out.shrink_to_fit();
+    Ok(out)
+}
+
+fn encode_into_vec(rgb: &[u8], w: u32, h: u32, fmt: Format, effort: Effort) -> Result<Vec<u8>, ImageError> {
     match fmt {
         Format::Png => png(rgb, w, h, effort),
         Format::Jpeg => {
