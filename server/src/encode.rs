@@ -108,3 +108,25 @@ pub fn png(rgb: &[u8], w: u32, h: u32, effort: Effort) -> Result<Vec<u8>, ImageE
     )?;
     Ok(out.into_inner())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn encoded_tiles_hold_no_spare_capacity_and_decode_to_their_pixels() {
+        // The tile cache bounds its memory by the sum of lengths: capacity must equal length.
+        let rgb: Vec<u8> = (0..256 * 256 * 3u32).map(|i| ((i * 7919) >> 5) as u8).collect();
+        for fmt in [Format::Png, Format::Jpeg, Format::Webp] {
+            for effort in [Effort::Tight, Effort::Quick] {
+                let out = encode(&rgb, 256, 256, fmt, effort).unwrap();
+                assert_eq!(out.capacity(), out.len(), "{fmt:?} {effort:?}");
+                let img = image::load_from_memory(&out).unwrap().to_rgb8();
+                assert_eq!(img.dimensions(), (256, 256));
+                if fmt != Format::Jpeg {
+                    assert_eq!(img.into_raw(), rgb, "{fmt:?} {effort:?} is lossless");
+                }
+            }
+        }
+    }
+}
