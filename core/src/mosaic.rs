@@ -275,6 +275,13 @@ pub fn render(an: &Analysis, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
     Ok(sampled(an, &layout, zoom_out, rect))
 }
 
+/// Rows per parallel piece of a native render, and pixels per piece of the colour lookup: a
+/// tile (264 rows with its margin) splits in two, not sixteen. Under load every pool thread is
+/// busy with its own tiles and finer pieces only cost splitting and stealing (mosaic pan
+/// +7–10 % in alternating runs); a lone 256² window is as fast as with finer pieces (0.45 ms).
+const PAR_ROWS: usize = 128;
+const PAR_PIXELS: usize = 1 << 15;
+
 fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
     let n = layout.n as usize;
     let s = layout.p.smoothing;
@@ -285,7 +292,7 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
     let m0: Vec<[u8; 3]> = pt
         .src
         .par_iter()
-        .with_min_len(4096)
+        .with_min_len(PAR_PIXELS)
         .map(|&v| an.exemplar[(v >> 16) as usize * n + (v & 0xFFFF) as usize])
         .collect();
     let (w, h) = (rect.width() as usize, rect.height() as usize);
@@ -302,7 +309,7 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
     // horizontal distance to the nearest edge pixel in its row (capped at 4).
     let (ew, eh) = (w + 6, h + 6);
     let mut hd = vec![4u8; ew * eh];
-    hd.par_chunks_mut(ew).enumerate().with_min_len(16).for_each(|(j, row)| {
+    hd.par_chunks_mut(ew).enumerate().with_min_len(PAR_ROWS).for_each(|(j, row)| {
         let mut last = 4u8;
         for (i, d) in row.iter_mut().enumerate() {
             let k = (j + 1) * gw + i + 1;
@@ -320,7 +327,7 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
     // Horizontal tent (1,2,3,4,3,2,1) = two 4-wide boxes, as running sums, over e's rows and
     // rect's columns (at most 16 · 255 = 4 080: u16).
     let mut th = vec![[0u16; 3]; w * eh];
-    th.par_chunks_mut(w).enumerate().with_min_len(16).for_each_init(
+    th.par_chunks_mut(w).enumerate().with_min_len(PAR_ROWS).for_each_init(
         || vec![[0u32; 3]; w + 3],
         |bx, (j, out)| {
             let row = &m0[(j + 1) * gw + 1..(j + 1) * gw + 1 + ew];
@@ -355,7 +362,7 @@ fn native(an: &Analysis, layout: &Layout, rect: Rect) -> RgbWindow {
     );
     const TENT: [u32; 7] = [1, 2, 3, 4, 3, 2, 1];
     pixels.resize(3 * w * h, 0);
-    pixels.par_chunks_mut(3 * w).enumerate().with_min_len(16).for_each_init(
+    pixels.par_chunks_mut(3 * w).enumerate().with_min_len(PAR_ROWS).for_each_init(
         || vec![4u8; w],
         |dist, (j, out)| {
             // Chebyshev distance to the nearest edge pixel, from the row distances (dy outer
