@@ -3,7 +3,7 @@
 
 mod support;
 
-use support::{assert_error, paste, Server};
+use support::{assert_error, gravel_textures_config, paste, Server};
 
 #[tokio::test]
 async fn mosaic_tiles_equal_windows_and_differ_from_synth() {
@@ -66,13 +66,7 @@ async fn mosaic_parameters_are_validated() {
 #[tokio::test]
 async fn a_texture_can_default_to_mosaic() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("textile.toml");
-    std::fs::write(
-        &cfg,
-        "[[textures]]\nid = \"gravel\"\nname = \"Gravel\"\nexemplar = \"embedded:gravel.png\"\n\n\
-         [[textures]]\nid = \"cheap\"\nname = \"Cheap gravel\"\nexemplar = \"embedded:gravel.png\"\ndefault_mode = \"mosaic\"\n",
-    )
-    .unwrap();
+    let cfg = gravel_textures_config(dir.path(), &[("gravel", ""), ("cheap", "default_mode = \"mosaic\"")]);
     let s = Server::start(&["--config", cfg.to_str().unwrap()]);
     let cat = s.json("/catalog").await;
     assert_eq!(cat["textures"][1]["default_mode"], "mosaic");

@@ -4,7 +4,7 @@
 
 mod support;
 
-use support::{binary, shared_data_dir, Server};
+use support::{binary, gravel_textures_config, shared_data_dir, Server};
 
 #[tokio::test]
 async fn tiles_decode_to_the_right_size_in_every_format() {
@@ -150,13 +150,7 @@ async fn health_ready_viewer_and_openapi() {
 #[tokio::test]
 async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = dir.path().join("textile.toml");
-    std::fs::write(
-        &cfg,
-        "[[textures]]\nid = \"plain\"\nname = \"Plain\"\nexemplar = \"embedded:gravel.png\"\n\n\
-         [[textures]]\nid = \"coherent\"\nname = \"Coherent\"\nexemplar = \"embedded:gravel.png\"\nkappa = 1.0\n",
-    )
-    .unwrap();
+    let cfg = gravel_textures_config(dir.path(), &[("plain", ""), ("coherent", "kappa = 1.0")]);
     let data = shared_data_dir();
     let s = Server::start(&["--config", cfg.to_str().unwrap()]);
     let k = |v: &serde_json::Value| v["synthesis"]["kappa"].as_f64().unwrap();

@@ -18,6 +18,20 @@ pub fn shared_data_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("textile-test-data")
 }
 
+/// Write `textile.toml` in `dir` serving the embedded gravel exemplar once per `(id, extra TOML
+/// lines)` entry; returns its path.
+pub fn gravel_textures_config(dir: &Path, textures: &[(&str, &str)]) -> PathBuf {
+    let text: String = textures
+        .iter()
+        .map(|(id, extra)| {
+            format!("[[textures]]\nid = \"{id}\"\nname = \"{id}\"\nexemplar = \"embedded:gravel.png\"\n{extra}\n\n")
+        })
+        .collect();
+    let path = dir.join("textile.toml");
+    std::fs::write(&path, text).expect("write config");
+    path
+}
+
 /// A running server process.
 pub struct Server {
     child: Child,
