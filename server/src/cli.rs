@@ -119,7 +119,7 @@ pub struct RenderArgs {
     /// Mosaic: pixel layers smoothed at block edges (0-3).
     #[arg(long)]
     pub smoothing: Option<u32>,
-    /// Randomness: one value in [0,1] or a comma list, one per level (coarse to fine).
+    /// Randomness: one value in [0, 1] or a comma list, one per level (coarse to fine).
     #[arg(long)]
     pub randomness: Option<String>,
     /// Period in native tiles (power of two): periodic, seamless output.
@@ -128,7 +128,7 @@ pub struct RenderArgs {
     /// Correction passes per level (0 switches correction off).
     #[arg(long)]
     pub passes: Option<u32>,
-    /// κ in [0,1]: penalty on jumps to the second candidate.
+    /// κ in [0, 1]: penalty on jumps to the second candidate.
     #[arg(long)]
     pub kappa: Option<String>,
     /// Output image (.png, .jpg, .webp).
