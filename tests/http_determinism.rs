@@ -36,8 +36,7 @@ async fn same_bytes_across_processes_thread_counts_and_orders() {
     let a = Server::start(&["--workers", "1"]);
     // b is also sent everything at once below; lift the queue-wait bound so that a slow machine
     // queues those requests instead of shedding some with 503.
-    let b =
-        Server::start_in(&support::shared_data_dir(), &["--workers", "2"], &[("TEXTILE_MAX_QUEUE_WAIT_MS", "600000")]);
+    let b = Server::start_queueing(&["--workers", "2"]);
     let paths: Vec<String> = [(7, 0, 0), (7, -3, 12), (6, 1, -1), (7, -(1i64 << 31), (1i64 << 31) - 1), (3, 0, 0)]
         .iter()
         .flat_map(|&(z, x, y)| {

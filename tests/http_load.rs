@@ -65,11 +65,7 @@ async fn bytes_do_not_depend_on_the_caches_or_the_order() {
     let b = Server::start(&["--cache-mib", "1", "--level-cache-mib", "1"]);
     // C sends everything at once: on a slow machine the last of those may queue longer than the
     // default 1 s queue-wait bound and be shed, so that bound is lifted for C.
-    let c = Server::start_in(
-        &support::shared_data_dir(),
-        &["--level-cache-mib", "0"],
-        &[("TEXTILE_MAX_QUEUE_WAIT_MS", "600000")],
-    );
+    let c = Server::start_queueing(&["--level-cache-mib", "0"]);
     let mut paths: Vec<String> = (0..30)
         .map(|i| {
             let mode = if i % 3 == 0 { "&mode=mosaic" } else { "" };

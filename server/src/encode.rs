@@ -94,7 +94,7 @@ fn encode_into_vec(rgb: &[u8], w: u32, h: u32, fmt: Format, effort: Effort) -> R
 /// Encode RGB8 pixels as PNG with the fixed settings of an effort: Tight is level 4 unfiltered
 /// (synthesized texture repeats exemplar texels, which deflate finds unfiltered), Quick is
 /// level 1 with the Paeth filter.
-pub fn png(rgb: &[u8], w: u32, h: u32, effort: Effort) -> Result<Vec<u8>, ImageError> {
+fn png(rgb: &[u8], w: u32, h: u32, effort: Effort) -> Result<Vec<u8>, ImageError> {
     let (level, filter) = match effort {
         Effort::Tight => (4, FilterType::NoFilter),
         Effort::Quick => (1, FilterType::Paeth),

@@ -151,9 +151,11 @@ pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress
         let file_hash = analysis.file_hash();
         let m = analysis.side();
         let rgb: Vec<u8> = analysis.exemplar.iter().flatten().copied().collect();
-        let exemplar_png = crate::encode::png(&rgb, m, m, crate::encode::Effort::Tight).map_err(|e| {
-            LoadError::Core { id: t.id.clone(), source: textile_core::CoreError::ExemplarUndecodable(e.to_string()) }
-        })?;
+        let exemplar_png = crate::encode::encode(&rgb, m, m, crate::encode::Format::Png, crate::encode::Effort::Tight)
+            .map_err(|e| LoadError::Core {
+                id: t.id.clone(),
+                source: textile_core::CoreError::ExemplarUndecodable(e.to_string()),
+            })?;
         let mut defaults = SynthParams { seed: t.default_seed, ..SynthParams::default() };
         if !t.default_randomness.is_empty() {
             defaults.randomness = Randomness::parse(&t.default_randomness).map_err(core)?;

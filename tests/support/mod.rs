@@ -50,6 +50,13 @@ impl Server {
         Self::start_in(&dir, extra, &[])
     }
 
+    /// Start with the shared data dir and extra arguments, with the queue-wait bound lifted: for
+    /// tests that send many cold tiles at once and need every one answered 200 even on a slow
+    /// machine (shedding has tests of its own).
+    pub fn start_queueing(extra: &[&str]) -> Server {
+        Self::start_in(&shared_data_dir(), extra, &[("TEXTILE_MAX_QUEUE_WAIT_MS", "600000")])
+    }
+
     /// Start with a given data dir, extra arguments and environment.
     pub fn start_in(data_dir: &Path, extra: &[&str], env: &[(&str, &str)]) -> Server {
         let mut args: Vec<std::ffi::OsString> = vec!["serve".into(), "--bind".into(), "127.0.0.1:0".into()];

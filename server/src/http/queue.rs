@@ -100,22 +100,33 @@ impl RunQueue {
 mod tests {
     use super::*;
 
-    #[tokio::test]
-    async fn short_queues_are_fifo_and_long_ones_serve_the_newest() {
-        let q = RunQueue::new(1, 2);
-        let running = q.acquire(Duration::from_secs(1)).await.expect("free thread");
+    /// Queue `n` waiters 20 ms apart (each holds its thread for `hold`); returns the order in
+    /// which they were served and their tasks.
+    async fn queue_waiters(
+        q: &Arc<RunQueue>,
+        n: usize,
+        hold: Duration,
+    ) -> (Arc<Mutex<Vec<usize>>>, Vec<tokio::task::JoinHandle<()>>) {
         let order = Arc::new(Mutex::new(Vec::new()));
         let mut tasks = Vec::new();
-        for i in 0..4 {
+        for i in 0..n {
             let (q, order) = (q.clone(), order.clone());
             tasks.push(tokio::spawn(async move {
                 let p = q.acquire(Duration::from_secs(5)).await.expect("served");
                 order.lock().unwrap().push(i);
-                tokio::time::sleep(Duration::from_millis(5)).await;
+                tokio::time::sleep(hold).await;
                 drop(p);
             }));
             tokio::time::sleep(Duration::from_millis(20)).await;
         }
+        (order, tasks)
+    }
+
+    #[tokio::test]
+    async fn short_queues_are_fifo_and_long_ones_serve_the_newest() {
+        let q = RunQueue::new(1, 2);
+        let running = q.acquire(Duration::from_secs(1)).await.expect("free thread");
+        let (order, tasks) = queue_waiters(&q, 4, Duration::from_millis(5)).await;
         assert_eq!(q.waiting(), 4);
         drop(running);
         for t in tasks {
@@ -153,17 +164,7 @@ mod tests {
         for _ in 0..3 {
             assert!(q.acquire(Duration::from_millis(5)).await.is_none());
         }
-        let order = Arc::new(Mutex::new(Vec::new()));
-        let mut tasks = Vec::new();
-        for i in 0..2 {
-            let (q, order) = (q.clone(), order.clone());
-            tasks.push(tokio::spawn(async move {
-                let p = q.acquire(Duration::from_secs(5)).await.expect("served");
-                order.lock().unwrap().push(i);
-                drop(p);
-            }));
-            tokio::time::sleep(Duration::from_millis(20)).await;
-        }
+        let (order, tasks) = queue_waiters(&q, 2, Duration::ZERO).await;
         assert_eq!(q.waiting(), 2);
         drop(running);
         for t in tasks {
