@@ -1,0 +1,140 @@
+//! Golden bytes: blake3 digests of rendered windows for every mode × zoom (native, native−1,
+//! native−3) × period (none, a world of 2 tiles) × two seeds, on two embedded exemplars.
+//!
+//! Output bytes are a permanent contract: tiles are cached for a year by clients and CDNs under
+//! ETags that include each mode's version. A failure here means a change altered the pixels of
+//! a mode. If that was not intended, it is a bug. If it was, bump that mode's `VERSION`
+//! (`core/src/modes/<mode>/mod.rs`) so ETags and cache keys change with the bytes, and replace
+//! the digests below with the table this test prints.
+
+mod common;
+
+use textile_core::{Analysis, MosaicParams, Rect, RgbWindow, SynthParams};
+
+/// Modes rendered (until modes are first-class).
+const MODE_NAMES: &[&str] = &["synth", "mosaic"];
+
+fn golden_source(name: &str) -> Analysis {
+    common::analyse(&common::embedded_exemplar(name), Default::default())
+}
+
+fn render_mode(an: &Analysis, query: &str, zoom_out: u32, rect: Rect) -> RgbWindow {
+    let q: std::collections::HashMap<&str, &str> = query.split('&').filter_map(|kv| kv.split_once('=')).collect();
+    let seed: u64 = q["seed"].parse().unwrap();
+    let period = q.get("world").map(|w| w.parse::<i64>().unwrap() * 256);
+    match q["mode"] {
+        "synth" => {
+            textile_core::render(an, &SynthParams { seed, period, ..Default::default() }, zoom_out, rect).unwrap()
+        }
+        _ => textile_core::mosaic::render(an, &MosaicParams { seed, period, ..Default::default() }, zoom_out, rect)
+            .unwrap(),
+    }
+}
+
+/// A 96×64 window straddling tile borders, away from the origin.
+const WINDOW: Rect = Rect { x0: -40, y0: 1000, x1: 56, y1: 1064 };
+
+/// `(exemplar, mode, seed, zoom_out, world, digest)`.
+#[rustfmt::skip]
+const GOLDEN: &[(&str, &str, u64, u32, u32, &str)] = &[
+    ("gravel.png", "synth", 0, 0, 0, "2803c90d05400ed3"),
+    ("gravel.png", "synth", 0, 0, 2, "db9ed6e41e7c970b"),
+    ("gravel.png", "synth", 0, 1, 0, "e79c4724630626cb"),
+    ("gravel.png", "synth", 0, 1, 2, "0670e4087d1ed321"),
+    ("gravel.png", "synth", 0, 3, 0, "7177c7f01e02ec8c"),
+    ("gravel.png", "synth", 0, 3, 2, "79a179a441f2768e"),
+    ("gravel.png", "synth", 7, 0, 0, "89fee1b3034f599e"),
+    ("gravel.png", "synth", 7, 0, 2, "eff5ccb176ba2e10"),
+    ("gravel.png", "synth", 7, 1, 0, "134187eabeab5006"),
+    ("gravel.png", "synth", 7, 1, 2, "c33230dc1b7a2608"),
+    ("gravel.png", "synth", 7, 3, 0, "2dfbf83a7d425735"),
+    ("gravel.png", "synth", 7, 3, 2, "76e82945fd733f00"),
+    ("gravel.png", "mosaic", 0, 0, 0, "2743d1b55860d4a4"),
+    ("gravel.png", "mosaic", 0, 0, 2, "d89082bbba093829"),
+    ("gravel.png", "mosaic", 0, 1, 0, "cc712d63eaa3c2ea"),
+    ("gravel.png", "mosaic", 0, 1, 2, "68a11959e32c5a37"),
+    ("gravel.png", "mosaic", 0, 3, 0, "5d24cc0362a853e1"),
+    ("gravel.png", "mosaic", 0, 3, 2, "67aeb348ed6061da"),
+    ("gravel.png", "mosaic", 7, 0, 0, "9c25469cceeb77c5"),
+    ("gravel.png", "mosaic", 7, 0, 2, "ec305c14a9c72b1f"),
+    ("gravel.png", "mosaic", 7, 1, 0, "5faef2237b27fe1e"),
+    ("gravel.png", "mosaic", 7, 1, 2, "9281f85938c27973"),
+    ("gravel.png", "mosaic", 7, 3, 0, "42a05aa8a7874b63"),
+    ("gravel.png", "mosaic", 7, 3, 2, "20409635046c5bba"),
+    ("brick.png", "synth", 0, 0, 0, "b9094eae5d99dcc9"),
+    ("brick.png", "synth", 0, 0, 2, "05d2213ec69e1b48"),
+    ("brick.png", "synth", 0, 1, 0, "59397d5ffce6def3"),
+    ("brick.png", "synth", 0, 1, 2, "57a51062c805fcc8"),
+    ("brick.png", "synth", 0, 3, 0, "f8f6e5033b52750d"),
+    ("brick.png", "synth", 0, 3, 2, "bc1875f88d760ad1"),
+    ("brick.png", "synth", 7, 0, 0, "46eb7fda6970bc8e"),
+    ("brick.png", "synth", 7, 0, 2, "e1aa2f4bbb81efb9"),
+    ("brick.png", "synth", 7, 1, 0, "2c372e25b94a55a5"),
+    ("brick.png", "synth", 7, 1, 2, "937a26cecf8f679b"),
+    ("brick.png", "synth", 7, 3, 0, "78812f97b4431039"),
+    ("brick.png", "synth", 7, 3, 2, "29904232f3065c88"),
+    ("brick.png", "mosaic", 0, 0, 0, "ea46e408fbe07e44"),
+    ("brick.png", "mosaic", 0, 0, 2, "05750d5d6d1dd25c"),
+    ("brick.png", "mosaic", 0, 1, 0, "5d0ee74263fcaf0e"),
+    ("brick.png", "mosaic", 0, 1, 2, "ffb580d2a8e9d023"),
+    ("brick.png", "mosaic", 0, 3, 0, "38ad8db99a83c819"),
+    ("brick.png", "mosaic", 0, 3, 2, "9cdcb449d90f91f9"),
+    ("brick.png", "mosaic", 7, 0, 0, "e266cdfa948c5303"),
+    ("brick.png", "mosaic", 7, 0, 2, "efe5625eb4434ac8"),
+    ("brick.png", "mosaic", 7, 1, 0, "70463c0a83d56fa0"),
+    ("brick.png", "mosaic", 7, 1, 2, "49f0f066874367af"),
+    ("brick.png", "mosaic", 7, 3, 0, "6b8e17f8e567e659"),
+    ("brick.png", "mosaic", 7, 3, 2, "f82d33525e35bac0"),
+];
+
+fn table() -> Vec<(&'static str, &'static str, u64, u32, u32, String)> {
+    let mut out = Vec::new();
+    for exemplar in ["gravel.png", "brick.png"] {
+        let src = golden_source(exemplar);
+        for mode in MODE_NAMES {
+            for seed in [0u64, 7] {
+                for zoom_out in [0u32, 1, 3] {
+                    for world in [0u32, 2] {
+                        let query = format!(
+                            "mode={mode}&seed={seed}{}",
+                            if world > 0 { format!("&world={world}") } else { String::new() }
+                        );
+                        let img = render_mode(&src, &query, zoom_out, WINDOW);
+                        let digest = blake3::hash(&img.pixels).to_hex()[..16].to_string();
+                        out.push((exemplar, *mode, seed, zoom_out, world, digest));
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn rendered_bytes_match_the_pinned_digests() {
+    let got = table();
+    let printed: String =
+        got.iter().map(|(e, m, s, z, w, d)| format!("    ({e:?}, {m:?}, {s}, {z}, {w}, {d:?}),\n")).collect();
+    let mut changed = Vec::new();
+    for row in &got {
+        let pinned = GOLDEN.iter().find(|g| (g.0, g.1, g.2, g.3, g.4) == (row.0, row.1, row.2, row.3, row.4));
+        match pinned {
+            Some(g) if g.5 == row.5 => {}
+            Some(g) => changed.push(format!(
+                "{} {} seed {} zoom-out {} world {}: pinned {}, got {}",
+                row.0, row.1, row.2, row.3, row.4, g.5, row.5
+            )),
+            None => changed.push(format!(
+                "{} {} seed {} zoom-out {} world {}: not pinned (got {})",
+                row.0, row.1, row.2, row.3, row.4, row.5
+            )),
+        }
+    }
+    assert!(
+        changed.is_empty(),
+        "rendered bytes changed:\n  {}\n\nIf this was not intended, it is a bug. If it was: bump the VERSION of each mode \
+         whose bytes changed (core/src/modes/<mode>/mod.rs) and replace GOLDEN in core/tests/golden.rs with:\n{printed}",
+        changed.join("\n  ")
+    );
+    assert_eq!(got.len(), GOLDEN.len(), "GOLDEN has rows for modes or cases that no longer exist:\n{printed}");
+}
