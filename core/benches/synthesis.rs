@@ -9,7 +9,9 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use textile_core::{render, Analysis, Exemplar, ExemplarOptions, MosaicParams, NoProgress, Rect, SynthParams};
+use textile_core::modes::mosaic::MosaicParams;
+use textile_core::modes::synth::{render, SynthParams};
+use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress, Rect};
 
 fn exemplar(side: u32) -> Exemplar {
     // The 256² gravel of the development set, area-resampled to the side wanted.
@@ -62,7 +64,7 @@ fn windows(c: &mut Criterion) {
 }
 
 fn mosaic(c: &mut Criterion) {
-    let an = Analysis::build(&exemplar(128), &NoProgress);
+    let ex = exemplar(128);
     let p = MosaicParams::default();
     let mut g = c.benchmark_group("mosaic");
     g.sample_size(100).measurement_time(Duration::from_secs(5));
@@ -71,7 +73,7 @@ fn mosaic(c: &mut Criterion) {
         g.bench_function(format!("window_{side}"), |b| {
             b.iter(|| {
                 i += 1;
-                textile_core::mosaic::render(&an, &p, 0, Rect::new(side * i, -side * i, side, side)).unwrap()
+                textile_core::modes::mosaic::render(&ex, &p, 0, Rect::new(side * i, -side * i, side, side)).unwrap()
             })
         });
     }

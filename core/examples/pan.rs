@@ -2,8 +2,7 @@
 //! pyramidal cache, and timings.
 //! `cargo run --release -p textile-core --example pan -- EXEMPLAR [COLS ROWS CACHE_MIB]`
 use std::time::Instant;
-use textile_core::pyramid::Pyramid;
-use textile_core::synth::synthesize_with;
+use textile_core::modes::synth::{self as synth, synthesize_with, SynthParams};
 use textile_core::*;
 
 fn main() {

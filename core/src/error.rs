@@ -46,6 +46,29 @@ pub enum CoreError {
         /// What was wrong and what is allowed.
         message: String,
     },
+    /// A parameter key is misplaced: repeated, of another mode, or a texture setting given in a
+    /// request.
+    #[error("parameter '{key}' {message}")]
+    ParamKey {
+        /// The key as given.
+        key: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A parameter key that no mode knows.
+    #[error("unknown parameter '{key}'; allowed: {allowed}")]
+    UnknownParam {
+        /// The key as given.
+        key: String,
+        /// The keys that would have been read.
+        allowed: String,
+    },
+    /// The mode needs the texture's analysis, which is not available (yet).
+    #[error("mode={mode} needs the texture's analysis, which is not ready")]
+    NotAnalysed {
+        /// The mode asked for.
+        mode: &'static str,
+    },
     /// A requested window is empty or too large.
     #[error("window {width}x{height} is not allowed: {message}")]
     Window {

@@ -25,15 +25,20 @@ pub fn analyse(path: &PathBuf, opts: ExemplarOptions) -> Analysis {
     Analysis::build(&ex, &NoProgress)
 }
 
-/// A 64×64 crop-free analysis of the gravel exemplar (non-toroidal, m = 64 after resampling).
-pub fn small() -> &'static Analysis {
-    static A: OnceLock<Analysis> = OnceLock::new();
-    A.get_or_init(|| {
+/// A 64×64 crop of the gravel exemplar (non-toroidal).
+pub fn small_exemplar() -> &'static Exemplar {
+    static E: OnceLock<Exemplar> = OnceLock::new();
+    E.get_or_init(|| {
         let bytes = std::fs::read(embedded_exemplar("gravel.png")).expect("read gravel");
         let img = image::load_from_memory(&bytes).expect("decode").to_rgba8();
         let small = image::imageops::crop_imm(&img, 0, 0, 64, 64).to_image();
         let px: Vec<[u8; 4]> = small.pixels().map(|p| p.0).collect();
-        let ex = Exemplar::from_rgba(64, 64, &px, &ExemplarOptions::default());
-        Analysis::build(&ex, &NoProgress)
+        Exemplar::from_rgba(64, 64, &px, &ExemplarOptions::default())
     })
+}
+
+/// The analysis of [`small_exemplar`].
+pub fn small() -> &'static Analysis {
+    static A: OnceLock<Analysis> = OnceLock::new();
+    A.get_or_init(|| Analysis::build(small_exemplar(), &NoProgress))
 }

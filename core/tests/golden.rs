@@ -9,26 +9,24 @@
 
 mod common;
 
-use textile_core::{Analysis, MosaicParams, Rect, RgbWindow, SynthParams};
+use textile_core::{
+    Analysis, Defaults, Exemplar, ExemplarOptions, NoProgress, ParamReader, Pyramid, Rect, RgbWindow, Source, View,
+    MODE_NAMES,
+};
 
-/// Modes rendered (until modes are first-class).
-const MODE_NAMES: &[&str] = &["synth", "mosaic"];
-
-fn golden_source(name: &str) -> Analysis {
-    common::analyse(&common::embedded_exemplar(name), Default::default())
+fn golden_source(name: &str) -> (Exemplar, Analysis) {
+    let bytes = std::fs::read(common::embedded_exemplar(name)).expect("read exemplar");
+    let ex = Exemplar::from_bytes(&bytes, &ExemplarOptions::default()).expect("decode exemplar");
+    let an = Analysis::build(&ex, &NoProgress);
+    (ex, an)
 }
 
-fn render_mode(an: &Analysis, query: &str, zoom_out: u32, rect: Rect) -> RgbWindow {
-    let q: std::collections::HashMap<&str, &str> = query.split('&').filter_map(|kv| kv.split_once('=')).collect();
-    let seed: u64 = q["seed"].parse().unwrap();
-    let period = q.get("world").map(|w| w.parse::<i64>().unwrap() * 256);
-    match q["mode"] {
-        "synth" => {
-            textile_core::render(an, &SynthParams { seed, period, ..Default::default() }, zoom_out, rect).unwrap()
-        }
-        _ => textile_core::mosaic::render(an, &MosaicParams { seed, period, ..Default::default() }, zoom_out, rect)
-            .unwrap(),
-    }
+/// Render through the same path as a request: the query read over the built-in defaults.
+fn render_mode((ex, an): &(Exemplar, Analysis), query: &str, zoom_out: u32, rect: Rect) -> RgbWindow {
+    let src = Source::new(ex, an);
+    let pairs = query.split('&').filter_map(|kv| kv.split_once('='));
+    let params = Defaults::builtin(&src).request(&src, ParamReader::request(pairs).unwrap()).unwrap();
+    params.render(&src, &Pyramid::off(), View { zoom_out, rect }).unwrap().image
 }
 
 /// A 96×64 window straddling tile borders, away from the origin.

@@ -4,16 +4,16 @@
 mod common;
 
 use proptest::prelude::*;
-use textile_core::mosaic::render;
-use textile_core::{MosaicParams, Rect, RgbWindow};
+use textile_core::modes::mosaic::{render, MosaicParams};
+use textile_core::{Exemplar, Rect, RgbWindow};
 
-fn stitch(an: &textile_core::Analysis, p: &MosaicParams, k: u32, whole: Rect, sx: i64, sy: i64) -> Vec<u8> {
+fn stitch(ex: &Exemplar, p: &MosaicParams, k: u32, whole: Rect, sx: i64, sy: i64) -> Vec<u8> {
     let w = whole.width() as usize;
     let mut out = vec![0u8; 3 * whole.area() as usize];
     for (y0, y1) in [(whole.y0, whole.y0 + sy), (whole.y0 + sy, whole.y1)] {
         for (x0, x1) in [(whole.x0, whole.x0 + sx), (whole.x0 + sx, whole.x1)] {
             let r = Rect { x0, y0, x1, y1 };
-            let part = render(an, p, k, r).unwrap();
+            let part = render(ex, p, k, r).unwrap();
             for j in 0..r.height() as usize {
                 for i in 0..r.width() as usize {
                     let d = 3 * ((y0 - whole.y0) as usize * w + j * w + (x0 - whole.x0) as usize + i);
@@ -37,23 +37,23 @@ proptest! {
         k in prop::sample::select(vec![0u32, 0, 1, 2, 4, 6]), seed in any::<u64>(), it in 0u32..12,
         world in prop::sample::select(vec![None, Some(256i64), Some(4096)]),
     ) {
-        let an = common::small();
+        let ex = common::small_exemplar();
         let p = MosaicParams { seed, iterations: it, period: world, ..MosaicParams::default() };
         let (w, h) = if (1..=3).contains(&k) { (w.min(100), h.min(100)) } else { (w, h) };
         let whole = Rect::new((far >> k) + dx, (far >> k) + dy, w, h);
         let sx = ((w as f64 * fx) as i64).clamp(1, w - 1);
         let sy = ((h as f64 * fy) as i64).clamp(1, h - 1);
-        let full = render(an, &p, k, whole).unwrap();
-        prop_assert_eq!(full.pixels, stitch(an, &p, k, whole, sx, sy));
+        let full = render(ex, &p, k, whole).unwrap();
+        prop_assert_eq!(full.pixels, stitch(ex, &p, k, whole, sx, sy));
     }
 }
 
-fn tiled(an: &textile_core::Analysis, r: Rect) -> Vec<u8> {
-    let m = an.side() as i64;
+fn tiled(ex: &Exemplar, r: Rect) -> Vec<u8> {
+    let m = ex.side as i64;
     let mut v = Vec::new();
     for y in r.y0..r.y1 {
         for x in r.x0..r.x1 {
-            v.extend_from_slice(&an.exemplar[(y.rem_euclid(m) * m + x.rem_euclid(m)) as usize]);
+            v.extend_from_slice(&ex.pixels[(y.rem_euclid(m) * m + x.rem_euclid(m)) as usize]);
         }
     }
     v
@@ -61,37 +61,37 @@ fn tiled(an: &textile_core::Analysis, r: Rect) -> Vec<u8> {
 
 #[test]
 fn zero_iterations_without_smoothing_is_the_tiling() {
-    let an = common::small();
+    let ex = common::small_exemplar();
     let p = MosaicParams { iterations: 0, smoothing: 0, ..MosaicParams::default() };
     for r in [Rect::new(0, 0, 200, 150), Rect::new(-(1 << 30) - 7, 99, 130, 70)] {
-        assert_eq!(render(an, &p, 0, r).unwrap().pixels, tiled(an, r));
+        assert_eq!(render(ex, &p, 0, r).unwrap().pixels, tiled(ex, r));
     }
     // With iterations the blocks move: not the tiling.
     let moved = MosaicParams { smoothing: 0, ..MosaicParams::default() };
     let r = Rect::new(0, 0, 256, 256);
-    assert_ne!(render(an, &moved, 0, r).unwrap().pixels, tiled(an, r));
+    assert_ne!(render(ex, &moved, 0, r).unwrap().pixels, tiled(ex, r));
 }
 
 #[test]
 fn seeds_change_the_texture_and_periods_repeat() {
-    let an = common::small();
+    let ex = common::small_exemplar();
     let r = Rect::new(-100, 40, 160, 120);
-    let a = render(an, &MosaicParams { seed: 1, ..MosaicParams::default() }, 0, r).unwrap();
-    let b = render(an, &MosaicParams { seed: 2, ..MosaicParams::default() }, 0, r).unwrap();
+    let a = render(ex, &MosaicParams { seed: 1, ..MosaicParams::default() }, 0, r).unwrap();
+    let b = render(ex, &MosaicParams { seed: 2, ..MosaicParams::default() }, 0, r).unwrap();
     assert_ne!(a, b);
     for period in [256i64, 1024, 8192] {
         let p = MosaicParams { seed: 5, period: Some(period), ..MosaicParams::default() };
-        let base: RgbWindow = render(an, &p, 0, r).unwrap();
+        let base: RgbWindow = render(ex, &p, 0, r).unwrap();
         for (i, j) in [(1, 0), (0, -1), (3, 7)] {
             let moved = Rect::new(r.x0 + i * period, r.y0 + j * period, r.width(), r.height());
-            assert_eq!(render(an, &p, 0, moved).unwrap(), base, "period {period} shift ({i},{j})");
+            assert_eq!(render(ex, &p, 0, moved).unwrap(), base, "period {period} shift ({i},{j})");
         }
     }
 }
 
 #[test]
 fn invalid_parameters_are_refused() {
-    let an = common::small();
+    let ex = common::small_exemplar();
     let r = Rect::new(0, 0, 8, 8);
     for p in [
         MosaicParams { iterations: 65, ..MosaicParams::default() },
@@ -101,6 +101,6 @@ fn invalid_parameters_are_refused() {
         MosaicParams { period: Some(48), ..MosaicParams::default() },
         MosaicParams { period: Some(32), ..MosaicParams::default() },
     ] {
-        assert!(matches!(render(an, &p, 0, r), Err(textile_core::CoreError::Param { .. })), "{p:?}");
+        assert!(matches!(render(ex, &p, 0, r), Err(textile_core::CoreError::Param { .. })), "{p:?}");
     }
 }

@@ -5,9 +5,10 @@
 mod common;
 
 use proptest::prelude::*;
-use textile_core::pyramid::Pyramid;
-use textile_core::synth::{synthesis_cost, synthesize_with};
-use textile_core::{render_with, synthesize, Rect, SynthParams};
+use textile_core::modes::synth::{render_with, synthesize, SynthParams};
+use textile_core::modes::synth::{synthesis_cost, synthesize_with};
+use textile_core::Pyramid;
+use textile_core::Rect;
 
 fn windows() -> impl Strategy<Value = Vec<(u32, Rect)>> {
     let one = (3u32..=6, -200i64..200, -200i64..200, 1i64..90, 1i64..90)
@@ -75,7 +76,7 @@ fn a_repeated_window_computes_nothing_and_a_pan_shares_its_padding() {
     // Zooming out reuses the coarser levels the sweep computed.
     let zoomed = render_with(&pyr, an, &p, 1, Rect::new(0, 0, 3 * 32, 2 * 32)).unwrap();
     assert_eq!(zoomed.synthesized, 0);
-    assert_eq!(zoomed.image, textile_core::render(an, &p, 1, Rect::new(0, 0, 96, 64)).unwrap());
+    assert_eq!(zoomed.image, textile_core::modes::synth::render(an, &p, 1, Rect::new(0, 0, 96, 64)).unwrap());
 }
 
 #[test]

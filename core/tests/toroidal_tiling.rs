@@ -3,7 +3,8 @@
 
 mod common;
 
-use textile_core::{render, ExemplarOptions, Randomness, Rect, SynthParams};
+use textile_core::modes::synth::{render, Randomness, SynthParams};
+use textile_core::{ExemplarOptions, Rect};
 
 #[test]
 fn zero_randomness_on_toroidal_exemplars_is_exact_tiling() {

@@ -5,7 +5,8 @@
 mod common;
 
 use proptest::prelude::*;
-use textile_core::{render, synthesize, Analysis, Randomness, Rect, SynthParams};
+use textile_core::modes::synth::{render, synthesize, Randomness, SynthParams};
+use textile_core::{Analysis, Rect};
 
 fn stitched(an: &Analysis, p: &SynthParams, level: u32, whole: Rect, sx: i64, sy: i64) -> Vec<u32> {
     // Four parts split at (sx, sy) (relative to the window origin), synthesized separately.

@@ -6,10 +6,10 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use crate::generations::{class_cols, class_origin};
+use super::generations::{class_cols, class_origin};
 use crate::geom::Rect;
-use crate::plan::Class;
-use crate::pyramid::{Block, BlockGrid, Pyramid, BLOCK};
+use super::plan::Class;
+use crate::cache::{Block, BlockGrid, Pyramid, BLOCK};
 
 /// Index of pixel `(x, y)` in the generation-`k ≥ 1` array of its block.
 #[inline]

@@ -3,7 +3,7 @@
 //! subpasses with k-coherence candidates. Output: exemplar coordinates of any rectangle at any
 //! level, bit-identical to the same pixels cut from any larger window.
 //!
-//! Per level, the work is shared through the [`crate::pyramid`] cache: `generations`
+//! Per level, the work is shared through the [`crate::cache`] cache: `generations`
 //! says which generation of which pixel is still needed, `history` lays cached blocks over the
 //! buffer and gathers what this call computes, and `kernel` corrects one pixel.
 
@@ -11,15 +11,17 @@ use rayon::prelude::*;
 
 use crate::analysis::{Analysis, CorrectionLevel};
 use crate::error::{CoreError, Result};
-use crate::features::TAPS5;
-use crate::generations::{class_cols, class_layout, needed_generations};
+use crate::analysis::features::TAPS5;
+use super::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash, TAG_JITTER};
-use crate::history::{block_index, capture, for_rows, overlay, pending};
-use crate::kernel::{projection_pairs, Kernel};
-use crate::params::SynthParams;
-use crate::plan::{pad_for_correction, plan_window, schedule, Class};
-use crate::pyramid::{Block, BlockGrid, BlockKey, Pyramid, StreamId, BLOCK};
+use super::history::{block_index, capture, for_rows, overlay, pending};
+use super::kernel::{projection_pairs, Kernel};
+use super::params::SynthParams;
+use super::Synth;
+use crate::modes::Mode;
+use super::plan::{pad_for_correction, plan_window, schedule, Class};
+use crate::cache::{Block, BlockGrid, BlockKey, Pyramid, StreamId, BLOCK};
 
 /// Largest number of pixels synthesized at the finest requested level in one call (2^26).
 pub const MAX_WINDOW_PIXELS: i64 = 1 << 26;
@@ -88,7 +90,7 @@ pub fn synthesize_with(
     level: u32,
     rect: Rect,
 ) -> Result<Synthesized> {
-    params.validate_for(an)?;
+    params.validate(an.side())?;
     if level > an.levels() {
         return Err(CoreError::Param { name: "level", message: format!("must be 0 to {}", an.levels()) });
     }
@@ -131,7 +133,7 @@ impl<'a> Ctx<'a> {
         Ctx {
             an,
             pyr,
-            stream: StreamId::new(an, p),
+            stream: StreamId::new(&format!("{}|v{}|{}|{}", Synth::NAME, Synth::VERSION, an.header.id, p.canonical())),
             sched: schedule(p.passes, p.subpasses),
             seed: p.seed,
             r: p.randomness.resolve(an.levels()),

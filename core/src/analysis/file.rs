@@ -7,9 +7,9 @@ use std::fs;
 use std::io::Write;
 use std::path::Path;
 
+use crate::analysis::features::{RUNTIME_DIMS, TAPS5};
 use crate::analysis::{Analysis, AnalysisHeader, Candidate, CorrectionLevel, FIRST_CORRECTED_LEVEL};
 use crate::error::{AnalysisFileProblem, CoreError, Result};
-use crate::features::{RUNTIME_DIMS, TAPS5};
 
 /// First bytes of every analysis file.
 pub const MAGIC: &[u8; 8] = b"TXTLANA\0";

@@ -1,15 +1,11 @@
 //! Validated synthesis parameters (design note §1.9–1.10). Everything is parsed once into
 //! canonical fixed point, so "0.5" and "0.50" are the same request, and the engine trusts it.
 
-use crate::analysis::Analysis;
 use crate::error::{CoreError, Result};
+use crate::modes::params::{check_period, parse_unit, ONE_Q16};
 
-/// Fixed-point one for randomness and κ (2^16).
-pub const ONE_Q16: u32 = 1 << 16;
 /// Largest number of correction passes accepted.
 pub const MAX_PASSES: u32 = 4;
-/// Largest period accepted, in texels (2^40).
-pub const MAX_PERIOD: i64 = 1 << 40;
 
 /// Per-level randomness: one value for every level, or an explicit list (coarse to fine).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -38,18 +34,6 @@ pub fn default_randomness(levels: u32) -> Vec<u32> {
             (r * ONE_Q16 as f64).round() as u32
         })
         .collect()
-}
-
-/// Parse one randomness value in `[0, 1]` to fixed point.
-fn parse_unit(name: &'static str, s: &str) -> Result<u32> {
-    let v: f64 = s.trim().parse().map_err(|_| CoreError::Param {
-        name,
-        message: format!("'{s}' is not a number; expected a value in [0, 1]"),
-    })?;
-    if !v.is_finite() || !(0.0..=1.0).contains(&v) {
-        return Err(CoreError::Param { name, message: format!("{s} is outside [0, 1]") });
-    }
-    Ok((v * ONE_Q16 as f64).round() as u32)
 }
 
 impl Randomness {
@@ -112,14 +96,9 @@ impl Default for SynthParams {
 }
 
 impl SynthParams {
-    /// Parse κ from text (`[0, 1]`).
-    pub fn parse_kappa(s: &str) -> Result<u32> {
-        parse_unit("kappa", s)
-    }
-
-    /// Check the parameters against an analysis (list length, period, ranges).
-    pub fn validate_for(&self, an: &Analysis) -> Result<()> {
-        let levels = an.levels();
+    /// Check the parameters for an exemplar of side `side` (list length, period, ranges).
+    pub fn validate(&self, side: u32) -> Result<()> {
+        let levels = side.trailing_zeros();
         if let Randomness::PerLevel(v) = &self.randomness {
             if v.len() != levels as usize + 1 {
                 return Err(CoreError::Param {
@@ -145,15 +124,7 @@ impl SynthParams {
         if !in_unit(self.kappa) {
             return Err(CoreError::Param { name: "kappa", message: "must be in [0, 1]".into() });
         }
-        if let Some(n) = self.period {
-            let m = an.side() as i64;
-            if n < m || n > MAX_PERIOD || n.count_ones() != 1 {
-                return Err(CoreError::Param {
-                    name: "period",
-                    message: format!("must be a power of two from {m} (the exemplar side) to 2^40 texels, got {n}"),
-                });
-            }
-        }
+        check_period(self.period, side)?;
         Ok(())
     }
 

@@ -5,7 +5,7 @@
 //!
 //! Every pixel's value at a generation is a function of the previous generation's values around
 //! it only (design note §1.5), so a value from the cache is the value a cold synthesis computes:
-//! what is cached changes the work done, never the result. [`crate::synth`] asks for the blocks
+//! what is cached changes the work done, never the result. [`crate::modes::synth::window`] asks for the blocks
 //! a window's plan touches, computes only the pixels no block holds (and what those need), and
 //! offers back every block it now knows completely.
 
@@ -14,9 +14,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use lru::LruCache;
 
-use crate::analysis::{Analysis, ALGORITHM_VERSION};
 use crate::geom::Rect;
-use crate::params::SynthParams;
 
 /// Side of a cached block in pixels of its level. Even, so that parity classes line up with
 /// block origins.
@@ -31,10 +29,10 @@ const BLOCK_OVERHEAD: u64 = 96;
 pub struct StreamId([u8; 16]);
 
 impl StreamId {
-    /// The stream of `an` synthesized with `p`.
-    pub fn new(an: &Analysis, p: &SynthParams) -> Self {
-        let text = format!("{ALGORITHM_VERSION}|{}|{}", an.header.id, p.canonical());
-        let h = blake3::hash(text.as_bytes());
+    /// The stream named by `identity`: everything that determines its pixels (mode, mode
+    /// version, analysis id, canonical parameters).
+    pub fn new(identity: &str) -> Self {
+        let h = blake3::hash(identity.as_bytes());
         let mut id = [0u8; 16];
         id.copy_from_slice(&h.as_bytes()[..16]);
         StreamId(id)

@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, SymmetricEigen};
 
-use crate::stack::addr;
+use crate::analysis::stack::addr;
 
 /// Dimensions of the runtime (correction) feature vectors.
 pub const RUNTIME_DIMS: usize = 8;

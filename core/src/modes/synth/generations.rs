@@ -5,7 +5,7 @@
 //! dilation around what must be computed otherwise — with each subpass's bounding box.
 
 use crate::geom::Rect;
-use crate::plan::{correction_cone, Class};
+use super::plan::{correction_cone, Class};
 
 /// Where a subpass class lies in a rectangle: its first row and first column (relative to the
 /// rectangle) and the step between its rows and between its columns.
@@ -167,7 +167,7 @@ fn cone_generations(ext: Rect, need: Rect, gens: &[Class]) -> (Vec<i8>, Vec<Rect
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::{pad_for_correction, schedule};
+    use crate::modes::synth::plan::{pad_for_correction, schedule};
 
     /// With nothing cached, the plan's cone (filled by rows) and the pixel-by-pixel dilation
     /// agree on every pixel's needed generation and every subpass's box.

@@ -1,15 +1,21 @@
 //! The exemplar analysis (design note §1.2): everything synthesis needs, computed once per
 //! texture — the Gaussian stack, per-level runtime projections and the k = 2 candidate sets with
-//! their features stored next to them. See [`crate::analysis_file`] for how it is stored.
+//! their features stored next to them. See [`crate::analysis::file`] for how it is stored.
+
+pub mod candidates;
+pub mod features;
+pub mod file;
+pub mod kdtree;
+pub mod stack;
 
 use serde::{Deserialize, Serialize};
 
-use crate::candidates::{candidate_sets, CandidateRules};
-use crate::exemplar::{Exemplar, Preparation};
-use crate::features::{
+use crate::analysis::candidates::{candidate_sets, CandidateRules};
+use crate::analysis::features::{
     principal_directions, project_runtime, project_search, quantise_projection, LevelColours, RUNTIME_DIMS, SEARCH_DIMS,
 };
-use crate::stack::{build_stack, to_u8};
+use crate::analysis::stack::{build_stack, to_u8};
+use crate::exemplar::{Exemplar, Preparation};
 
 /// Version of the synthesis algorithm (hash, tags, filters, schedules). Part of every ETag:
 /// bump it whenever any output pixel could change.

@@ -4,44 +4,17 @@
 //! the pyramid the view is the exemplar's mean colour.
 
 use crate::analysis::Analysis;
+use crate::image::{Rendered, RgbWindow};
 use crate::error::Result;
 use crate::geom::Rect;
-use crate::params::SynthParams;
-use crate::pyramid::Pyramid;
-use crate::synth::synthesize_with;
-
-/// An RGB8 image of a window.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct RgbWindow {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Row-major RGB bytes (`3·width·height`).
-    pub pixels: Vec<u8>,
-}
-
-impl RgbWindow {
-    /// The pixel at `(x, y)`.
-    pub fn pixel(&self, x: u32, y: u32) -> [u8; 3] {
-        let i = 3 * (y as usize * self.width as usize + x as usize);
-        [self.pixels[i], self.pixels[i + 1], self.pixels[i + 2]]
-    }
-}
+use super::params::SynthParams;
+use crate::cache::Pyramid;
+use super::window::synthesize_with;
 
 /// Render `rect` of the texture viewed `zoom_out` steps coarser than native (0 = native: one
 /// pixel per exemplar texel; `k`: one pixel covers `2^k × 2^k` texels).
 pub fn render(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
     render_with(&Pyramid::off(), an, params, zoom_out, rect).map(|r| r.image)
-}
-
-/// A rendered window and the work it took.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Rendered {
-    /// The image.
-    pub image: RgbWindow,
-    /// Pixels synthesized at all levels for it (see [`crate::synth::Synthesized`]).
-    pub synthesized: u64,
 }
 
 /// [`render`] through a pyramidal cache (same pixels, shared work).
@@ -79,7 +52,7 @@ pub fn render_with(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out:
             }
         }
     } else {
-        params.validate_for(an)?;
+        params.validate(an.side())?;
         let mean = an.mean_colour();
         for _ in 0..w * h {
             pixels.extend_from_slice(&mean);

@@ -4,8 +4,8 @@
 
 use rayon::prelude::*;
 
-use crate::features::SEARCH_DIMS;
-use crate::kdtree::KdTree;
+use crate::analysis::features::SEARCH_DIMS;
+use crate::analysis::kdtree::KdTree;
 
 /// Geometry of one level's candidate problem.
 pub struct CandidateRules {

@@ -5,7 +5,7 @@
 //! both give identical results.
 
 use crate::analysis::Candidate;
-use crate::features::{FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
+use crate::analysis::features::{FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
 
 /// The correction kernel of one level: everything a pixel's correction reads besides the
 /// snapshot buffers.
@@ -190,8 +190,8 @@ mod tests {
     use std::sync::atomic::{AtomicBool, Ordering};
 
     use crate::geom::Rect;
-    use crate::params::SynthParams;
-    use crate::synth::synthesize;
+    use crate::modes::synth::params::SynthParams;
+    use crate::modes::synth::window::synthesize;
     use crate::{Analysis, Exemplar, ExemplarOptions, NoProgress};
 
     static FORCE_PORTABLE: AtomicBool = AtomicBool::new(false);

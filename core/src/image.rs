@@ -1,0 +1,70 @@
+//! Images as the modes produce them: an RGB8 window, what rendering it cost, and the exact box
+//! filter that zoomed-out views of cheap modes are made with.
+
+/// An RGB8 image of a window.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RgbWindow {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major RGB bytes (`3·width·height`).
+    pub pixels: Vec<u8>,
+}
+
+impl RgbWindow {
+    /// The pixel at `(x, y)`.
+    pub fn pixel(&self, x: u32, y: u32) -> [u8; 3] {
+        let i = 3 * (y as usize * self.width as usize + x as usize);
+        [self.pixels[i], self.pixels[i + 1], self.pixels[i + 2]]
+    }
+
+    /// An image of `side × side` pixels from row-major RGB texels.
+    pub fn from_texels(side: u32, texels: &[[u8; 3]]) -> Self {
+        RgbWindow { width: side, height: side, pixels: texels.iter().flatten().copied().collect() }
+    }
+
+    /// The exact box average over `f × f` blocks (rounded to nearest); width and height must be
+    /// multiples of `f`.
+    pub fn box_down(&self, f: usize) -> RgbWindow {
+        let (w, h) = (self.width as usize / f, self.height as usize / f);
+        let iw = self.width as usize;
+        let area = (f * f) as u32;
+        let mut pixels = Vec::with_capacity(3 * w * h);
+        for j in 0..h {
+            for i in 0..w {
+                let mut s = [0u32; 3];
+                for y in j * f..(j + 1) * f {
+                    let row = &self.pixels[3 * (y * iw + i * f)..3 * (y * iw + (i + 1) * f)];
+                    for px in row.chunks_exact(3) {
+                        for (acc, &v) in s.iter_mut().zip(px) {
+                            *acc += v as u32;
+                        }
+                    }
+                }
+                pixels.extend(s.map(|v| ((v + area / 2) / area) as u8));
+            }
+        }
+        RgbWindow { width: w as u32, height: h as u32, pixels }
+    }
+
+    /// The texels of this image, row-major.
+    pub fn texels(&self) -> Vec<[u8; 3]> {
+        self.pixels.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+    }
+}
+
+/// A rendered window and the work it took.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rendered {
+    /// The image.
+    pub image: RgbWindow,
+    /// Pixels computed for it at all levels (padding included; what a cache supplied is not
+    /// counted): the numerator of the computation ratio.
+    pub synthesized: u64,
+}
+
+/// An `n × n` exemplar box-filtered `lvl` times (side `n >> lvl`).
+pub fn box_mip(texels: &[[u8; 3]], n: usize, lvl: usize) -> Vec<[u8; 3]> {
+    RgbWindow::from_texels(n as u32, texels).box_down(1 << lvl).texels()
+}

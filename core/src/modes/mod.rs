@@ -1,0 +1,318 @@
+//! The modes: every engine that renders a texture is one folder here implementing [`Mode`], and
+//! one line of the `modes!` list below, which generates the closed [`ModeParams`] enum and
+//! its dispatch. Everything else — the server's parsing, metadata, OpenAPI, metrics, the CLI,
+//! the viewer's panel — is written once against this module and learns a new mode from it.
+//!
+//! A mode's output bytes are a permanent contract: each mode has its own [`Mode::VERSION`],
+//! part of every ETag and cache key of its tiles, bumped whenever its pixels change (the golden
+//! test in `core/tests/golden.rs` says when).
+
+pub mod params;
+
+use std::collections::BTreeMap;
+use std::fmt::Debug;
+use std::hash::Hash;
+
+use serde_json::{Map, Value};
+
+use crate::analysis::Analysis;
+use crate::cache::Pyramid;
+use crate::error::{CoreError, Result};
+use crate::exemplar::Exemplar;
+use crate::geom::Rect;
+use crate::image::Rendered;
+use params::{Common, ParamReader, ParamSpec};
+
+/// What a mode needs from a texture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Needs {
+    /// The prepared exemplar's pixels only: servable while the analysis is computed.
+    Exemplar,
+    /// The exemplar analysis (Gaussian stack, PCA, candidates).
+    Analysis,
+}
+
+/// How expensive a mode's pixels are, so front ends can spend encoder effort accordingly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cost {
+    /// Milliseconds per tile or more: worth compressing tightly.
+    Heavy,
+    /// Cheaper than encoding well: encode fast.
+    Light,
+}
+
+/// What a texture offers a mode: its prepared exemplar, and its analysis once computed.
+#[derive(Debug, Clone, Copy)]
+pub struct Source<'a> {
+    /// The prepared (square, power-of-two) exemplar.
+    pub exemplar: &'a Exemplar,
+    /// The analysis, when available.
+    pub analysis: Option<&'a Analysis>,
+}
+
+impl<'a> Source<'a> {
+    /// A source with both exemplar and analysis.
+    pub fn new(exemplar: &'a Exemplar, analysis: &'a Analysis) -> Self {
+        Source { exemplar, analysis: Some(analysis) }
+    }
+
+    /// Exemplar side `m`.
+    pub fn side(&self) -> u32 {
+        self.exemplar.side
+    }
+
+    /// `L = log2 m`: the native zoom and finest level.
+    pub fn levels(&self) -> u32 {
+        self.exemplar.side.trailing_zeros()
+    }
+
+    /// The analysis, or [`CoreError::NotAnalysed`] for `mode`.
+    pub fn analysis(&self, mode: &'static str) -> Result<&'a Analysis> {
+        self.analysis.ok_or(CoreError::NotAnalysed { mode })
+    }
+}
+
+/// What to render: `rect` viewed `zoom_out` steps coarser than native (0: one pixel per texel;
+/// `k`: one pixel covers `2^k × 2^k` texels).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct View {
+    /// Steps coarser than native.
+    pub zoom_out: u32,
+    /// Pixels at that zoom.
+    pub rect: Rect,
+}
+
+/// An engine: its name, version, parameters and rendering of any window.
+pub trait Mode {
+    /// Name as the API spells it (`mode=NAME`).
+    const NAME: &'static str;
+    /// Version of the bytes this mode renders: part of its ETags and cache keys. Bump it with
+    /// every change of output, and update the golden digests.
+    const VERSION: u32;
+    /// One line for documentation and the viewer.
+    const SUMMARY: &'static str;
+    /// What it needs from a texture.
+    const NEEDS: Needs;
+    /// How expensive its pixels are.
+    const COST: Cost;
+    /// Validated parameters: everything besides the texture that determines the pixels.
+    type Params: Clone + Debug + PartialEq + Eq + Hash + Send + Sync + 'static;
+
+    /// The mode's own parameters (the common ones are [`params::COMMON`]).
+    fn specs() -> &'static [ParamSpec];
+    /// Built-in defaults, before a texture's configuration.
+    fn defaults() -> Self::Params;
+    /// Read this mode's keys from `r` over `base`, apply `common`, and validate for `src`.
+    fn parse(base: &Self::Params, common: &Common, r: &mut ParamReader, src: &Source) -> Result<Self::Params>;
+    /// The current value of each of [`Mode::specs`] (and `seed`) as JSON, for descriptions.
+    fn values(p: &Self::Params, src: &Source) -> Map<String, Value>;
+    /// Canonical text of every field, for cache keys and ETags.
+    fn canonical(p: &Self::Params) -> String;
+    /// Render a view; `cache` is the shared pyramidal cache (modes that keep nothing ignore it).
+    fn render(p: &Self::Params, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered>;
+}
+
+/// A mode as data: what the server, the CLI and the viewer describe.
+#[derive(Debug, Clone, Copy)]
+pub struct ModeInfo {
+    /// Name.
+    pub name: &'static str,
+    /// Version of its bytes.
+    pub version: u32,
+    /// One line.
+    pub summary: &'static str,
+    /// What it needs from a texture.
+    pub needs: Needs,
+    /// How expensive its pixels are.
+    pub cost: Cost,
+    /// Its own parameters.
+    pub specs: &'static [ParamSpec],
+}
+
+impl ModeInfo {
+    const fn of<M: Mode>(specs: &'static [ParamSpec]) -> ModeInfo {
+        ModeInfo { name: M::NAME, version: M::VERSION, summary: M::SUMMARY, needs: M::NEEDS, cost: M::COST, specs }
+    }
+}
+
+/// The list of modes: `Variant => folder::Type`. Adding a mode is a folder and a line here.
+macro_rules! modes {
+    ($($variant:ident => $module:ident :: $ty:ident),+ $(,)?) => {
+        $(pub mod $module;)+
+
+        /// Names of all modes, in the order they are listed.
+        pub const MODE_NAMES: &[&str] = &[$(<$module::$ty as Mode>::NAME),+];
+
+        /// Every mode, described.
+        pub fn all() -> Vec<ModeInfo> {
+            vec![$(ModeInfo::of::<$module::$ty>(<$module::$ty as Mode>::specs())),+]
+        }
+
+        /// A mode with its validated parameters: everything besides the texture that
+        /// determines a tile's pixels.
+        #[derive(Debug, Clone, PartialEq, Eq, Hash)]
+        pub enum ModeParams {
+            $(
+                #[doc = concat!("`mode=", stringify!($module), "`.")]
+                $variant(<$module::$ty as Mode>::Params)
+            ),+
+        }
+
+        impl ModeParams {
+            /// The built-in defaults of the mode called `name`.
+            pub fn defaults(name: &str) -> Option<ModeParams> {
+                match name {
+                    $(n if n == <$module::$ty as Mode>::NAME => Some(ModeParams::$variant(<$module::$ty as Mode>::defaults())),)+
+                    _ => None,
+                }
+            }
+
+            /// The mode's description.
+            pub fn info(&self) -> ModeInfo {
+                match self {
+                    $(ModeParams::$variant(_) => ModeInfo::of::<$module::$ty>(<$module::$ty as Mode>::specs()),)+
+                }
+            }
+
+            /// Read the mode's keys over these parameters (see [`Mode::parse`]).
+            pub fn parse(&self, common: &Common, r: &mut ParamReader, src: &Source) -> Result<ModeParams> {
+                match self {
+                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::parse(p, common, r, src).map(ModeParams::$variant),)+
+                }
+            }
+
+            /// Current values as JSON (see [`Mode::values`]).
+            pub fn values(&self, src: &Source) -> Map<String, Value> {
+                match self {
+                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::values(p, src),)+
+                }
+            }
+
+            /// Canonical text, mode name and version included: the identity of the pixels for
+            /// cache keys and ETags.
+            pub fn canonical(&self) -> String {
+                match self {
+                    $(ModeParams::$variant(p) => format!(
+                        "mode={};v{};{}",
+                        <$module::$ty as Mode>::NAME,
+                        <$module::$ty as Mode>::VERSION,
+                        <$module::$ty as Mode>::canonical(p)
+                    ),)+
+                }
+            }
+
+            /// Render a view.
+            pub fn render(&self, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
+                match self {
+                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::render(p, src, cache, view),)+
+                }
+            }
+        }
+    };
+}
+
+modes! {
+    Synth => synth::Synth,
+    Mosaic => mosaic::Mosaic,
+}
+
+impl ModeParams {
+    /// The mode's name.
+    pub fn name(&self) -> &'static str {
+        self.info().name
+    }
+}
+
+/// Every mode's parameters, for naming the mode a stray key belongs to.
+fn all_specs() -> Vec<(&'static str, &'static [ParamSpec])> {
+    all().iter().map(|m| (m.name, m.specs)).collect()
+}
+
+/// The parameters a texture starts every request from: its default mode, and each mode's
+/// parameters with the texture's configured defaults and settings.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct Defaults {
+    /// Mode of requests that name none.
+    pub mode: &'static str,
+    /// One entry per mode, in [`MODE_NAMES`] order.
+    pub params: Vec<ModeParams>,
+}
+
+/// A configured default that could not be used: which mode's table, and why.
+#[derive(Debug, thiserror::Error)]
+#[error("{}{source}", .mode.as_ref().map(|m| format!("[{m}] ")).unwrap_or_default())]
+pub struct DefaultsError {
+    /// The mode whose table was wrong (none: the mode name itself).
+    pub mode: Option<String>,
+    /// Why.
+    #[source]
+    pub source: CoreError,
+}
+
+impl Defaults {
+    /// A texture's defaults: `mode` names the default mode, `seed` the default seed of every
+    /// mode, and `tables` holds, per mode name, the configured `key = value` pairs (request
+    /// parameters as defaults, and texture settings).
+    pub fn configure(
+        src: &Source,
+        mode: &str,
+        seed: u64,
+        tables: &BTreeMap<String, Vec<(String, String)>>,
+    ) -> std::result::Result<Defaults, DefaultsError> {
+        let mode_name = MODE_NAMES.iter().copied().find(|m| *m == mode).ok_or_else(|| DefaultsError {
+            mode: None,
+            source: params::MODE.error(format!("'{mode}' is not one of {}", MODE_NAMES.join(", "))),
+        })?;
+        if let Some(unknown) = tables.keys().find(|k| !MODE_NAMES.contains(&k.as_str())) {
+            return Err(DefaultsError {
+                mode: None,
+                source: CoreError::ParamKey {
+                    key: unknown.clone(),
+                    message: format!("is not a mode; per-mode tables are {}", MODE_NAMES.join(", ")),
+                },
+            });
+        }
+        let common = Common { seed: Some(seed), period: None };
+        let mut out = Vec::new();
+        for name in MODE_NAMES {
+            let fail = |source| DefaultsError { mode: Some(name.to_string()), source };
+            let Some(base) = ModeParams::defaults(name) else { continue };
+            let mut r = ParamReader::texture(tables.get(*name).cloned().unwrap_or_default()).map_err(fail)?;
+            let p = base.parse(&common, &mut r, src).map_err(fail)?;
+            r.finish(name, &all_specs()).map_err(fail)?;
+            out.push(p);
+        }
+        Ok(Defaults { mode: mode_name, params: out })
+    }
+
+    /// Built-in defaults for every mode, default mode `synth`.
+    pub fn builtin(src: &Source) -> Defaults {
+        Defaults::configure(src, MODE_NAMES[0], 0, &BTreeMap::new())
+            .unwrap_or_else(|e| unreachable!("built-in defaults are valid: {e}"))
+    }
+
+    /// The defaults of the mode called `name`.
+    pub fn get(&self, name: &str) -> Option<&ModeParams> {
+        MODE_NAMES.iter().position(|m| *m == name).and_then(|i| self.params.get(i))
+    }
+
+    /// Read a request: `mode` (or the default), `seed` and `world`, then the mode's keys over
+    /// this texture's defaults, then reject whatever is left. The caller takes its own keys
+    /// from `r` first.
+    pub fn request(&self, src: &Source, mut r: ParamReader) -> Result<ModeParams> {
+        let mode = r.get(&params::MODE).unwrap_or_else(|| self.mode.to_string());
+        let base = self.get(&mode).ok_or_else(|| {
+            params::MODE.error(format!("'{mode}' is not available; allowed: {}", MODE_NAMES.join(", ")))
+        })?;
+        let common = Common::read(&mut r, src.side())?;
+        let p = base.parse(&common, &mut r, src)?;
+        r.finish(&mode, &all_specs())?;
+        Ok(p)
+    }
+
+    /// Canonical text of every mode's defaults: changes whenever any default does.
+    pub fn canonical(&self) -> String {
+        let each: Vec<String> = self.params.iter().map(ModeParams::canonical).collect();
+        format!("default={}|{}", self.mode, each.join("|"))
+    }
+}

@@ -1,0 +1,163 @@
+//! Chaos mosaic (Xu, Guo & Shum; design note §4): the cheap mode. The exemplar is tiled; every
+//! tile contributes one block of the exemplar (area between the paper's bounds) moved by the cat
+//! map inside its super-tile and pasted over the tiling, higher priority on top; block and tile
+//! edges are smoothed over three pixel layers. Everything is a function of absolute
+//! coordinates, so any window equals the same pixels cut from any larger one.
+
+mod layout;
+mod paint;
+pub mod params;
+mod smooth;
+
+use serde_json::{json, Map, Value};
+
+use crate::cache::Pyramid;
+use crate::error::{CoreError, Result};
+use crate::exemplar::Exemplar;
+use crate::geom::Rect;
+use crate::image::{box_mip, Rendered, RgbWindow};
+use crate::modes::params::{Common, Kind, ParamReader, ParamSpec, Scope};
+use crate::modes::{Cost, Mode, Needs, Source, View};
+
+pub use params::{MosaicParams, MAX_ITERATIONS, MAX_SMOOTHING};
+
+use layout::Layout;
+use paint::paint;
+use smooth::native;
+
+/// Largest native window, in pixels, one call may evaluate (2^26).
+pub const MAX_PIXELS: i64 = 1 << 26;
+
+/// The mosaic mode.
+pub struct Mosaic;
+
+const ITERATIONS: ParamSpec = ParamSpec {
+    name: "iterations",
+    kind: Kind::Integer { min: 0, max: MAX_ITERATIONS as u64 },
+    scope: Scope::Request,
+    help: "cat-map iterations that move the blocks (0 = blocks stay in place: the plain tiling)",
+};
+const BLOCK_AREA: ParamSpec = ParamSpec {
+    name: "block_area",
+    kind: Kind::Interval { min: 0.05, max: 1.0 },
+    scope: Scope::Request,
+    help: "MIN,MAX block area as fractions of the exemplar area",
+};
+const SMOOTHING: ParamSpec = ParamSpec {
+    name: "smoothing",
+    kind: Kind::Integer { min: 0, max: MAX_SMOOTHING as u64 },
+    scope: Scope::Request,
+    help: "pixel layers smoothed on each side of block and tile edges",
+};
+const SPECS: &[ParamSpec] = &[ITERATIONS, BLOCK_AREA, SMOOTHING];
+
+impl Mode for Mosaic {
+    const NAME: &'static str = "mosaic";
+    const VERSION: u32 = 1;
+    const SUMMARY: &'static str = "chaos mosaic (Xu, Guo & Shum): the tiled exemplar with blocks moved by the cat map; cheap";
+    const NEEDS: Needs = Needs::Exemplar;
+    const COST: Cost = Cost::Light;
+    type Params = MosaicParams;
+
+    fn specs() -> &'static [ParamSpec] {
+        SPECS
+    }
+
+    fn defaults() -> MosaicParams {
+        MosaicParams::default()
+    }
+
+    fn parse(base: &MosaicParams, common: &Common, r: &mut ParamReader, src: &Source) -> Result<MosaicParams> {
+        let mut p = base.clone();
+        common.apply(&mut p.seed, &mut p.period);
+        if let Some(s) = r.get(&ITERATIONS) {
+            p.iterations = ITERATIONS.integer(&s)? as u32;
+        }
+        if let Some(s) = r.get(&BLOCK_AREA) {
+            (p.area_min, p.area_max) = BLOCK_AREA.interval_milli(&s)?;
+        }
+        if let Some(s) = r.get(&SMOOTHING) {
+            p.smoothing = SMOOTHING.integer(&s)? as u32;
+        }
+        p.validate(src.side())?;
+        Ok(p)
+    }
+
+    fn values(p: &MosaicParams, _: &Source) -> Map<String, Value> {
+        let mut m = Map::new();
+        m.insert("seed".into(), json!(p.seed));
+        m.insert(ITERATIONS.name.into(), json!(p.iterations));
+        m.insert(BLOCK_AREA.name.into(), json!([p.area_min as f64 / 1000.0, p.area_max as f64 / 1000.0]));
+        m.insert(SMOOTHING.name.into(), json!(p.smoothing));
+        m
+    }
+
+    fn canonical(p: &MosaicParams) -> String {
+        p.canonical()
+    }
+
+    fn render(p: &MosaicParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
+        Ok(Rendered {
+            image: render(src.exemplar, p, view.zoom_out, view.rect)?,
+            synthesized: render_cost(view.zoom_out, view.rect),
+        })
+    }
+}
+
+/// Texels [`render`] evaluates for this view (with the smoothing margin), for computation ratios.
+pub fn render_cost(zoom_out: u32, rect: Rect) -> u64 {
+    match zoom_out {
+        0 => rect.grow(4).area() as u64,
+        k if k <= 3 => {
+            let f = 1i64 << k;
+            Rect { x0: rect.x0 * f, y0: rect.y0 * f, x1: rect.x1 * f, y1: rect.y1 * f }.grow(4).area() as u64
+        }
+        _ => rect.area() as u64,
+    }
+}
+
+/// Render `rect` of the mosaic viewed `zoom_out` steps coarser than native.
+pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    p.validate(ex.side)?;
+    let scale = 1i64.checked_shl(zoom_out.min(62)).unwrap_or(i64::MAX);
+    if rect.is_empty() || rect.area() > MAX_PIXELS || (zoom_out <= 3 && rect.area() * scale * scale > MAX_PIXELS) {
+        return Err(CoreError::Window {
+            width: rect.width(),
+            height: rect.height(),
+            message: format!("must be non-empty with at most {MAX_PIXELS} pixels at native scale"),
+        });
+    }
+    let layout = Layout::new(ex.side as i64, p);
+    if zoom_out == 0 {
+        return Ok(native(ex, &layout, rect));
+    }
+    if zoom_out <= 3 {
+        // Exact: the box average of the native pixels.
+        let big = native(
+            ex,
+            &layout,
+            Rect { x0: rect.x0 * scale, y0: rect.y0 * scale, x1: rect.x1 * scale, y1: rect.y1 * scale },
+        );
+        return Ok(big.box_down(scale as usize));
+    }
+    Ok(sampled(ex, &layout, zoom_out, rect))
+}
+
+/// Far zoom-out (`2^k` texels per pixel, k > 3): label each pixel by its centre texel and colour
+/// it from the box-filtered exemplar at that scale (the mean colour once a pixel covers the
+/// whole exemplar). Approximate, like the paper's reduced-scale rendering.
+fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
+    let n = layout.n as usize;
+    let (w, h) = (rect.width() as usize, rect.height() as usize);
+    let lvl = k.min(ex.side.trailing_zeros()) as usize;
+    let side = n >> lvl;
+    let mip = box_mip(&ex.pixels, n, lvl);
+    let mut pixels = Vec::with_capacity(3 * w * h);
+    let step = 1i64 << k.min(40);
+    let pt = paint(layout, rect, ex.toroidal, step, step / 2);
+    for v in &pt.src {
+        let (x, y) = ((v & 0xFFFF) as usize >> lvl, (v >> 16) as usize >> lvl);
+        pixels.extend_from_slice(&mip[y.min(side - 1) * side + x.min(side - 1)]);
+    }
+    RgbWindow { width: w as u32, height: h as u32, pixels }
+}

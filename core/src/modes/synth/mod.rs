@@ -1,0 +1,117 @@
+//! `mode=synth`: Lefebvre & Hoppe's parallel controllable texture synthesis (design note §1),
+//! the main engine. The stages, one file each:
+//!
+//! 1. [`plan`] — which padded rectangle each level must compute for a window to be exact;
+//! 2. [`window`] — upsample, jitter by a hash of absolute coordinates, correct in subpasses
+//!    (`kernel`); `generations` and `history` share work through the pyramidal cache;
+//! 3. [`colour`] — exemplar coordinates to colours, at native or zoomed-out scale;
+//! 4. [`params`] — the validated parameters.
+
+pub mod colour;
+mod generations;
+mod history;
+mod kernel;
+pub mod params;
+pub mod plan;
+pub mod window;
+
+use serde_json::{json, Map, Value};
+
+use crate::cache::Pyramid;
+use crate::error::Result;
+use crate::image::Rendered;
+use crate::modes::params::{Common, Kind, ParamReader, ParamSpec, Scope, ONE_Q16};
+use crate::modes::{Cost, Mode, Needs, Source, View};
+
+pub use colour::{render, render_with};
+pub use params::{Randomness, SynthParams, MAX_PASSES};
+pub use window::{synthesis_cost, synthesize, synthesize_with, CoordWindow, Synthesized};
+
+/// The synth mode.
+pub struct Synth;
+
+const RANDOMNESS: ParamSpec = ParamSpec {
+    name: "randomness",
+    kind: Kind::Levels,
+    scope: Scope::Request,
+    help: "jitter strength per synthesis level: one value in [0, 1] for every level, or a comma list of one per level, coarse to fine",
+};
+const KAPPA: ParamSpec = ParamSpec {
+    name: "kappa",
+    kind: Kind::Unit,
+    scope: Scope::Texture,
+    help: "κ, the penalty on jumps to a pixel's second candidate: higher keeps exemplar patches more coherent",
+};
+const PASSES: ParamSpec = ParamSpec {
+    name: "passes",
+    kind: Kind::Integer { min: 0, max: MAX_PASSES as u64 },
+    scope: Scope::Texture,
+    help: "correction passes per corrected level (0 switches correction off)",
+};
+const SUBPASSES: ParamSpec = ParamSpec {
+    name: "subpasses",
+    kind: Kind::Integer { min: 1, max: 4 },
+    scope: Scope::Texture,
+    help: "subpasses per pass: 4 (parity classes, the paper's order) or 1 (all pixels at once)",
+};
+const SPECS: &[ParamSpec] = &[RANDOMNESS, KAPPA, PASSES, SUBPASSES];
+
+/// A fixed-point value in `[0, 1]` as a short decimal (4 places: no float noise).
+fn unit_value(v: u32) -> f64 {
+    (v as f64 / ONE_Q16 as f64 * 10_000.0).round() / 10_000.0
+}
+
+impl Mode for Synth {
+    const NAME: &'static str = "synth";
+    const VERSION: u32 = 1;
+    const SUMMARY: &'static str = "parallel controllable texture synthesis (Lefebvre & Hoppe 2005)";
+    const NEEDS: Needs = Needs::Analysis;
+    const COST: Cost = Cost::Heavy;
+    type Params = SynthParams;
+
+    fn specs() -> &'static [ParamSpec] {
+        SPECS
+    }
+
+    fn defaults() -> SynthParams {
+        SynthParams::default()
+    }
+
+    fn parse(base: &SynthParams, common: &Common, r: &mut ParamReader, src: &Source) -> Result<SynthParams> {
+        let mut p = base.clone();
+        common.apply(&mut p.seed, &mut p.period);
+        if let Some(s) = r.get(&RANDOMNESS) {
+            p.randomness = Randomness::parse(&s)?;
+        }
+        if let Some(s) = r.get(&KAPPA) {
+            p.kappa = KAPPA.unit(&s)?;
+        }
+        if let Some(s) = r.get(&PASSES) {
+            p.passes = PASSES.integer(&s)? as u32;
+        }
+        if let Some(s) = r.get(&SUBPASSES) {
+            p.subpasses = SUBPASSES.integer(&s)? as u32;
+        }
+        p.validate(src.side())?;
+        Ok(p)
+    }
+
+    fn values(p: &SynthParams, src: &Source) -> Map<String, Value> {
+        let r: Vec<f64> = p.randomness.resolve(src.levels()).into_iter().map(unit_value).collect();
+        let mut m = Map::new();
+        m.insert("seed".into(), json!(p.seed));
+        m.insert(RANDOMNESS.name.into(), json!(r));
+        m.insert(KAPPA.name.into(), json!(unit_value(p.kappa)));
+        m.insert(PASSES.name.into(), json!(p.passes));
+        m.insert(SUBPASSES.name.into(), json!(p.subpasses));
+        m
+    }
+
+    fn canonical(p: &SynthParams) -> String {
+        p.canonical()
+    }
+
+    fn render(p: &SynthParams, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
+        render_with(cache, src.analysis(Self::NAME)?, p, view.zoom_out, view.rect)
+    }
+}
