@@ -19,8 +19,8 @@ for f in "$SHARED"/exemplars/*.png; do
   case "$name" in *_256|*_tile) continue ;; esac
   cp "$f" "$OUT/exemplars/"
   "$BIN" render --exemplar "$f" "$WIN" "$@" -o "$OUT/default/$name.png" >/dev/null
-  "$BIN" render --exemplar "$f" "$WIN" --passes 0 "$@" -o "$OUT/no_correction/$name.png" >/dev/null
-  "$BIN" render --exemplar "$f" "$WIN" --randomness 0 --passes 0 -o "$OUT/tiling/$name.png" >/dev/null
+  "$BIN" render --exemplar "$f" "$WIN" --param passes=0 "$@" -o "$OUT/no_correction/$name.png" >/dev/null
+  "$BIN" render --exemplar "$f" "$WIN" --param randomness=0 --param passes=0 -o "$OUT/tiling/$name.png" >/dev/null
   "$BIN" render --exemplar "$f" "$WIN" --mode mosaic "$@" -o "$OUT/mosaic/$name.png" >/dev/null
 done
 python3 "$SHARED/tools/texq.py" table --exemplar-dir "$OUT/exemplars" \

@@ -104,5 +104,11 @@ fn help_describes_every_command() {
     }
     let (code, out, _) = run(&["render", "--help"]);
     assert_eq!(code, 0);
-    assert!(out.contains("--randomness") && out.contains("--window"), "{out}");
+    assert!(out.contains("--param") && out.contains("--window") && out.contains("synth, mosaic"), "{out}");
+    // Every mode's parameters, from their specs.
+    let (code, out, _) = run(&["render", "--list-params"]);
+    assert_eq!(code, 0);
+    for p in ["seed", "world", "randomness", "kappa", "iterations", "block_area", "smoothing"] {
+        assert!(out.contains(p), "{p}: {out}");
+    }
 }

@@ -106,10 +106,21 @@ fn invalid_configuration_stops_start_up_naming_the_key() {
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
     assert!(err.contains("default_mode") && err.contains("synth"), "{err}");
-    std::fs::write(&cfg, "[[textures]]\nid = \"x\"\nname = \"X\"\nexemplar = \"e.png\"\nkappa = 1.5\n").unwrap();
+    let texture = "[[textures]]\nid = \"x\"\nname = \"X\"\nexemplar = \"e.png\"\n";
+    std::fs::write(&cfg, format!("{texture}[textures.synth]\nkappa = 1.5\n")).unwrap();
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
-    assert!(err.contains("textures[0].kappa") && err.contains("[0, 1]"), "{err}");
+    assert!(err.contains("textures[0].synth.kappa") && err.contains("[0, 1]"), "{err}");
+    // The spelling before per-mode tables names the new one.
+    std::fs::write(&cfg, format!("{texture}kappa = 0.5\n")).unwrap();
+    let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("textures[0].kappa") && err.contains("[textures.synth] kappa"), "{err}");
+    // A key no mode has, in a mode's table, names the mode's keys.
+    std::fs::write(&cfg, format!("{texture}[textures.mosaic]\nrandomness = 0.5\n")).unwrap();
+    let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("textures[0].mosaic.randomness") && err.contains("iterations"), "{err}");
     let (code, err) = run(&["serve"], &[("TEXTILE_BIND", "not-an-address")]);
     assert_ne!(code, Some(0));
     assert!(err.contains("bind"), "{err}");

@@ -150,10 +150,10 @@ async fn health_ready_viewer_and_openapi() {
 #[tokio::test]
 async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = gravel_textures_config(dir.path(), &[("plain", ""), ("coherent", "kappa = 1.0")]);
+    let cfg = gravel_textures_config(dir.path(), &[("plain", ""), ("coherent", "[textures.synth]\nkappa = 1.0")]);
     let data = shared_data_dir();
     let s = Server::start(&["--config", cfg.to_str().unwrap()]);
-    let k = |v: &serde_json::Value| v["synthesis"]["kappa"].as_f64().unwrap();
+    let k = |v: &serde_json::Value| v["settings"]["synth"]["kappa"].as_f64().unwrap();
     assert!((k(&s.json("/textures/plain").await) - 0.2).abs() < 1e-4);
     assert_eq!(k(&s.json("/textures/coherent").await), 1.0);
     let (plain, coherent) = (s.get("/tiles/plain/7/1/2.png").await, s.get("/tiles/coherent/7/1/2.png").await);

@@ -13,7 +13,9 @@ use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use textile_core::{render, Analysis, Exemplar, ExemplarOptions, NoProgress, Rect, SynthParams};
+use textile_core::modes::mosaic::MosaicParams;
+use textile_core::modes::synth::{render, SynthParams};
+use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress, Rect};
 use textile_server::encode::{encode, Effort, Format};
 
 fn summary(name: &str, mut v: Vec<Duration>) {
@@ -33,7 +35,8 @@ fn main() {
     let n: usize = std::env::args().skip(1).find_map(|a| a.parse().ok()).unwrap_or(1000);
     // Encoding cost, in process.
     let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/../config/exemplars/gravel.png")).unwrap();
-    let an = Analysis::build(&Exemplar::from_bytes(&bytes, &ExemplarOptions::default()).unwrap(), &NoProgress);
+    let ex = Exemplar::from_bytes(&bytes, &ExemplarOptions::default()).unwrap();
+    let an = Analysis::build(&ex, &NoProgress);
     let tile = render(&an, &SynthParams::default(), 0, Rect::new(0, 0, 256, 256)).unwrap();
     let mut synth = Vec::new();
     for i in 0..50 {
@@ -44,8 +47,7 @@ fn main() {
     summary("synthesis 256² (in process)", synth);
     // Each effort on the tiles it is used for: Tight on a synthesized tile, Quick on a mosaic one.
     let mosaic_tile =
-        textile_core::mosaic::render(&an, &textile_core::mosaic::MosaicParams::default(), 0, Rect::new(0, 0, 256, 256))
-            .unwrap();
+        textile_core::modes::mosaic::render(&ex, &MosaicParams::default(), 0, Rect::new(0, 0, 256, 256)).unwrap();
     for (fmt, effort, px, what) in [
         (Format::Png, Effort::Tight, &tile.pixels, "synth"),
         (Format::Png, Effort::Quick, &mosaic_tile.pixels, "mosaic"),

@@ -10,7 +10,7 @@ use lru::LruCache;
 use prometheus::{IntCounter, IntGauge};
 use tokio::sync::OnceCell;
 
-use crate::http::error::ApiError;
+use crate::error::ApiError;
 
 type Flight = Arc<OnceCell<Result<Bytes, ApiError>>>;
 

@@ -3,7 +3,11 @@
 
 use std::path::PathBuf;
 
+use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
+
+/// Any error ending a command, as text for the user.
+pub type CliResult = Result<(), Box<dyn std::error::Error>>;
 
 /// textile — an infinite, deterministic, example-based texture as map tiles.
 #[derive(Debug, Parser)]
@@ -90,7 +94,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub config: ConfigArgs,
     /// A configured texture id.
-    #[arg(long, conflicts_with = "exemplar", required_unless_present = "exemplar")]
+    #[arg(long, conflicts_with = "exemplar", required_unless_present_any = ["exemplar", "list_params"])]
     pub texture: Option<String>,
     /// An exemplar image, analysed on the fly.
     #[arg(long, value_name = "IMAGE")]
@@ -107,33 +111,26 @@ pub struct RenderArgs {
     /// A window instead of a tile: X,Y,W,H in pixels at zoom --z.
     #[arg(long, value_name = "X,Y,W,H", allow_hyphen_values = true)]
     pub window: Option<String>,
-    /// Engine: synth (parallel controllable synthesis) or mosaic (chaos mosaic).
-    #[arg(long, default_value = "synth", value_parser = ["synth", "mosaic"])]
-    pub mode: String,
-    /// Seed.
+    /// Mode (engine); default: the texture's default mode.
+    #[arg(long, value_parser = PossibleValuesParser::new(textile_core::MODE_NAMES))]
+    pub mode: Option<String>,
+    /// Seed: selects another, equally good texture.
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Mosaic: cat-map iterations (0 = plain tiling).
-    #[arg(long)]
-    pub iterations: Option<u32>,
-    /// Mosaic: pixel layers smoothed at block edges (0-3).
-    #[arg(long)]
-    pub smoothing: Option<u32>,
-    /// Randomness: one value in [0, 1] or a comma list, one per level (coarse to fine).
-    #[arg(long)]
-    pub randomness: Option<String>,
     /// Period in native tiles (power of two): periodic, seamless output.
     #[arg(long)]
     pub world: Option<u64>,
-    /// Correction passes per level (0 switches correction off).
+    /// A parameter of the mode, as in a query string or a texture's configuration (repeatable):
+    /// e.g. `--param randomness=0.5`, `--param kappa=0.8`, `--param passes=0` (synth),
+    /// `--param iterations=0` (mosaic). `textile render --list-params` lists them all.
+    #[arg(long = "param", short = 'p', value_name = "KEY=VALUE")]
+    pub params: Vec<String>,
+    /// List every mode's parameters (name, range, description) and exit.
     #[arg(long)]
-    pub passes: Option<u32>,
-    /// κ in [0, 1]: penalty on jumps to the second candidate.
-    #[arg(long)]
-    pub kappa: Option<String>,
+    pub list_params: bool,
     /// Output image (.png, .jpg, .webp).
-    #[arg(short, long, value_name = "FILE")]
-    pub output: PathBuf,
+    #[arg(short, long, value_name = "FILE", required_unless_present = "list_params")]
+    pub output: Option<PathBuf>,
 }
 
 /// `textile info`.

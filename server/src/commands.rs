@@ -5,17 +5,15 @@ use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use textile_core::{Analysis, Exemplar, ExemplarOptions, Progress, Randomness, SynthParams};
+use textile_core::modes::params::{Scope, COMMON};
+use textile_core::{Analysis, Exemplar, ExemplarOptions, ParamReader, Progress, Pyramid};
 
-use crate::cli::{AnalyzeArgs, InfoArgs, RenderArgs};
-use crate::config::{Config, Overrides};
-use crate::encode::{encode, Format};
-use textile_core::Pyramid;
-
-use crate::render::{render_tile, render_window};
-use crate::serve::CliResult;
+use crate::cli::{AnalyzeArgs, CliResult, InfoArgs, RenderArgs};
+use crate::config::{Config, Overrides, TextureConfig};
+use crate::encode::Format;
+use crate::pipeline::{ImageJob, Target};
+use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::textures::{exemplar_bytes, load_registry, Texture};
-use crate::tile_request::{RenderParams, TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE, TILE_SIZE};
 
 struct Bar(Mutex<Option<ProgressBar>>);
 
@@ -76,7 +74,7 @@ pub fn info(a: InfoArgs) -> CliResult {
     println!("file:              {}", a.file.display());
     println!("analysis id:       {}", h.id);
     println!("file hash:         {}", an.file_hash());
-    println!("format version:    {}", textile_core::analysis_file::FORMAT_VERSION);
+    println!("format version:    {}", textile_core::analysis::file::FORMAT_VERSION);
     println!("algorithm version: {}", h.algorithm_version);
     println!(
         "exemplar:          {}x{} (input {}x{}, crop {})",
@@ -91,12 +89,46 @@ pub fn info(a: InfoArgs) -> CliResult {
     Ok(())
 }
 
+/// Every mode's parameters, one per line, for `textile render --list-params`.
+fn list_params() {
+    let line = |s: &textile_core::ParamSpec, who: &str| {
+        let d = s.describe();
+        let range = match (d.get("min"), d.get("max"), d.get("values")) {
+            (_, _, Some(v)) if v.is_array() => format!("one of {v}"),
+            (Some(lo), Some(hi), _) => format!("{lo}..={hi}"),
+            _ => String::new(),
+        };
+        let scope = if s.scope == Scope::Texture { ", texture setting" } else { "" };
+        println!(
+            "  {:<12} {who:<8} {} {range}{scope}\n               {}",
+            s.name,
+            d["type"].as_str().unwrap_or(""),
+            s.help
+        );
+    };
+    println!("common (--mode, --seed, --world, or --param):");
+    for s in COMMON {
+        line(s, "");
+    }
+    for m in textile_core::modes::all() {
+        println!("mode={} (v{}): {}", m.name, m.version, m.summary);
+        for s in m.specs {
+            line(s, m.name);
+        }
+    }
+}
+
 /// `textile render`.
 pub fn render(a: RenderArgs) -> CliResult {
+    if a.list_params {
+        list_params();
+        return Ok(());
+    }
+    let output = a.output.clone().ok_or("--output is required")?;
     let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
         let ex = read_exemplar(path, &ExemplarOptions::default())?;
         let an = Analysis::build(&ex, &textile_core::NoProgress);
-        Arc::new(texture_from(an))
+        Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
     } else {
         let id = a.texture.clone().unwrap_or_default();
         let overrides = Overrides { data_dir: a.config.data_dir.clone(), ..Default::default() };
@@ -111,50 +143,26 @@ pub fn render(a: RenderArgs) -> CliResult {
         let reg = load_registry(&only, &|s| eprintln!("{s}"), &textile_core::NoProgress)?;
         reg.list[0].clone()
     };
-    let mut synth = tex.defaults.clone();
-    if let Some(s) = a.seed {
-        synth.seed = s;
+    // The flags and `--param` pairs are read like a query string, with texture settings allowed.
+    let mut pairs: Vec<(String, String)> = Vec::new();
+    for p in &a.params {
+        let (k, v) = p.split_once('=').ok_or_else(|| format!("--param '{p}' must be KEY=VALUE"))?;
+        pairs.push((k.trim().to_string(), v.trim().to_string()));
     }
-    if let Some(r) = &a.randomness {
-        synth.randomness = Randomness::parse(r)?;
-    }
-    if let Some(w) = a.world {
-        if !w.is_power_of_two() || w > 1 << 31 {
-            return Err("--world must be a power of two up to 2^31".into());
-        }
-        synth.period = Some(w as i64 * TILE_SIZE);
-    }
-    if let Some(p) = a.passes {
-        synth.passes = p;
-    }
-    if let Some(k) = &a.kappa {
-        synth.kappa = SynthParams::parse_kappa(k)?;
-    }
-    synth.validate_for(&tex.analysis)?;
+    let flags =
+        [("mode", a.mode.clone()), ("seed", a.seed.map(|s| s.to_string())), ("world", a.world.map(|w| w.to_string()))];
+    pairs.extend(flags.into_iter().filter_map(|(k, v)| v.map(|v| (k.to_string(), v))));
+    let params = tex.defaults.request(&tex.source(), ParamReader::texture(pairs)?)?;
     let z = a.z.unwrap_or(tex.native_zoom());
     if z > tex.max_zoom() {
         return Err(format!("--z {z} is outside 0..={}", tex.max_zoom()).into());
     }
-    let fmt = a
-        .output
+    let format = output
         .extension()
         .and_then(|e| e.to_str())
         .and_then(Format::from_ext)
         .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
-    let p = if a.mode == "mosaic" {
-        let m = textile_core::MosaicParams {
-            seed: synth.seed,
-            period: synth.period,
-            iterations: a.iterations.unwrap_or(10),
-            smoothing: a.smoothing.unwrap_or(3),
-            ..Default::default()
-        };
-        m.validate_for(&tex.analysis)?;
-        RenderParams::Mosaic(m)
-    } else {
-        RenderParams::Synth(synth)
-    };
-    let img = if let Some(win) = &a.window {
+    let target = if let Some(win) = &a.window {
         let v: Vec<i64> = win
             .split(',')
             .map(|s| s.trim().parse::<i64>())
@@ -166,17 +174,17 @@ pub fn render(a: RenderArgs) -> CliResult {
         if !(1..=MAX_WINDOW_SIDE).contains(&w) || !(1..=MAX_WINDOW_SIDE).contains(&h) {
             return Err(format!("--window width and height must be 1..={MAX_WINDOW_SIDE}").into());
         }
-        render_window(&Pyramid::off(), &tex, &p, &WindowSpec { z, x, y, w, h, format: fmt })?.image
+        Target::Window(WindowSpec { z, x, y, w, h, format })
     } else {
         let (x, y) = (a.x.unwrap_or(0), a.y.unwrap_or(0));
         if !(COORD_MIN..=COORD_MAX).contains(&x) || !(COORD_MIN..=COORD_MAX).contains(&y) {
             return Err("--x and --y must be in [-2^31, 2^31-1]".into());
         }
-        render_tile(&Pyramid::off(), &tex, &p, &TileSpec { z, x, y, scale: 1, format: fmt })?.image
+        Target::Tile(TileSpec { z, x, y, scale: 1, format })
     };
-    let bytes = encode(&img.pixels, img.width, img.height, fmt, p.effort())?;
-    write_atomic(&a.output, &bytes)?;
-    println!("wrote {} ({}x{})", a.output.display(), img.width, img.height);
+    let (bytes, r) = ImageJob { tex, params, target }.bytes(&Pyramid::off())?;
+    write_atomic(&output, &bytes)?;
+    println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
     Ok(())
 }
 
@@ -186,25 +194,4 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     std::fs::rename(&tmp, path).inspect_err(|_| {
         let _ = std::fs::remove_file(&tmp);
     })
-}
-
-fn texture_from(an: Analysis) -> Texture {
-    let file_hash = an.file_hash();
-    Texture {
-        config: crate::config::TextureConfig {
-            id: "exemplar".into(),
-            name: "exemplar".into(),
-            exemplar: String::new(),
-            toroidal: crate::config::Toroidal::Auto,
-            default_mode: "synth".into(),
-            default_seed: 0,
-            default_randomness: String::new(),
-            kappa: None,
-            attribution: String::new(),
-        },
-        analysis: Arc::new(an),
-        file_hash,
-        exemplar_png: Vec::new(),
-        defaults: SynthParams::default(),
-    }
 }

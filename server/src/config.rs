@@ -2,11 +2,13 @@
 //! `config/textile.toml` < `--config FILE` < `TEXTILE_*` environment < command-line flags —
 //! and validated, with messages that name the key and the allowed values.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use figment::providers::{Env, Format, Serialized, Toml};
 use figment::Figment;
 use serde::{Deserialize, Serialize};
+use textile_core::MODE_NAMES;
 
 /// The default configuration, compiled in.
 pub const DEFAULT_CONFIG: &str = include_str!("../../config/textile.toml");
@@ -49,8 +51,12 @@ impl Toroidal {
 }
 
 /// One served texture.
+///
+/// Besides the keys below, a texture may hold one table per mode (`[textures.synth]`,
+/// `[textures.mosaic]`, …) of that mode's parameters: request parameters as the texture's
+/// defaults (`randomness = "0.5"`) and texture settings (`kappa = 0.5`). The keys and their
+/// ranges are the modes' own parameter specs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct TextureConfig {
     /// URL id: 1–64 of `a-z 0-9 _ -`.
     pub id: String,
@@ -64,21 +70,50 @@ pub struct TextureConfig {
     /// Mode used when a request names none.
     #[serde(default = "default_mode")]
     pub default_mode: String,
-    /// Seed used when a request names none.
+    /// Seed used when a request names none (every mode).
     #[serde(default)]
     pub default_seed: u64,
-    /// Randomness used when a request names none (`"0.5"` or a per-level list); empty = the
-    /// engine's default schedule.
-    #[serde(default)]
-    pub default_randomness: String,
-    /// κ of this texture's synthesis (`[0, 1]`, design note §1.3: the penalty on jumps to a
-    /// pixel's second candidate; higher keeps patches more coherent); absent = 0.2. Not a
-    /// request parameter: it is part of the texture, like its exemplar.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kappa: Option<f64>,
     /// Attribution shown in TileJSON.
     #[serde(default)]
     pub attribution: String,
+    /// Per-mode tables, and any other key (refused by validation, naming it).
+    #[serde(flatten)]
+    pub modes: BTreeMap<String, toml::Value>,
+}
+
+impl TextureConfig {
+    /// A texture of this id and exemplar with every other key at its default.
+    pub fn new(id: &str, exemplar: &str) -> Self {
+        TextureConfig {
+            id: id.into(),
+            name: id.into(),
+            exemplar: exemplar.into(),
+            toroidal: Toroidal::Auto,
+            default_mode: default_mode(),
+            default_seed: 0,
+            attribution: String::new(),
+            modes: BTreeMap::new(),
+        }
+    }
+
+    /// The per-mode tables as `key = value` text pairs (lists joined with commas).
+    pub fn mode_tables(&self) -> BTreeMap<String, Vec<(String, String)>> {
+        self.modes
+            .iter()
+            .filter_map(|(m, v)| {
+                v.as_table().map(|t| (m.clone(), t.iter().map(|(k, v)| (k.clone(), text(v))).collect()))
+            })
+            .collect()
+    }
+}
+
+/// A configuration value as the text a query string would carry.
+fn text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Array(a) => a.iter().map(text).collect::<Vec<_>>().join(","),
+        other => other.to_string(),
+    }
 }
 
 fn default_toroidal() -> Toroidal {
@@ -216,20 +251,34 @@ impl Config {
             if !seen.insert(&t.id) {
                 return bad(&format!("textures[{i}].id"), format!("'{}' is used twice", t.id));
             }
-            if !crate::tile_request::MODES.contains(&t.default_mode.as_str()) {
+            if !MODE_NAMES.contains(&t.default_mode.as_str()) {
                 return bad(
                     &format!("textures[{i}].default_mode"),
-                    format!("'{}' is not one of {:?}", t.default_mode, crate::tile_request::MODES),
+                    format!("'{}' is not one of {}", t.default_mode, MODE_NAMES.join(", ")),
                 );
             }
-            if !t.default_randomness.is_empty() {
-                if let Err(e) = textile_core::Randomness::parse(&t.default_randomness) {
-                    return bad(&format!("textures[{i}].default_randomness"), e.to_string());
+            for (key, value) in &t.modes {
+                let at = format!("textures[{i}].{key}");
+                if let Some(moved) = moved_key(key) {
+                    return bad(&at, format!("is now written per mode: {moved}"));
                 }
-            }
-            if let Some(k) = t.kappa {
-                if let Err(e) = textile_core::SynthParams::parse_kappa(&k.to_string()) {
-                    return bad(&format!("textures[{i}].kappa"), e.to_string());
+                let Some(info) = textile_core::modes::all().into_iter().find(|m| m.name == key) else {
+                    return bad(&at, format!("unknown key; per-mode tables are {}", MODE_NAMES.join(", ")));
+                };
+                let Some(table) = value.as_table() else {
+                    return bad(&at, format!("must be a table of mode={key}'s parameters ([textures.{key}])"));
+                };
+                for (k, v) in table {
+                    let Some(spec) = info.specs.iter().find(|s| s.name == k) else {
+                        let known: Vec<&str> = info.specs.iter().map(|s| s.name).collect();
+                        return bad(
+                            &format!("{at}.{k}"),
+                            format!("mode={key} has no parameter '{k}'; it has: {}", known.join(", ")),
+                        );
+                    };
+                    if let Err(e) = spec.check(&text(v)) {
+                        return bad(&format!("{at}.{k}"), e.to_string());
+                    }
                 }
             }
         }
@@ -248,6 +297,15 @@ impl Config {
             return PathBuf::from(h).join(".local/share/textile");
         }
         PathBuf::from("textile-data")
+    }
+}
+
+/// Where a key of the per-texture configuration before modes had tables went.
+fn moved_key(key: &str) -> Option<&'static str> {
+    match key {
+        "kappa" => Some("[textures.synth] kappa = …"),
+        "default_randomness" => Some("[textures.synth] randomness = …"),
+        _ => None,
     }
 }
 

@@ -4,9 +4,11 @@
 //! validation, rendering and encoding, the tile cache, and the axum HTTP layer. The binary
 //! (`src/main.rs`) only dispatches to [`run`].
 //!
-//! Data flow of a tile request: [`http`] route → [`tile_request`] validation → [`cache`] →
-//! [`http::state::AppState::synthesize`] on the rayon pool → [`render`] (textile-core) →
-//! [`encode`] → [`http::content`] headers.
+//! Data flow of a tile request: [`http`] route → [`request`] validation (the texture's mode
+//! defaults read the query) → [`pipeline`]: [`cache`] (single flight) →
+//! [`state::AppState::synthesize`] on the rayon pool → the mode renders (textile-core) →
+//! [`encode`] → [`http::content`] headers. `textile render` goes through the same
+//! [`pipeline::ImageJob`].
 
 pub mod assets;
 pub mod cache;
@@ -14,14 +16,17 @@ pub mod cli;
 pub mod commands;
 pub mod config;
 pub mod encode;
+pub mod error;
 pub mod http;
 pub mod loadtest;
 pub mod memory;
 pub mod metrics;
-pub mod render;
+pub mod pipeline;
+pub mod queue;
+pub mod request;
 pub mod serve;
+pub mod state;
 pub mod textures;
-pub mod tile_request;
 
 /// Parse the command line and run the chosen command; the process exit code.
 pub fn run() -> std::process::ExitCode {

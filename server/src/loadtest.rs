@@ -14,8 +14,7 @@ use std::io::Write;
 
 use serde_json::json;
 
-use crate::cli::LoadtestArgs;
-use crate::serve::CliResult;
+use crate::cli::{CliResult, LoadtestArgs};
 
 type Paths = Box<dyn Iterator<Item = String> + Send>;
 
@@ -213,7 +212,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let bytes: u64 = all.iter().map(|r| r.2 as u64).sum();
         // Pixels synthesized at all levels ÷ pixels delivered, over the syntheses of this run.
         let px = |kind: &str| {
-            ["synth", "mosaic"].iter().map(|m| d(&format!("textile_pixels_{kind}_total{{mode=\"{m}\"}}"))).sum::<f64>()
+            textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_pixels_{kind}_total{{mode=\"{m}\"}}"))).sum::<f64>()
         };
         let (synthesized, delivered) = (px("synthesized"), px("delivered"));
         let ratio = if delivered > 0.0 { synthesized / delivered } else { 0.0 };
@@ -224,7 +223,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             "latency_ms_200": { "p50": pct(&ok, 0.5), "p90": pct(&ok, 0.9), "p99": pct(&ok, 0.99), "max": pct(&ok, 1.0) },
             "status": statuses, "bytes": bytes,
             "server_cache_hit_ratio": if hits + misses > 0.0 { hits / (hits + misses) } else { 0.0 },
-            "server_syntheses": d("textile_syntheses_total{mode=\"synth\"}") + d("textile_syntheses_total{mode=\"mosaic\"}"),
+            "server_syntheses": textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_syntheses_total{{mode=\"{m}\"}}"))).sum::<f64>(),
             "server_computation_ratio": ratio,
         });
         // Write the report; a reader that went away (a closed pipe) is not an error worth a panic.

@@ -7,13 +7,10 @@ use std::sync::Arc;
 use tokio::net::TcpListener;
 use tracing::{info, warn};
 
-use crate::cli::ServeArgs;
+use crate::cli::{CliResult, ServeArgs};
 use crate::config::{Config, Overrides};
-use crate::http::state::AppState;
+use crate::state::AppState;
 use crate::textures::load_registry;
-
-/// Any error ending a command, as text for the user.
-pub type CliResult = Result<(), Box<dyn std::error::Error>>;
 
 struct LogProgress;
 

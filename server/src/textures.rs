@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use textile_core::{Analysis, Exemplar, ExemplarOptions, Progress, Randomness, SynthParams};
+use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, Progress, Source};
 
 use crate::config::{Config, TextureConfig};
 
@@ -26,17 +26,40 @@ pub fn embedded(name: &str) -> Option<&'static [u8]> {
 pub struct Texture {
     /// Its configuration.
     pub config: TextureConfig,
+    /// The prepared exemplar.
+    pub exemplar: Exemplar,
     /// The exemplar analysis.
     pub analysis: Arc<Analysis>,
     /// Hash of the stored analysis bytes (part of every ETag and the TileJSON version).
     pub file_hash: String,
     /// The prepared exemplar as PNG.
     pub exemplar_png: Vec<u8>,
-    /// Parameters a request starts from.
-    pub defaults: SynthParams,
+    /// Parameters a request starts from: default mode, and each mode's configured defaults.
+    pub defaults: Defaults,
 }
 
 impl Texture {
+    /// A texture from its configuration (`index`: its place in the configuration, for errors),
+    /// prepared exemplar and analysis.
+    pub fn new(config: TextureConfig, index: usize, exemplar: Exemplar, analysis: Analysis) -> Result<Self, LoadError> {
+        let file_hash = analysis.file_hash();
+        let m = analysis.side();
+        let rgb: Vec<u8> = analysis.exemplar.iter().flatten().copied().collect();
+        let exemplar_png = crate::encode::encode(&rgb, m, m, crate::encode::Format::Png, crate::encode::Effort::Tight)
+            .map_err(|e| LoadError::Core {
+                id: config.id.clone(),
+                source: textile_core::CoreError::ExemplarUndecodable(e.to_string()),
+            })?;
+        let src = Source::new(&exemplar, &analysis);
+        let defaults = Defaults::configure(&src, &config.default_mode, config.default_seed, &config.mode_tables())
+            .map_err(|source| LoadError::Defaults { id: config.id.clone(), index, source })?;
+        Ok(Texture { config, exemplar, analysis: Arc::new(analysis), file_hash, exemplar_png, defaults })
+    }
+
+    /// What the modes render from.
+    pub fn source(&self) -> Source<'_> {
+        Source::new(&self.exemplar, &self.analysis)
+    }
     /// Zoom at which one tile pixel is one texel.
     pub fn native_zoom(&self) -> u32 {
         self.analysis.levels()
@@ -86,6 +109,16 @@ pub enum LoadError {
         /// The name asked for.
         name: String,
     },
+    /// A configured default or setting is unusable for this exemplar.
+    #[error("texture '{id}' (textures[{index}]): {source}")]
+    Defaults {
+        /// Texture id.
+        id: String,
+        /// Position in the configuration.
+        index: usize,
+        /// Cause.
+        source: textile_core::modes::DefaultsError,
+    },
     /// The exemplar or its analysis is unusable.
     #[error("texture '{id}': {source}")]
     Core {
@@ -112,7 +145,7 @@ pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadEr
 pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress) -> Result<Registry, LoadError> {
     let data_dir = cfg.data_dir();
     let mut list = Vec::new();
-    for t in &cfg.textures {
+    for (index, t) in cfg.textures.iter().enumerate() {
         let core = |source| LoadError::Core { id: t.id.clone(), source };
         let bytes = exemplar_bytes(cfg, t)?;
         let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
@@ -148,29 +181,7 @@ pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress
                 a
             }
         };
-        let file_hash = analysis.file_hash();
-        let m = analysis.side();
-        let rgb: Vec<u8> = analysis.exemplar.iter().flatten().copied().collect();
-        let exemplar_png = crate::encode::encode(&rgb, m, m, crate::encode::Format::Png, crate::encode::Effort::Tight)
-            .map_err(|e| LoadError::Core {
-                id: t.id.clone(),
-                source: textile_core::CoreError::ExemplarUndecodable(e.to_string()),
-            })?;
-        let mut defaults = SynthParams { seed: t.default_seed, ..SynthParams::default() };
-        if !t.default_randomness.is_empty() {
-            defaults.randomness = Randomness::parse(&t.default_randomness).map_err(core)?;
-        }
-        if let Some(k) = t.kappa {
-            defaults.kappa = SynthParams::parse_kappa(&k.to_string()).map_err(core)?;
-        }
-        defaults.validate_for(&analysis).map_err(core)?;
-        list.push(Arc::new(Texture {
-            config: t.clone(),
-            analysis: Arc::new(analysis),
-            file_hash,
-            exemplar_png,
-            defaults,
-        }));
+        list.push(Arc::new(Texture::new(t.clone(), index, ex, analysis)?));
     }
     let by_id = list.iter().map(|t| (t.config.id.clone(), t.clone())).collect();
     Ok(Registry { list, by_id })

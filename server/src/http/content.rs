@@ -5,21 +5,6 @@ use axum::body::Bytes;
 use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 
-/// Version of everything besides the analysis that determines bytes.
-pub fn engine_version() -> String {
-    format!(
-        "textile/{}/algo{}/enc{}",
-        env!("CARGO_PKG_VERSION"),
-        textile_core::ALGORITHM_VERSION,
-        crate::encode::ENCODER_VERSION
-    )
-}
-
-/// The strong ETag (quoted) for a cache key.
-pub fn etag_for(key: &str) -> String {
-    format!("\"{}\"", &blake3::hash(key.as_bytes()).to_hex()[..32])
-}
-
 /// Does `If-None-Match` match this ETag? (Weak comparison, as RFC 9110 asks for this header.)
 pub fn if_none_match(headers: &HeaderMap, etag: &str) -> bool {
     headers.get_all(header::IF_NONE_MATCH).iter().any(|v| {

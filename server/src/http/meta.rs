@@ -1,5 +1,5 @@
 //! Descriptive endpoints: health and readiness, the catalog, texture metadata and exemplar,
-//! TileJSON 3.0.0, the OpenAPI document and the viewer page.
+//! TileJSON 3.0.0 and the Prometheus metrics. Parameters are described from the modes' specs.
 
 use std::sync::Arc;
 
@@ -8,29 +8,17 @@ use axum::extract::{Path, RawQuery, State};
 use axum::http::{header, HeaderMap, HeaderValue, Method, Uri};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use serde_json::{json, Value};
-use utoipa::OpenApi;
+use serde_json::{json, Map, Value};
+use textile_core::modes::params::{Scope, COMMON, MODE, SEED, WORLD};
+use textile_core::modes::{Cost, Needs};
+use textile_core::{MODE_NAMES, TILE_SIZE};
 
-use crate::http::content::engine_version;
-use crate::http::error::ApiError;
-use crate::http::images::path_error;
-use crate::http::state::AppState;
-use crate::textures::{Registry, Texture};
-use crate::tile_request::{parse_query, render_params, MODES, PARAM_KEYS};
-
-/// The texture with `id`, or a 404 naming the available ones.
-pub(crate) fn texture(reg: &Registry, id: &str) -> Result<Arc<Texture>, ApiError> {
-    reg.get(id).cloned().ok_or_else(|| {
-        let known: Vec<String> = reg.list.iter().map(|t| t.config.id.clone()).collect();
-        ApiError::unknown_texture(id, &known)
-    })
-}
-
-/// `http://HOST` of a request (for absolute URLs in documents).
-pub(crate) fn base_url(st: &AppState, headers: &HeaderMap) -> String {
-    let host = headers.get(header::HOST).and_then(|h| h.to_str().ok()).unwrap_or(&st.config.bind);
-    format!("http://{host}")
-}
+use crate::error::{ApiError, Kind};
+use crate::http::extract::{base_url, path_error, texture};
+use crate::pipeline::engine_version;
+use crate::request::{params, query_pairs};
+use crate::state::AppState;
+use crate::textures::Texture;
 
 /// Liveness.
 #[utoipa::path(get, path = "/health", tag = "service", responses((status = 200, description = "alive")))]
@@ -76,7 +64,7 @@ pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap) -> Res
         .iter()
         .map(|t| {
             json!({
-                "id": t.config.id, "name": t.config.name, "modes": MODES, "default_mode": t.config.default_mode,
+                "id": t.config.id, "name": t.config.name, "modes": MODE_NAMES, "default_mode": t.defaults.mode,
                 "tilejson": format!("{base}/tiles/{}/tilejson.json", t.config.id),
                 "exemplar": format!("{base}/textures/{}/exemplar.png", t.config.id),
             })
@@ -97,7 +85,6 @@ pub async fn texture_meta(
     let Path(id) = path.map_err(path_error)?;
     let t = texture(reg, &id)?;
     let h = &t.analysis.header;
-    let levels = h.levels;
     Ok(Json(json!({
         "id": t.config.id,
         "name": t.config.name,
@@ -108,36 +95,82 @@ pub async fn texture_meta(
             "crop_side": h.preparation.crop_side, "toroidal_forced": h.preparation.toroidal_forced,
         },
         "analysis": { "id": h.id, "file_hash": t.file_hash, "algorithm_version": h.algorithm_version },
-        "modes": MODES,
-        "default_mode": t.config.default_mode,
+        "modes": MODE_NAMES,
+        "default_mode": t.defaults.mode,
+        "mode_info": mode_info(),
         "native_zoom": t.native_zoom(),
         "minzoom": t.min_zoom(),
         "maxzoom": t.max_zoom(),
-        "tile_size": crate::tile_request::TILE_SIZE,
-        "levels": levels + 1,
-        "synthesis": {
-            "kappa": t.defaults.kappa as f64 / 65536.0,
-            "passes": t.defaults.passes,
-            "subpasses": t.defaults.subpasses,
-            "description": "fixed settings of this texture's synth mode (set in the configuration, not per request)",
-        },
-        "parameters": {
-            "seed": { "default": t.defaults.seed, "min": 0, "max": u64::MAX },
-            "randomness": {
-                "modes": ["synth"],
-                "default": t.defaults.randomness.resolve(levels).iter().map(|&r| r as f64 / 65536.0).collect::<Vec<_>>(),
-                "min": 0.0, "max": 1.0, "values": levels + 1,
-                "description": "one value for every level or a comma list of one per level, coarse to fine",
-            },
-            "world": { "default": null, "min": (h.side as i64 / crate::tile_request::TILE_SIZE).max(1),
-                       "max": crate::tile_request::MAX_WORLD, "description": "power of two: period in native tiles" },
-            "mode": { "default": t.config.default_mode, "values": MODES },
-            "iterations": { "default": 10, "min": 0, "max": textile_core::mosaic::MAX_ITERATIONS, "modes": ["mosaic"] },
-            "smoothing": { "default": 3, "min": 0, "max": textile_core::mosaic::MAX_SMOOTHING, "modes": ["mosaic"] },
-            "block_area": { "default": [0.5, 0.75], "min": 0.05, "max": 1.0, "modes": ["mosaic"],
-                            "description": "MIN,MAX block area as fractions of the exemplar area" },
-        },
+        "tile_size": TILE_SIZE,
+        "levels": h.levels + 1,
+        "settings": settings(&t),
+        "parameters": parameters(&t),
     })))
+}
+
+/// Each mode's version, summary, needs and cost.
+fn mode_info() -> Value {
+    let each = textile_core::modes::all().into_iter().map(|m| {
+        let needs = match m.needs {
+            Needs::Exemplar => "exemplar",
+            Needs::Analysis => "analysis",
+        };
+        let cost = match m.cost {
+            Cost::Heavy => "heavy",
+            Cost::Light => "light",
+        };
+        (m.name.to_string(), json!({ "version": m.version, "summary": m.summary, "needs": needs, "cost": cost }))
+    });
+    Value::Object(each.collect())
+}
+
+/// The request parameters of every mode, from their specs: type, range, help, the modes that
+/// accept each, and this texture's default.
+fn parameters(t: &Texture) -> Value {
+    let src = t.source();
+    let mut out = Map::new();
+    for spec in COMMON {
+        out.insert(spec.name.into(), spec.describe());
+    }
+    out[MODE.name]["default"] = json!(t.defaults.mode);
+    let default_params = t.defaults.get(t.defaults.mode).map(|p| p.values(&src)).unwrap_or_default();
+    out[SEED.name]["default"] = default_params.get("seed").cloned().unwrap_or(Value::Null);
+    out[WORLD.name]["default"] = Value::Null;
+    out[WORLD.name]["min"] = json!((src.side() as i64 / TILE_SIZE).max(1));
+    for info in textile_core::modes::all() {
+        let values = t.defaults.get(info.name).map(|p| p.values(&src)).unwrap_or_default();
+        for spec in info.specs.iter().filter(|s| s.scope == Scope::Request) {
+            let entry = out.entry(spec.name).or_insert_with(|| {
+                let mut d = spec.describe();
+                d["default"] = values.get(spec.name).cloned().unwrap_or(Value::Null);
+                d["modes"] = json!([]);
+                if spec.kind == textile_core::modes::params::Kind::Levels {
+                    d["values"] = json!(src.levels() + 1);
+                }
+                d
+            });
+            if let Some(modes) = entry["modes"].as_array_mut() {
+                modes.push(json!(info.name));
+            }
+        }
+    }
+    Value::Object(out)
+}
+
+/// This texture's settings of each mode (texture-scope parameters, set in the configuration).
+fn settings(t: &Texture) -> Value {
+    let src = t.source();
+    let each = textile_core::modes::all().into_iter().filter_map(|info| {
+        let values = t.defaults.get(info.name)?.values(&src);
+        let s: Map<String, Value> = info
+            .specs
+            .iter()
+            .filter(|s| s.scope == Scope::Texture)
+            .map(|s| (s.name.to_string(), values.get(s.name).cloned().unwrap_or(Value::Null)))
+            .collect();
+        (!s.is_empty()).then(|| (info.name.to_string(), Value::Object(s)))
+    });
+    Value::Object(each.collect())
 }
 
 /// The prepared exemplar image.
@@ -159,11 +192,7 @@ pub async fn exemplar(
 
 /// TileJSON 3.0.0 of a texture; query parameters are validated and carried into `tiles`.
 #[utoipa::path(get, path = "/tiles/{id}/tilejson.json", tag = "tiles",
-    params(("id" = String, Path, description = "texture id"),
-           ("mode" = Option<String>, Query, description = "carried into the tiles template"),
-           ("seed" = Option<u64>, Query, description = "carried into the tiles template"),
-           ("randomness" = Option<String>, Query, description = "carried into the tiles template"),
-           ("world" = Option<u64>, Query, description = "carried into the tiles template")),
+    params(("id" = String, Path, description = "texture id")),
     responses((status = 200, description = "TileJSON"), (status = 404, description = "unknown texture")))]
 pub async fn tilejson(
     State(st): State<Arc<AppState>>,
@@ -174,16 +203,17 @@ pub async fn tilejson(
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
     let t = texture(reg, &id)?;
-    let q = parse_query(raw.as_deref(), PARAM_KEYS)?;
-    render_params(&t, &q)?;
+    let q = query_pairs(raw.as_deref());
+    params(&t, textile_core::ParamReader::request(q.clone())?)?;
     // Everything that decides a tile's bytes besides its own request: engine, analysis, and the
-    // texture's configured defaults (a changed default seed or κ must not hit stale immutable copies).
-    let version = &blake3::hash(
-        format!("{}|{}|{}|{}", engine_version(), t.file_hash, t.config.default_mode, t.defaults.canonical()).as_bytes(),
-    )
-    .to_hex()[..12];
+    // texture's configured defaults of every mode with the modes' versions (a changed default
+    // seed or κ, or a new mode version, must not hit stale immutable copies).
+    let version = &blake3::hash(format!("{}|{}|{}", engine_version(), t.file_hash, t.defaults.canonical()).as_bytes())
+        .to_hex()[..12];
     let mut qs = form_urlencoded::Serializer::new(String::new());
     qs.append_pair("v", version);
+    let mut q = q;
+    q.sort();
     for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
         qs.append_pair(k, v);
     }
@@ -200,39 +230,9 @@ pub async fn tilejson(
         "maxzoom": t.max_zoom(),
         "bounds": [-180.0, -85.051_128_779_806_59, 180.0, 85.051_128_779_806_59],
         "center": [0.0, 0.0, t.native_zoom()],
-        "tileSize": crate::tile_request::TILE_SIZE,
+        "tileSize": TILE_SIZE,
         "textile": { "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.analysis.side() },
     })))
-}
-
-/// The OpenAPI 3 document of every route, generated from the handlers' annotations.
-#[derive(OpenApi)]
-#[openapi(
-    info(title = "textile", description = "Infinite, deterministic, example-based texture tiles"),
-    paths(
-        crate::http::meta::health,
-        crate::http::meta::ready,
-        crate::http::meta::catalog,
-        crate::http::meta::texture_meta,
-        crate::http::meta::exemplar,
-        crate::http::meta::tilejson,
-        crate::http::images::tile,
-        crate::http::images::window,
-        crate::http::meta::openapi,
-        crate::http::meta::metrics,
-        crate::http::static_files::index,
-        crate::http::static_files::world,
-        crate::http::models::gltf_tile,
-        crate::http::models::gltf_patch,
-        crate::http::models::x3d_tile
-    )
-)]
-pub struct ApiDoc;
-
-/// This document.
-#[utoipa::path(get, path = "/openapi.json", tag = "service", responses((status = 200, description = "OpenAPI 3")))]
-pub async fn openapi() -> Json<utoipa::openapi::OpenApi> {
-    Json(ApiDoc::openapi())
 }
 
 /// Prometheus metrics in the text exposition format.
@@ -252,7 +252,7 @@ pub async fn not_found(uri: Uri) -> ApiError {
 /// 405 for known routes with another method.
 pub async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
     ApiError::new(
-        axum::http::StatusCode::METHOD_NOT_ALLOWED,
+        Kind::MethodNotAllowed,
         "method_not_allowed",
         format!("{method} is not allowed on '{}'; use GET or HEAD", uri.path()),
     )

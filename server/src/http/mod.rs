@@ -1,13 +1,15 @@
 //! The HTTP service: routes, middleware (CORS, compression of JSON, panic → 500 JSON) and the
-//! modules behind them (errors, content headers, state, image and descriptive endpoints).
+//! modules behind them: errors as HTTP answers, content headers, request extraction, and the
+//! route modules (images, descriptive endpoints, 3D assets, static files, OpenAPI), which import
+//! nothing from each other. Nothing outside this folder names it but the server's start-up.
 
 pub mod content;
 pub mod error;
+pub mod extract;
 pub mod images;
 pub mod meta;
 pub mod models;
-pub mod queue;
-pub mod state;
+pub mod openapi;
 pub mod static_files;
 
 use std::sync::Arc;
@@ -22,8 +24,8 @@ use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::compression::CompressionLayer;
 use tower_http::cors::{AllowOrigin, CorsLayer};
 
-use self::error::ApiError;
-use self::state::AppState;
+use crate::error::ApiError;
+use crate::state::AppState;
 
 /// Count every routed request by route template and status, and time it.
 async fn track(State(st): State<Arc<AppState>>, req: Request, next: Next) -> Response {
@@ -45,7 +47,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/health", get(meta::health))
         .route("/ready", get(meta::ready))
         .route("/catalog", get(meta::catalog))
-        .route("/openapi.json", get(meta::openapi))
+        .route("/openapi.json", get(openapi::openapi))
         .route("/metrics", get(meta::metrics))
         .route("/textures/{id}", get(meta::texture_meta))
         .route("/textures/{id}/exemplar.png", get(meta::exemplar))

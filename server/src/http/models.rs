@@ -10,17 +10,22 @@ use axum::http::HeaderMap;
 use axum::response::Response;
 use base64::Engine;
 
+use std::collections::BTreeMap;
+
+use textile_core::{ModeParams, ParamReader, TILE_SIZE};
+
 use crate::assets::{glb, gltf_json, x3d, Quad};
 use crate::encode::Format;
-use crate::http::content::{engine_version, etag_for, if_none_match, image, not_modified};
-use crate::http::error::ApiError;
-use crate::http::images::{cache_key, cached, path_error, tile_bytes, tile_key};
-use crate::http::meta::{base_url, texture};
-use crate::http::state::AppState;
+use crate::error::ApiError;
+use crate::http::content::{if_none_match, image, not_modified};
+use crate::http::extract::{base_url, path_error, texture};
+use crate::pipeline::{cache_key, cached, engine_version, etag_for, produce, ImageJob, Target, GLTF_LABEL};
+use crate::request::{params, parse_tile, query_pairs, TileSpec, COORD_MAX};
+use crate::state::AppState;
 use crate::textures::Texture;
-use crate::tile_request::{
-    parse_query, parse_tile, render_params, Query, RenderParams, TileSpec, COORD_MAX, PARAM_KEYS, TILE_SIZE,
-};
+
+/// A request's parameters, sorted, as carried into tile URLs.
+type Query = BTreeMap<String, String>;
 
 /// Largest patch side in tiles.
 pub const MAX_PATCH: i64 = 8;
@@ -64,11 +69,25 @@ fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), Api
     }
 }
 
+#[derive(Clone)]
 struct TileRequest {
     tex: Arc<Texture>,
     spec: TileSpec,
     query: Query,
-    params: RenderParams,
+    params: ModeParams,
+}
+
+impl TileRequest {
+    /// The PNG tile this asset shows.
+    fn image(&self) -> ImageJob {
+        let spec = TileSpec { format: Format::Png, scale: 1, ..self.spec };
+        ImageJob { tex: self.tex.clone(), params: self.params.clone(), target: Target::Tile(spec) }
+    }
+}
+
+/// The bytes of a PNG tile, through the pipeline.
+async fn tile_png(st: &Arc<AppState>, job: ImageJob) -> Result<Vec<u8>, ApiError> {
+    Ok(produce(st, job).await.0?.to_vec())
 }
 
 fn tile_request(
@@ -96,9 +115,9 @@ fn tile_request(
         _ => (y, raw),
     };
     let spec = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
-    let query = parse_query(raw.as_deref(), PARAM_KEYS)?;
-    let params = render_params(&tex, &query)?;
-    Ok((TileRequest { tex, spec, query, params }, ext.to_string()))
+    let pairs = query_pairs(raw.as_deref());
+    let params = params(&tex, ParamReader::request(pairs.clone())?)?;
+    Ok((TileRequest { tex, spec, query: pairs.into_iter().collect(), params }, ext.to_string()))
 }
 
 fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
@@ -110,9 +129,7 @@ fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
 #[utoipa::path(get, path = "/gltf/{id}/{z}/{x}/{y}.{ext}", tag = "3d",
     params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
            ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row"),
-           ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png`"),
-           ("mode" = Option<String>, Query, description = "as for tiles"), ("seed" = Option<u64>, Query, description = "as for tiles"),
-           ("randomness" = Option<String>, Query, description = "as for tiles"), ("world" = Option<u64>, Query, description = "as for tiles")),
+           ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png`")),
     responses((status = 200, description = "model/gltf-binary or model/gltf+json"), (status = 304, description = "not modified"),
               (status = 400, description = "bad coordinates or parameters"), (status = 404, description = "unknown texture")))]
 pub async fn gltf_tile(
@@ -124,7 +141,8 @@ pub async fn gltf_tile(
     let (r, ext) = tile_request(&st, path, raw, &["glb", "gltf", "png"])?;
     let cc = &st.config.cache_control;
     if ext == "png" {
-        let etag = etag_for(&tile_key(&r.tex, &r.params, &r.spec));
+        let job = r.image();
+        let etag = job.etag();
         if if_none_match(&headers, &etag) {
             return Ok(not_modified(&etag, cc));
         }
@@ -132,7 +150,7 @@ pub async fn gltf_tile(
         let found = hit.is_some();
         let bytes = match hit {
             Some(b) => b,
-            None => tile_bytes(&st, &r.tex, &r.params, r.spec).await?,
+            None => tile_png(&st, job).await?.into(),
         };
         return Ok(image(bytes, "image/png", &etag, cc, found));
     }
@@ -157,10 +175,9 @@ pub async fn gltf_tile(
     if let Some(b) = st.cache.peek(&etag) {
         return Ok(image(b, "model/gltf-binary", &etag, cc, true));
     }
-    let png = tile_bytes(&st, &r.tex, &r.params, r.spec).await?;
+    let png = tile_png(&st, r.image()).await?;
     let q = quad(&r.tex, &r.spec);
-    let (bytes, hit) =
-        cached(&st, &etag, "gltf", move || Ok(glb(&[q], &[(png.to_vec(), "image/png")], &generator()))).await;
+    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move || Ok(glb(&[q], &[(png, "image/png")], &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
@@ -168,9 +185,7 @@ pub async fn gltf_tile(
 #[utoipa::path(get, path = "/gltf/{id}/patch.glb", tag = "3d",
     params(("id" = String, Path, description = "texture id"), ("z" = u32, Query, description = "zoom"),
            ("x" = i64, Query, description = "left tile column"), ("y" = i64, Query, description = "top tile row"),
-           ("tiles" = u32, Query, description = "patch side in tiles, 1..=8"),
-           ("mode" = Option<String>, Query, description = "as for tiles"), ("seed" = Option<u64>, Query, description = "as for tiles"),
-           ("randomness" = Option<String>, Query, description = "as for tiles"), ("world" = Option<u64>, Query, description = "as for tiles")),
+           ("tiles" = u32, Query, description = "patch side in tiles, 1..=8")),
     responses((status = 200, description = "model/gltf-binary"), (status = 400, description = "bad parameters"),
               (status = 404, description = "unknown texture")))]
 pub async fn gltf_patch(
@@ -182,14 +197,12 @@ pub async fn gltf_patch(
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
     let tex = texture(reg, &id)?;
-    let mut keys: Vec<&str> = PARAM_KEYS.to_vec();
-    keys.extend(["z", "x", "y", "tiles"]);
-    let mut query = parse_query(raw.as_deref(), &keys)?;
-    let need = |q: &mut Query, k: &str| {
-        q.remove(k).ok_or_else(|| ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required")))
+    let pairs = query_pairs(raw.as_deref());
+    let mut reader = ParamReader::request(pairs.clone())?;
+    let mut need = |k: &str| {
+        reader.take(k).ok_or_else(|| ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required")))
     };
-    let (z, x, y, n) =
-        (need(&mut query, "z")?, need(&mut query, "x")?, need(&mut query, "y")?, need(&mut query, "tiles")?);
+    let (z, x, y, n) = (need("z")?, need("x")?, need("y")?, need("tiles")?);
     let n: i64 = n.parse().ok().filter(|n| (1..=MAX_PATCH).contains(n)).ok_or_else(|| {
         ApiError::bad_request(
             "invalid_parameter",
@@ -203,7 +216,8 @@ pub async fn gltf_patch(
             format!("the patch must end at or before {COORD_MAX}"),
         ));
     }
-    let params = render_params(&tex, &query)?;
+    let params = params(&tex, reader)?;
+    let query = pairs.into_iter().filter(|(k, _)| !["z", "x", "y", "tiles"].contains(&k.as_str())).collect();
     let r = TileRequest { tex: tex.clone(), spec: origin, query, params };
     let etag = etag_for(&key(&r, "patch", &n.to_string()));
     let cc = &st.config.cache_control;
@@ -217,21 +231,19 @@ pub async fn gltf_patch(
     let mut images = Vec::new();
     for j in 0..n {
         for i in 0..n {
-            let spec = TileSpec { x: origin.x + i, y: origin.y + j, format: Format::Png, ..origin };
-            images.push((tile_bytes(&st, &tex, &r.params, spec).await?.to_vec(), "image/png"));
+            let spec = TileSpec { x: origin.x + i, y: origin.y + j, ..origin };
+            images.push((tile_png(&st, TileRequest { spec, ..r.clone() }.image()).await?, "image/png"));
             quads.push(quad(&tex, &spec));
         }
     }
-    let (bytes, hit) = cached(&st, &etag, "gltf", move || Ok(glb(&quads, &images, &generator()))).await;
+    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move || Ok(glb(&quads, &images, &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
 /// A tile as an X3D scene whose `ImageTexture` points at the tile URL (the VRML use case).
 #[utoipa::path(get, path = "/x3d/{id}/{z}/{x}/{y}.x3d", tag = "3d",
     params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
-           ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row"),
-           ("mode" = Option<String>, Query, description = "as for tiles"), ("seed" = Option<u64>, Query, description = "as for tiles"),
-           ("randomness" = Option<String>, Query, description = "as for tiles"), ("world" = Option<u64>, Query, description = "as for tiles")),
+           ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row")),
     responses((status = 200, description = "model/x3d+xml"), (status = 400, description = "bad coordinates or parameters"),
               (status = 404, description = "unknown texture")))]
 pub async fn x3d_tile(

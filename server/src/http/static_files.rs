@@ -5,7 +5,7 @@ use axum::extract::Path;
 use axum::http::{header, HeaderValue};
 use axum::response::{IntoResponse, Response};
 
-use crate::http::error::ApiError;
+use crate::error::ApiError;
 
 /// `(path under /static/, content type, bytes)`.
 const FILES: &[(&str, &str, &[u8])] = &[

@@ -1,4 +1,4 @@
-//! Shared state of the running service: configuration, the texture registry (set once textures
+//! Shared state of the running service (no HTTP in it): configuration, the texture registry (set once textures
 //! are loaded), the tile cache, admission control and counters; and the one way work reaches
 //! the synthesis thread pool.
 
@@ -10,12 +10,11 @@ use axum::body::Bytes;
 use textile_core::Pyramid;
 use tokio::sync::Semaphore;
 
-use crate::http::queue::RunQueue;
-
 use crate::cache::{CacheStats, TileCache};
 use crate::config::Config;
-use crate::http::error::ApiError;
+use crate::error::ApiError;
 use crate::metrics::Metrics;
+use crate::queue::RunQueue;
 use crate::textures::Registry;
 
 /// Waiters per pool thread beyond which the synthesis queue serves the newest first.
@@ -67,9 +66,13 @@ impl AppState {
         }
     }
 
-    /// Syntheses started so far (all modes).
+    /// Syntheses started so far (every mode, and glTF documents).
     pub fn syntheses(&self) -> u64 {
-        ["synth", "mosaic", "gltf"].iter().map(|m| self.metrics.syntheses.with_label_values(&[m]).get()).sum()
+        textile_core::MODE_NAMES
+            .iter()
+            .chain(&[crate::pipeline::GLTF_LABEL])
+            .map(|m| self.metrics.syntheses.with_label_values(&[m]).get())
+            .sum()
     }
 
     /// The registry, or 503 while loading.
@@ -110,12 +113,7 @@ impl AppState {
             }
         };
         let wait = Duration::from_secs(self.config.request_timeout_secs);
-        tokio::time::timeout(wait, work).await.unwrap_or_else(|_| {
-            Err(ApiError {
-                retry_after: Some(5),
-                ..ApiError::new(axum::http::StatusCode::SERVICE_UNAVAILABLE, "timeout", "synthesis took too long")
-            })
-        })
+        tokio::time::timeout(wait, work).await.unwrap_or_else(|_| Err(ApiError::timeout()))
     }
 }
 

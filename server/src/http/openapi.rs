@@ -1,0 +1,105 @@
+//! The OpenAPI 3 document of every route: generated from the handlers' annotations, then the
+//! image and 3D routes get the query parameters of every mode from the modes' specs (names,
+//! types, ranges, which modes accept them), so a new mode's parameters are documented without
+//! touching this file.
+
+use axum::Json;
+use textile_core::modes::params::{Kind, ParamSpec, Scope, COMMON};
+use utoipa::openapi::path::{Parameter, ParameterBuilder, ParameterIn};
+use utoipa::openapi::schema::{ObjectBuilder, Type};
+use utoipa::openapi::Required;
+use utoipa::{Modify, OpenApi};
+
+/// The OpenAPI 3 document of every route, generated from the handlers' annotations.
+#[derive(OpenApi)]
+#[openapi(
+    info(title = "textile", description = "Infinite, deterministic, example-based texture tiles"),
+    modifiers(&ModeParameters),
+    paths(
+        crate::http::meta::health,
+        crate::http::meta::ready,
+        crate::http::meta::catalog,
+        crate::http::meta::texture_meta,
+        crate::http::meta::exemplar,
+        crate::http::meta::tilejson,
+        crate::http::images::tile,
+        crate::http::images::window,
+        openapi,
+        crate::http::meta::metrics,
+        crate::http::static_files::index,
+        crate::http::static_files::world,
+        crate::http::models::gltf_tile,
+        crate::http::models::gltf_patch,
+        crate::http::models::x3d_tile
+    )
+)]
+pub struct ApiDoc;
+
+/// Routes whose query carries the mode parameters.
+const WITH_MODE_PARAMETERS: &[&str] = &[
+    "/tiles/{id}/{z}/{x}/{y}.{fmt}",
+    "/windows/{id}.{fmt}",
+    "/tiles/{id}/tilejson.json",
+    "/gltf/{id}/{z}/{x}/{y}.{ext}",
+    "/gltf/{id}/patch.glb",
+    "/x3d/{id}/{z}/{x}/{y}.x3d",
+];
+
+/// Adds the common and every mode's request parameters to [`WITH_MODE_PARAMETERS`].
+struct ModeParameters;
+
+fn parameter(spec: &ParamSpec, modes: &[&str]) -> Parameter {
+    let mut schema = ObjectBuilder::new();
+    schema = match spec.kind {
+        Kind::Choice(values) => schema.schema_type(Type::String).enum_values(Some(values.iter().copied())),
+        Kind::Integer { min, max } | Kind::PowerOfTwo { min, max } => {
+            schema.schema_type(Type::Integer).minimum(Some(min as f64)).maximum(Some(max as f64))
+        }
+        Kind::Unit => schema.schema_type(Type::Number).minimum(Some(0.0)).maximum(Some(1.0)),
+        Kind::Levels | Kind::Interval { .. } => schema.schema_type(Type::String),
+    };
+    let applies = if modes.is_empty() { String::new() } else { format!(" (mode={})", modes.join(", mode=")) };
+    let shape = match spec.kind {
+        Kind::Levels => " One value in [0, 1], or a comma list of one per level, coarse to fine.".to_string(),
+        Kind::Interval { min, max } => format!(" LOW,HIGH with {min} <= LOW <= HIGH <= {max}."),
+        Kind::PowerOfTwo { .. } => " A power of two.".to_string(),
+        _ => String::new(),
+    };
+    ParameterBuilder::new()
+        .name(spec.name)
+        .parameter_in(ParameterIn::Query)
+        .required(Required::False)
+        .description(Some(format!("{}{applies}.{shape}", spec.help)))
+        .schema(Some(schema.build()))
+        .build()
+}
+
+impl Modify for ModeParameters {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        let mut params: Vec<Parameter> = COMMON.iter().map(|s| parameter(s, &[])).collect();
+        let mut seen: Vec<(&str, Vec<&str>, ParamSpec)> = Vec::new();
+        for m in textile_core::modes::all() {
+            for s in m.specs.iter().filter(|s| s.scope == Scope::Request) {
+                match seen.iter_mut().find(|(n, _, _)| *n == s.name) {
+                    Some((_, modes, _)) => modes.push(m.name),
+                    None => seen.push((s.name, vec![m.name], *s)),
+                }
+            }
+        }
+        params.extend(seen.iter().map(|(_, modes, s)| parameter(s, modes)));
+        for (path, item) in doc.paths.paths.iter_mut() {
+            if !WITH_MODE_PARAMETERS.contains(&path.as_str()) {
+                continue;
+            }
+            if let Some(op) = item.get.as_mut() {
+                op.parameters.get_or_insert_with(Vec::new).extend(params.iter().cloned());
+            }
+        }
+    }
+}
+
+/// This document.
+#[utoipa::path(get, path = "/openapi.json", tag = "service", responses((status = 200, description = "OpenAPI 3")))]
+pub async fn openapi() -> Json<utoipa::openapi::OpenApi> {
+    Json(ApiDoc::openapi())
+}

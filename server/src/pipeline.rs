@@ -1,0 +1,168 @@
+//! From a validated request to bytes, one way for every front end: the HTTP routes, `textile
+//! render` and (later) exports all describe what they want as an [`ImageJob`], whose cache key
+//! and ETag say everything that determines its bytes, whose [`ImageJob::bytes`] renders it
+//! (tiles and windows mapped onto a mode's view at the right zoom-out; `@2x` tiles one zoom-out
+//! less at twice the size, or each texel as 2×2 pixels at native zoom) and encodes it, and whose
+//! [`produce`] runs that through the tile cache (single flight) on the synthesis pool.
+
+use std::sync::Arc;
+
+use axum::body::Bytes;
+use textile_core::modes::Cost;
+use textile_core::{ModeParams, Pyramid, Rect, Rendered, RgbWindow, View, TILE_SIZE};
+
+use crate::encode::{encode, Effort, Format, ENCODER_VERSION};
+use crate::error::ApiError;
+use crate::request::{TileSpec, WindowSpec};
+use crate::state::AppState;
+use crate::textures::Texture;
+
+/// Label under which glTF/X3D documents are counted (besides the modes' names).
+pub const GLTF_LABEL: &str = "gltf";
+
+/// Version of everything besides the analysis and the mode that determines bytes (each mode's
+/// version is part of its parameters' canonical text).
+pub fn engine_version() -> String {
+    format!("textile/{}/enc{ENCODER_VERSION}", env!("CARGO_PKG_VERSION"))
+}
+
+/// The strong ETag (quoted) for a cache key.
+pub fn etag_for(key: &str) -> String {
+    format!("\"{}\"", &blake3::hash(key.as_bytes()).to_hex()[..32])
+}
+
+/// A cache key: everything that determines an answer's bytes — engine, texture and analysis,
+/// the mode's canonical parameters (name and version included) — then `what` it is.
+pub fn cache_key(tex: &Texture, p: &ModeParams, what: std::fmt::Arguments) -> String {
+    format!("{}|{}|{}|{}|{what}", engine_version(), tex.config.id, tex.file_hash, p.canonical())
+}
+
+/// What part of the texture an image shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    /// A tile.
+    Tile(TileSpec),
+    /// A window.
+    Window(WindowSpec),
+}
+
+/// An image to produce: texture, mode with parameters, and target.
+#[derive(Clone)]
+pub struct ImageJob {
+    /// The texture.
+    pub tex: Arc<Texture>,
+    /// The mode and its parameters.
+    pub params: ModeParams,
+    /// What part.
+    pub target: Target,
+}
+
+impl ImageJob {
+    /// The encoding.
+    pub fn format(&self) -> Format {
+        match self.target {
+            Target::Tile(t) => t.format,
+            Target::Window(w) => w.format,
+        }
+    }
+
+    /// The cache key.
+    pub fn key(&self) -> String {
+        let f = self.format().ext();
+        match self.target {
+            Target::Tile(t) => {
+                cache_key(&self.tex, &self.params, format_args!("tile|{}|{}|{}|{}|{f}", t.z, t.x, t.y, t.scale))
+            }
+            Target::Window(w) => {
+                cache_key(&self.tex, &self.params, format_args!("window|{}|{}|{}|{}|{}|{f}", w.z, w.x, w.y, w.w, w.h))
+            }
+        }
+    }
+
+    /// The strong ETag.
+    pub fn etag(&self) -> String {
+        etag_for(&self.key())
+    }
+
+    /// The view rendered, and whether it is upscaled 2× (`@2x` at native zoom).
+    fn view(&self) -> (View, bool) {
+        let native = self.tex.native_zoom();
+        match self.target {
+            Target::Window(w) => (View { zoom_out: native - w.z, rect: Rect::new(w.x, w.y, w.w, w.h) }, false),
+            Target::Tile(t) => {
+                let k = native - t.z;
+                let (s, big) = (TILE_SIZE, 2 * TILE_SIZE);
+                match (t.scale, k) {
+                    (1, _) => (View { zoom_out: k, rect: Rect::new(s * t.x, s * t.y, s, s) }, false),
+                    (_, k) if k >= 1 => {
+                        (View { zoom_out: k - 1, rect: Rect::new(big * t.x, big * t.y, big, big) }, false)
+                    }
+                    _ => (View { zoom_out: 0, rect: Rect::new(s * t.x, s * t.y, s, s) }, true),
+                }
+            }
+        }
+    }
+
+    /// Render the image through a pyramidal cache.
+    pub fn render(&self, cache: &Pyramid) -> Result<Rendered, ApiError> {
+        let (view, upscale) = self.view();
+        let mut r = self.params.render(&self.tex.source(), cache, view)?;
+        if upscale {
+            r.image = upscale2(&r.image);
+        }
+        Ok(r)
+    }
+
+    /// Encode a rendered image: tightly for modes whose pixels are expensive, fast for cheap ones.
+    pub fn encode(&self, img: &RgbWindow) -> Result<Vec<u8>, ApiError> {
+        let effort = match self.params.info().cost {
+            Cost::Heavy => Effort::Tight,
+            Cost::Light => Effort::Quick,
+        };
+        encode(&img.pixels, img.width, img.height, self.format(), effort)
+            .map_err(|e| ApiError::internal(format!("encoding: {e}")))
+    }
+
+    /// Render and encode: the bytes every front end serves or writes, with the render's figures.
+    pub fn bytes(&self, cache: &Pyramid) -> Result<(Vec<u8>, Rendered), ApiError> {
+        let r = self.render(cache)?;
+        Ok((self.encode(&r.image)?, r))
+    }
+}
+
+/// Bytes for `key` from the tile cache, or from `make` on the synthesis pool (single flight;
+/// counted under `label`). Returns whether it was a cache hit.
+pub async fn cached<F>(st: &Arc<AppState>, key: &str, label: &'static str, make: F) -> (Result<Bytes, ApiError>, bool)
+where
+    F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
+{
+    st.cache.get_or_compute(key, || st.synthesize(label, make)).await
+}
+
+/// A job's bytes through the tile cache and the pool, through the shared pyramidal cache; the
+/// pixels it synthesized and delivered are counted when it actually runs.
+pub async fn produce(st: &Arc<AppState>, job: ImageJob) -> (Result<Bytes, ApiError>, bool) {
+    let mode = job.params.name();
+    let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
+    let pyramid = st.pyramid.clone();
+    let etag = job.etag();
+    cached(st, &etag, mode, move || {
+        let (bytes, r) = job.bytes(&pyramid)?;
+        synthesized.with_label_values(&[mode]).inc_by(r.synthesized);
+        delivered.with_label_values(&[mode]).inc_by(r.image.width as u64 * r.image.height as u64);
+        Ok(bytes)
+    })
+    .await
+}
+
+fn upscale2(img: &RgbWindow) -> RgbWindow {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let mut px = Vec::with_capacity(12 * w * h);
+    for j in 0..2 * h {
+        for i in 0..w * 2 {
+            let s = 3 * ((j / 2) * w + i / 2);
+            px.extend_from_slice(&img.pixels[s..s + 3]);
+        }
+    }
+    RgbWindow { width: 2 * img.width, height: 2 * img.height, pixels: px }
+}

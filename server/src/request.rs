@@ -1,0 +1,128 @@
+//! Validated tile and window requests: path segments and query strings parsed once, at the
+//! edge, into typed values with errors that name the parameter, the value and what is allowed.
+//!
+//! A query is read by one [`ParamReader`]: the server takes its own keys (`v`, a window's
+//! geometry), then the texture's [`textile_core::Defaults`] read `mode`, `seed`, `world` and the
+//! mode's own keys, and whatever is left is refused, naming the mode it belongs to.
+
+use textile_core::{ModeParams, ParamReader};
+
+use crate::encode::Format;
+use crate::error::ApiError;
+use crate::textures::Texture;
+
+/// Smallest tile coordinate.
+pub const COORD_MIN: i64 = -(1 << 31);
+/// Largest tile coordinate.
+pub const COORD_MAX: i64 = (1 << 31) - 1;
+/// Largest window side.
+pub const MAX_WINDOW_SIDE: i64 = 4096;
+/// Largest window origin magnitude, in pixels at the requested zoom.
+pub const MAX_WINDOW_COORD: i64 = 1 << 40;
+/// Longest `v` (cache-busting version) accepted.
+pub const MAX_V: usize = 64;
+
+/// The key–value pairs of a raw query string, percent-decoded, in order.
+pub fn query_pairs(raw: Option<&str>) -> Vec<(String, String)> {
+    form_urlencoded::parse(raw.unwrap_or("").as_bytes()).into_owned().collect()
+}
+
+/// A reader over a raw query string (a repeated key is an error).
+pub fn query_reader(raw: Option<&str>) -> Result<ParamReader, ApiError> {
+    Ok(ParamReader::request(query_pairs(raw))?)
+}
+
+/// Resolve a request's parameters against a texture's defaults: takes `v` (checked, not part
+/// of the content), then the texture reads the rest and refuses leftovers.
+pub fn params(tex: &Texture, mut r: ParamReader) -> Result<ModeParams, ApiError> {
+    if r.take("v").is_some_and(|v| v.len() > MAX_V) {
+        return Err(ApiError::bad_request("invalid_parameter", format!("parameter 'v': at most {MAX_V} characters")));
+    }
+    Ok(tex.defaults.request(&tex.source(), r)?)
+}
+
+/// A tile address.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TileSpec {
+    /// Zoom.
+    pub z: u32,
+    /// Column.
+    pub x: i64,
+    /// Row.
+    pub y: i64,
+    /// 1 (256 px) or 2 (`@2x`, 512 px).
+    pub scale: u32,
+    /// Encoding.
+    pub format: Format,
+}
+
+fn parse_int(name: &str, s: &str, lo: i64, hi: i64) -> Result<i64, ApiError> {
+    let v: i64 = s.parse().map_err(|_| {
+        ApiError::bad_request("invalid_coordinate", format!("'{name}' = '{s}' is not an integer in [{lo}, {hi}]"))
+    })?;
+    if v < lo || v > hi {
+        return Err(ApiError::bad_request("invalid_coordinate", format!("'{name}' = {v} is outside [{lo}, {hi}]")));
+    }
+    Ok(v)
+}
+
+/// Split `NAME.EXT` and parse the format.
+pub fn split_format(s: &str) -> Result<(&str, Format), ApiError> {
+    let (stem, ext) = s.rsplit_once('.').ok_or_else(|| {
+        ApiError::bad_request(
+            "invalid_format",
+            format!("'{s}' has no format extension; use .png, .jpg, .jpeg or .webp"),
+        )
+    })?;
+    let fmt = Format::from_ext(ext).ok_or_else(|| {
+        ApiError::bad_request("invalid_format", format!("format '{ext}' is not supported; use png, jpg, jpeg or webp"))
+    })?;
+    Ok((stem, fmt))
+}
+
+/// Parse `z`, `x` and `y[@2x].fmt` path segments for a texture.
+pub fn parse_tile(tex: &Texture, z: &str, x: &str, y_fmt: &str) -> Result<TileSpec, ApiError> {
+    let (y, format) = split_format(y_fmt)?;
+    let (y, scale) = match y.strip_suffix("@2x") {
+        Some(y) => (y, 2),
+        None => (y, 1),
+    };
+    let z = parse_int("z", z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32;
+    let x = parse_int("x", x, COORD_MIN, COORD_MAX)?;
+    let y = parse_int("y", y, COORD_MIN, COORD_MAX)?;
+    Ok(TileSpec { z, x, y, scale, format })
+}
+
+/// A window request (`/windows/{id}.{fmt}`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WindowSpec {
+    /// Zoom.
+    pub z: u32,
+    /// Left pixel at that zoom.
+    pub x: i64,
+    /// Top pixel at that zoom.
+    pub y: i64,
+    /// Width.
+    pub w: i64,
+    /// Height.
+    pub h: i64,
+    /// Encoding.
+    pub format: Format,
+}
+
+/// Take a window's geometry (`x`, `y`, `w`, `h`, optional `z`) from a query.
+pub fn parse_window(tex: &Texture, r: &mut ParamReader, format: Format) -> Result<WindowSpec, ApiError> {
+    let mut need = |k: &str| {
+        r.take(k).ok_or_else(|| ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required")))
+    };
+    let (x, y, w, h) = (need("x")?, need("y")?, need("w")?, need("h")?);
+    let z = match r.take("z") {
+        Some(z) => parse_int("z", &z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32,
+        None => tex.native_zoom(),
+    };
+    let x = parse_int("x", &x, -MAX_WINDOW_COORD, MAX_WINDOW_COORD)?;
+    let y = parse_int("y", &y, -MAX_WINDOW_COORD, MAX_WINDOW_COORD)?;
+    let w = parse_int("w", &w, 1, MAX_WINDOW_SIDE)?;
+    let h = parse_int("h", &h, 1, MAX_WINDOW_SIDE)?;
+    Ok(WindowSpec { z, x, y, w, h, format })
+}
