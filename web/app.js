@@ -1,8 +1,11 @@
 // textile viewer: a Leaflet map (CRS.Simple, so tile coordinates are unbounded and may be
 // negative) over the infinite texture, with the synthesis controls and a permalink in the URL hash.
+// The mode's controls are built from the parameter specs of /textures/{id} (type, range,
+// default, which modes accept each): a new mode or parameter needs no change here.
 'use strict';
 
-const state = { t: null, m: null, s: 0, r: null, z: null, x: 0, y: 0, g: false };
+// p: the parameters the user changed, by name, as the query string carries them.
+const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false };
 let catalog = null, meta = null, map = null, layer = null, grid = null, debounce = null;
 const $ = (id) => document.getElementById(id);
 
@@ -11,7 +14,7 @@ function readHash() {
   if (p.has('t')) state.t = p.get('t');
   if (p.has('m')) state.m = p.get('m');
   if (p.has('s') && /^\d+$/.test(p.get('s'))) state.s = p.get('s');
-  if (p.has('r')) state.r = p.get('r').split(',').map(Number).filter((v) => v >= 0 && v <= 1);
+  for (const [k, v] of p) if (k.startsWith('p.')) state.p[k.slice(2)] = v;
   if (p.has('z')) state.z = Number(p.get('z'));
   if (p.has('x')) state.x = Number(p.get('x'));
   if (p.has('y')) state.y = Number(p.get('y'));
@@ -21,7 +24,7 @@ function readHash() {
 function hash() {
   const p = new URLSearchParams();
   p.set('t', state.t); p.set('m', state.m); p.set('s', state.s);
-  if (state.r) p.set('r', state.r.map((v) => v.toFixed(2)).join(','));
+  for (const [k, v] of Object.entries(state.p)) p.set(`p.${k}`, v);
   p.set('z', state.z); p.set('x', Math.round(state.x)); p.set('y', Math.round(state.y));
   if (state.g) p.set('g', '1');
   return '#' + p.toString();
@@ -43,7 +46,7 @@ function tileUrl() {
   const q = new URLSearchParams();
   q.set('mode', state.m);
   q.set('seed', state.s);
-  if (state.m === 'synth' && state.r) q.set('randomness', state.r.map((v) => v.toFixed(2)).join(','));
+  for (const [k, v] of Object.entries(state.p)) q.set(k, v);
   return `/tiles/${encodeURIComponent(state.t)}/{z}/{x}/{y}.png?` + q.toString();
 }
 
@@ -74,38 +77,85 @@ function refreshLayer() {
   } else if (layer._url !== url) {
     layer.setUrl(url);
   }
-  $('randomness').disabled = state.m !== 'synth';
   writeHash();
 }
 
-function buildSliders() {
-  const defaults = meta.parameters.randomness.default;
-  if (!state.r || state.r.length !== defaults.length) state.r = null;
-  const values = state.r || defaults;
-  const box = $('sliders');
+// A number as short text: at most 4 decimals, no trailing zeros (0.475 stays 0.475).
+const num = (v) => String(Number(Number(v).toFixed(4)));
+
+// The request parameters of the current mode, from the specs (common ones have their own
+// controls: mode and seed; world is for wrapped web maps).
+function modeParams() {
+  return Object.entries(meta.parameters).filter(([, s]) => s.modes && s.modes.includes(state.m) && s.scope === 'request');
+}
+
+function changed() {
+  clearTimeout(debounce);
+  debounce = setTimeout(refreshLayer, 120);
+}
+
+// One slider: label, range input and live value; `set` receives the new value.
+function slider(id, text, min, max, step, value, aria, set) {
+  const row = document.createElement('div');
+  row.className = 'slider';
+  const label = document.createElement('label');
+  label.htmlFor = id;
+  label.textContent = text;
+  const input = document.createElement('input');
+  Object.assign(input, { type: 'range', id, min, max, step, value });
+  input.setAttribute('aria-label', aria);
+  const out = document.createElement('output');
+  out.htmlFor = id;
+  out.textContent = num(value);
+  input.addEventListener('input', () => { out.textContent = num(input.value); set(Number(input.value)); changed(); });
+  row.append(label, input, out);
+  return row;
+}
+
+// Controls for one parameter spec; values the user did not touch keep their exact defaults.
+function control(name, spec) {
+  const box = document.createElement('div');
+  box.className = 'param';
+  box.title = spec.description;
+  const given = state.p[name];
+  if (spec.type === 'levels') {
+    const values = given ? given.split(',').map(Number) : spec.default.slice();
+    if (values.length !== spec.default.length || values.some((v) => !(v >= 0 && v <= 1))) {
+      delete state.p[name];
+      values.splice(0, values.length, ...spec.default);
+    }
+    const title = document.createElement('p');
+    title.textContent = `${name} per level, coarse → fine`;
+    box.append(title);
+    values.forEach((v, l) => box.append(slider(`p-${name}-${l}`, `level ${l}`, spec.min, spec.max, 0.05, v,
+      `${name} of level ${l} of ${values.length - 1} (0 is coarsest)`,
+      (x) => { values[l] = x; state.p[name] = values.map(num).join(','); })));
+  } else if (spec.type === 'interval') {
+    const values = given ? given.split(',').map(Number) : spec.default.slice();
+    ['low', 'high'].forEach((end, i) => box.append(slider(`p-${name}-${i}`, `${name} ${end}`, spec.min, spec.max, 0.05,
+      values[i], `${name}, ${end} end`, (x) => {
+        values[i] = x;
+        if (values[0] > values[1]) values[1 - i] = x;
+        state.p[name] = values.map(num).join(',');
+      })));
+  } else if (spec.type === 'integer' || spec.type === 'number') {
+    const step = spec.type === 'integer' ? 1 : 0.05;
+    box.append(slider(`p-${name}`, name, spec.min, spec.max, step, given ?? spec.default, spec.description,
+      (x) => { state.p[name] = num(x); }));
+  }
+  return box;
+}
+
+function buildControls() {
+  const box = $('controls');
   box.textContent = '';
-  values.forEach((v, l) => {
-    const row = document.createElement('div');
-    row.className = 'slider';
-    const id = `r${l}`;
-    const label = document.createElement('label');
-    label.htmlFor = id;
-    label.textContent = `level ${l}`;
-    const input = document.createElement('input');
-    Object.assign(input, { type: 'range', id, min: 0, max: 1, step: 0.05, value: v });
-    input.setAttribute('aria-label', `randomness of level ${l} of ${values.length - 1} (0 is coarsest)`);
-    const out = document.createElement('output');
-    out.htmlFor = id;
-    out.textContent = Number(v).toFixed(2);
-    input.addEventListener('input', () => {
-      out.textContent = Number(input.value).toFixed(2);
-      state.r = [...box.querySelectorAll('input')].map((i) => Number(i.value));
-      clearTimeout(debounce);
-      debounce = setTimeout(refreshLayer, 120);
-    });
-    row.append(label, input, out);
-    box.append(row);
-  });
+  const params = modeParams();
+  for (const k of Object.keys(state.p)) if (!params.some(([n]) => n === k)) delete state.p[k];
+  for (const [name, spec] of params) box.append(control(name, spec));
+  $('modename').textContent = `mode=${state.m}`;
+  $('modesummary').textContent = meta.mode_info[state.m] ? meta.mode_info[state.m].summary : '';
+  $('params').hidden = false;
+  if (!params.length) box.textContent = 'This mode has no parameters besides the seed.';
 }
 
 async function selectTexture(id, keepView) {
@@ -121,7 +171,7 @@ async function selectTexture(id, keepView) {
   for (const m of meta.modes) modes.append(new Option(m, m));
   if (!meta.modes.includes(state.m)) state.m = meta.default_mode;
   modes.value = state.m;
-  buildSliders();
+  buildControls();
   map.setMinZoom(meta.minzoom);
   map.setMaxZoom(meta.maxzoom + 2);
   if (layer) { map.removeLayer(layer); layer = null; }
@@ -170,7 +220,7 @@ async function init() {
   setGrid(state.g);
   onMove();
   sel.addEventListener('change', () => selectTexture(sel.value, true));
-  $('mode').addEventListener('change', (e) => { state.m = e.target.value; refreshLayer(); });
+  $('mode').addEventListener('change', (e) => { state.m = e.target.value; buildControls(); refreshLayer(); });
   $('seed').addEventListener('change', (e) => {
     const v = String(e.target.value).trim();
     if (/^\d+$/.test(v)) { state.s = v; refreshLayer(); } else { e.target.value = state.s; }
@@ -180,7 +230,7 @@ async function init() {
     $('seed').value = state.s;
     refreshLayer();
   });
-  $('resetr').addEventListener('click', () => { state.r = null; buildSliders(); refreshLayer(); });
+  $('resetp').addEventListener('click', () => { state.p = {}; buildControls(); refreshLayer(); });
   $('grid').addEventListener('change', (e) => setGrid(e.target.checked));
   $('worldlink').addEventListener('click', (e) => {
     e.currentTarget.href = `/world.html#t=${encodeURIComponent(state.t)}&m=${state.m}&s=${state.s}`;

@@ -127,10 +127,10 @@ test('a randomness slider (by keyboard) changes tile URLs and pixels; the permal
   const old = find(before, key);
   assert.ok(old, `tile ${key} on screen`);
   assert.ok(!old.src.includes('randomness='));
-  await page.focus('#r3');
+  await page.focus('#p-randomness-3');
   for (let i = 0; i < 6; i++) await page.keyboard.press('ArrowRight');
   const moved = Date.now();
-  assert.equal(await page.inputValue('#r3'), '0.9');
+  assert.equal(await page.inputValue('#p-randomness-3'), '0.9');
   await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('randomness=')));
   await settled(page);
   const shown = await page.$$eval('img.leaflet-tile', (l) => l.length);
@@ -138,7 +138,9 @@ test('a randomness slider (by keyboard) changes tile URLs and pixels; the permal
   console.log(`${shown} cold tiles re-rendered ${Date.now() - moved} ms after the slider moved (incl. 120 ms debounce)`);
   const after = await tileStats(page);
   const now = find(after, key);
-  assert.ok(now && now.src.includes('randomness=') && now.src.includes('0.90'), now && now.src);
+  assert.ok(now && now.src.includes('randomness=') && now.src.includes('0.9'), now && now.src);
+  // Levels the user did not touch keep their exact defaults (0.475, not the slider step's 0.5).
+  assert.ok(decodeURIComponent(now.src).includes('randomness=1,1,0.8,0.9,0.475,0.35,0.225,0.1'), now.src);
   assert.notEqual(now.sum, old.sum, 'pixels changed with the randomness');
   await page.fill('#seed', '77');
   await page.press('#seed', 'Enter');
@@ -146,29 +148,45 @@ test('a randomness slider (by keyboard) changes tile URLs and pixels; the permal
   await page.waitForFunction(() => location.hash.includes('s=77'));
   const hash = await page.evaluate(() => location.hash);
   assert.match(hash, /t=grass/);
-  assert.match(hash, /r=[^&]*0\.90/);
+  assert.match(hash, /p\.randomness=[^&]*0\.9/);
   // Restore in a fresh page.
   const second = await open('/' + hash);
   await settled(second.page);
   assert.equal(await second.page.inputValue('#texture'), 'grass');
   assert.equal(await second.page.inputValue('#seed'), '77');
-  assert.equal(await second.page.inputValue('#r3'), '0.9');
+  assert.equal(await second.page.inputValue('#p-randomness-3'), '0.9');
   assert.equal(await second.page.evaluate(() => window.textileMap.getZoom()), 7);
   const restored = await tileStats(second.page);
-  assert.ok(restored.every((s) => s.src.includes('seed=77') && s.src.includes('0.90')));
+  assert.ok(restored.every((s) => s.src.includes('seed=77') && s.src.includes('0.9')));
   assert.deepEqual(errors, []);
   assert.deepEqual(second.errors, []);
   await page.close();
   await second.page.close();
 });
 
-test('mode and texture pickers re-request tiles; zoom out stays within minzoom', async () => {
+test('every mode is offered from the specs, with its own controls; texture picker; zoom out stays within minzoom', async () => {
   const { page, errors } = await open('/#t=gravel&z=7&x=0&y=0');
   await settled(page);
+  const meta = await page.evaluate(async () => (await fetch('/textures/gravel')).json());
+  const offered = await page.$$eval('#mode option', (l) => l.map((o) => o.value));
+  assert.deepEqual(offered, meta.modes);
+  for (const mode of meta.modes) {
+    await page.selectOption('#mode', mode);
+    await page.waitForFunction((m) => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes(`mode=${m}`)), mode);
+    await settled(page);
+    assertTexture(await tileStats(page));
+    // Exactly the request parameters of this mode have controls.
+    for (const [name, spec] of Object.entries(meta.parameters)) {
+      if (!spec.modes || spec.scope !== 'request') continue;
+      const shown = await page.$(`[id^="p-${name}"]`);
+      assert.equal(Boolean(shown), spec.modes.includes(mode), `${name} control with mode=${mode}`);
+    }
+  }
   await page.selectOption('#mode', 'mosaic');
-  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('mode=mosaic')));
+  await page.focus('#p-iterations');
+  await page.keyboard.press('ArrowLeft');
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('iterations=9')));
   await settled(page);
-  assert.ok(await page.$eval('#randomness', (f) => f.disabled), 'randomness does not apply to mosaic');
   await page.selectOption('#texture', 'brick');
   await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('/tiles/brick/')));
   await settled(page);
