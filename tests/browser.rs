@@ -26,9 +26,9 @@ fn viewer_in_headless_chromium() {
     // The viewer opens with a burst of cold tiles; on a slow machine some would wait out the
     // default 1 s queue bound and be shed. Shedding is the second server's subject, so the first
     // one queues instead and every tile it is asked for must come back 200.
-    let server = Server::start_queueing(&[]);
+    let server = Server::builder().queueing().start();
     // A server that sheds almost everything a viewer asks for at once.
-    let shedding = Server::start(&["--max-in-flight", "2", "--workers", "1"]);
+    let shedding = Server::builder().args(&["--max-in-flight", "2", "--workers", "1"]).start();
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("viewer.png");
     let status = Command::new("node")
         .args(["--test", "--test-concurrency=1", "viewer.test.mjs"])

@@ -77,7 +77,7 @@ async fn render_writes_the_same_bytes_as_the_server() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(code, 0, "{err}");
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let (status, body) = s.get_bytes("/tiles/gravel/7/-3/4.png?seed=8").await;
     assert_eq!(status, 200);
     assert_eq!(std::fs::read(&out).unwrap(), body);

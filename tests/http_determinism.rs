@@ -18,7 +18,7 @@ async fn block(s: &Server, id: &str, z: u32, tx: i64, ty: i64, q: &str) -> image
 
 #[tokio::test]
 async fn two_by_two_tiles_equal_one_window() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let edge = (1i64 << 31) - 2;
     for (id, tx, ty) in [("gravel", 0, 0), ("grass", -1, -1), ("brick", 5, -9), ("gravel", edge, -(1 << 31))] {
         let tiles = block(&s, id, 7, tx, ty, "?seed=11").await;
@@ -33,10 +33,10 @@ async fn two_by_two_tiles_equal_one_window() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn same_bytes_across_processes_thread_counts_and_orders() {
-    let a = Server::start(&["--workers", "1"]);
+    let a = Server::builder().args(&["--workers", "1"]).start();
     // b is also sent everything at once below; lift the queue-wait bound so that a slow machine
     // queues those requests instead of shedding some with 503.
-    let b = Server::start_queueing(&["--workers", "2"]);
+    let b = Server::builder().args(&["--workers", "2"]).queueing().start();
     let paths: Vec<String> = [(7, 0, 0), (7, -3, 12), (6, 1, -1), (7, -(1i64 << 31), (1i64 << 31) - 1), (3, 0, 0)]
         .iter()
         .flat_map(|&(z, x, y)| {
@@ -70,7 +70,7 @@ async fn same_bytes_across_processes_thread_counts_and_orders() {
 
 #[tokio::test]
 async fn zoomed_out_tiles_are_reduced_views_of_their_children() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     // z = native - 1: exactly the 2×2 box average of the four native children (up to rounding).
     for (id, x, y) in [("gravel", 0, 0), ("brick", -3, 2)] {
         let parent = s.image(&format!("/tiles/{id}/6/{x}/{y}.png")).await;
@@ -111,7 +111,7 @@ fn mean_abs_diff(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
 
 #[tokio::test]
 async fn world_parameter_makes_the_texture_periodic() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let a = s.get_bytes("/tiles/gravel/7/1/2.png?world=4").await;
     assert_eq!(a.0, 200);
     assert_eq!(s.get_bytes("/tiles/gravel/7/5/2.png?world=4").await, a);

@@ -10,7 +10,7 @@ use support::{assert_error, binary, Server};
 
 #[tokio::test]
 async fn bad_requests_are_json_4xx() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let cases: &[(&str, u16, &str)] = &[
         ("/tiles/gravel/7/abc/0.png", 400, "invalid_coordinate"),
         ("/tiles/gravel/x/0/0.png", 400, "invalid_coordinate"),
@@ -63,7 +63,7 @@ async fn bad_requests_are_json_4xx() {
 #[tokio::test]
 async fn corrupt_analysis_at_start_up_is_recomputed() {
     let dir = tempfile::tempdir().unwrap();
-    let s = Server::start_in(dir.path(), &[], &[]);
+    let s = Server::builder().data_dir(dir.path()).start();
     let before = s.get_bytes("/tiles/gravel/7/2/3.png").await;
     assert_eq!(s.terminate(), Some(0));
     let file = dir.path().join("gravel.tex");
@@ -72,7 +72,7 @@ async fn corrupt_analysis_at_start_up_is_recomputed() {
     bytes[n / 2] ^= 0xFF;
     std::fs::write(&file, &bytes).unwrap();
     std::fs::write(dir.path().join("grass.tex"), &bytes[..100]).unwrap();
-    let s = Server::start_in(dir.path(), &[], &[]);
+    let s = Server::builder().data_dir(dir.path()).start();
     assert_eq!(s.get_bytes("/tiles/gravel/7/2/3.png").await, before);
     assert_eq!(s.get("/tiles/grass/7/0/0.png").await.status(), 200);
     drop(s);
@@ -131,7 +131,7 @@ fn invalid_configuration_stops_start_up_naming_the_key() {
 
 #[tokio::test]
 async fn sigterm_exits_cleanly() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     assert_eq!(s.get("/health").await.status(), 200);
     assert_eq!(s.terminate(), Some(0));
 }
@@ -140,7 +140,11 @@ async fn sigterm_exits_cleanly() {
 async fn bare_binary_serves_with_environment_configuration() {
     // `textile` with no sub-command is `textile serve`; configured here only through TEXTILE_*.
     let data = support::shared_data_dir();
-    let s = Server::spawn(&[], &[("TEXTILE_BIND", "127.0.0.1:0"), ("TEXTILE_DATA_DIR", data.to_str().unwrap())]);
+    let s = Server::builder()
+        .bare()
+        .env("TEXTILE_BIND", "127.0.0.1:0")
+        .env("TEXTILE_DATA_DIR", data.to_str().unwrap())
+        .start();
     assert_eq!(s.json("/ready").await["status"], "ready");
     assert_eq!(s.get("/tiles/brick/7/0/0.png").await.status(), 200);
 }

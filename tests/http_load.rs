@@ -11,7 +11,7 @@ async fn synthesized(s: &Server) -> u64 {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn concurrent_requests_for_one_tile_cause_one_synthesis() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let before = synthesized(&s).await;
     let path = "/tiles/brick/7/123/-456.png?seed=99";
     let mut tasks = Vec::new();
@@ -34,7 +34,7 @@ async fn concurrent_requests_for_one_tile_cause_one_synthesis() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 4)]
 async fn overload_sheds_with_503_and_retry_after() {
-    let s = Server::start(&["--max-in-flight", "1", "--workers", "1"]);
+    let s = Server::builder().args(&["--max-in-flight", "1", "--workers", "1"]).start();
     let mut tasks = Vec::new();
     for i in 0..24 {
         let c = s.client.clone();
@@ -61,11 +61,11 @@ async fn bytes_do_not_depend_on_the_caches_or_the_order() {
     // 1 MiB pyramidal cache (under a hundred blocks), both evicting constantly, reverse order,
     // twice (the second pass re-synthesizes evicted tiles from partly evicted levels). C: no
     // pyramidal cache, requests all at once.
-    let a = Server::start(&[]);
-    let b = Server::start(&["--cache-mib", "1", "--level-cache-mib", "1"]);
+    let a = Server::builder().start();
+    let b = Server::builder().args(&["--cache-mib", "1", "--level-cache-mib", "1"]).start();
     // C sends everything at once: on a slow machine the last of those may queue longer than the
     // default 1 s queue-wait bound and be shed, so that bound is lifted for C.
-    let c = Server::start_queueing(&["--level-cache-mib", "0"]);
+    let c = Server::builder().args(&["--level-cache-mib", "0"]).queueing().start();
     let mut paths: Vec<String> = (0..30)
         .map(|i| {
             let mode = if i % 3 == 0 { "&mode=mosaic" } else { "" };

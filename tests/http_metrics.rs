@@ -16,7 +16,7 @@ fn value(text: &str, series: &str) -> f64 {
 
 #[tokio::test]
 async fn metrics_count_requests_cache_and_syntheses() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     for _ in 0..3 {
         assert_eq!(s.get("/tiles/gravel/7/4/4.png?mode=mosaic").await.status(), 200);
     }
@@ -58,7 +58,7 @@ async fn metrics_count_requests_cache_and_syntheses() {
 
 #[test]
 fn loadtest_runs_every_pattern_and_reports() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let dir = tempfile::tempdir().unwrap();
     let replay = dir.path().join("urls.txt");
     std::fs::write(&replay, format!("# recorded\n/tiles/grass/7/0/0.png\n{}/tiles/grass/6/1/1.png?seed=2\n", s.base))

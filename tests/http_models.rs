@@ -42,7 +42,7 @@ fn image_bytes(json: &Value, bin: &[u8], i: usize) -> Vec<u8> {
 
 #[tokio::test]
 async fn glb_embeds_the_tile_and_is_well_formed() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let r = s.get("/gltf/gravel/6/-3/2.glb?seed=4").await;
     assert_eq!(r.status(), 200);
     assert_eq!(r.headers()["content-type"], "model/gltf-binary");
@@ -73,7 +73,7 @@ async fn glb_embeds_the_tile_and_is_well_formed() {
 
 #[tokio::test]
 async fn gltf_json_images_resolve_to_the_tile() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     for q in ["", "?seed=9&mode=mosaic"] {
         let r = s.get(&format!("/gltf/brick/7/5/-6.gltf{q}")).await;
         assert_eq!(r.status(), 200);
@@ -92,7 +92,7 @@ async fn gltf_json_images_resolve_to_the_tile() {
 
 #[tokio::test]
 async fn patch_has_one_node_per_tile() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let (status, b) = s.get_bytes("/gltf/grass/patch.glb?z=7&x=-1&y=4&tiles=3&seed=2").await;
     assert_eq!(status, 200);
     let (json, bin) = parse_glb(&b);
@@ -109,7 +109,7 @@ async fn patch_has_one_node_per_tile() {
 
 #[tokio::test]
 async fn x3d_is_well_formed_and_points_at_the_tile() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let r = s.get("/x3d/gravel/7/1/2.x3d?seed=3").await;
     assert_eq!(r.status(), 200);
     assert_eq!(r.headers()["content-type"], "model/x3d+xml");
@@ -139,7 +139,7 @@ async fn x3d_is_well_formed_and_points_at_the_tile() {
 
 #[tokio::test]
 async fn bad_model_requests_are_json_4xx() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     for (path, status, code) in [
         ("/gltf/gravel/8/0/0.glb", 400, "invalid_coordinate"),
         ("/gltf/gravel/7/x/0.glb", 400, "invalid_coordinate"),

@@ -7,7 +7,7 @@ use support::{assert_error, gravel_textures_config, paste, Server};
 
 #[tokio::test]
 async fn mosaic_tiles_equal_windows_and_differ_from_synth() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     for (z, tx, ty, q) in
         [(7, 0, 0, "mode=mosaic"), (7, -5, 3, "mode=mosaic&seed=4&world=8"), (5, -1, -1, "mode=mosaic")]
     {
@@ -30,8 +30,8 @@ async fn mosaic_tiles_equal_windows_and_differ_from_synth() {
 
 #[tokio::test]
 async fn mosaic_is_deterministic_across_processes() {
-    let a = Server::start(&["--workers", "1"]);
-    let b = Server::start(&["--workers", "2"]);
+    let a = Server::builder().args(&["--workers", "1"]).start();
+    let b = Server::builder().args(&["--workers", "2"]).start();
     for p in [
         "/tiles/grass/7/9/-9.png?mode=mosaic&seed=2",
         "/tiles/grass/4/0/0.png?mode=mosaic",
@@ -45,7 +45,7 @@ async fn mosaic_is_deterministic_across_processes() {
 
 #[tokio::test]
 async fn mosaic_parameters_are_validated() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     for q in [
         "mode=mosaic&iterations=65",
         "mode=mosaic&iterations=-1",
@@ -67,7 +67,7 @@ async fn mosaic_parameters_are_validated() {
 async fn a_texture_can_default_to_mosaic() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = gravel_textures_config(dir.path(), &[("gravel", ""), ("cheap", "default_mode = \"mosaic\"")]);
-    let s = Server::start(&["--config", cfg.to_str().unwrap()]);
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
     let cat = s.json("/catalog").await;
     assert_eq!(cat["textures"][1]["default_mode"], "mosaic");
     let cheap = s.get_bytes("/tiles/cheap/7/2/2.png").await;

@@ -8,7 +8,7 @@ use support::{binary, gravel_textures_config, shared_data_dir, Server};
 
 #[tokio::test]
 async fn tiles_decode_to_the_right_size_in_every_format() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     for fmt in ["png", "jpg", "jpeg", "webp"] {
         let img = s.image(&format!("/tiles/gravel/7/3/-2.{fmt}")).await;
         assert_eq!(img.dimensions(), (256, 256), "{fmt}");
@@ -25,7 +25,7 @@ async fn tiles_decode_to_the_right_size_in_every_format() {
 
 #[tokio::test]
 async fn tilejson_is_valid_and_its_template_fetches_tiles() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let tj = s.json("/tiles/grass/tilejson.json?seed=5&randomness=0.4").await;
     assert_eq!(tj["tilejson"], "3.0.0");
     assert_eq!(tj["scheme"], "xyz");
@@ -54,7 +54,7 @@ async fn tilejson_is_valid_and_its_template_fetches_tiles() {
 
 #[tokio::test]
 async fn catalog_and_metadata_agree() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let cat = s.json("/catalog").await;
     let list = cat["textures"].as_array().unwrap();
     let ids: Vec<&str> = list.iter().map(|t| t["id"].as_str().unwrap()).collect();
@@ -82,7 +82,7 @@ async fn catalog_and_metadata_agree() {
 
 #[tokio::test]
 async fn etag_304_cache_headers_head_and_cors() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let path = "/tiles/brick/7/11/-7.png?seed=77";
     let first = s.client.get(s.url(path)).header("Origin", "https://example.org").send().await.unwrap();
     assert_eq!(first.status(), 200);
@@ -115,7 +115,7 @@ async fn etag_304_cache_headers_head_and_cors() {
 
 #[tokio::test]
 async fn health_ready_viewer_and_openapi() {
-    let s = Server::start(&[]);
+    let s = Server::builder().start();
     let h = s.json("/health").await;
     assert_eq!(h["status"], "ok");
     let r = s.json("/ready").await;
@@ -152,7 +152,7 @@ async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = gravel_textures_config(dir.path(), &[("plain", ""), ("coherent", "[textures.synth]\nkappa = 1.0")]);
     let data = shared_data_dir();
-    let s = Server::start(&["--config", cfg.to_str().unwrap()]);
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
     let k = |v: &serde_json::Value| v["settings"]["synth"]["kappa"].as_f64().unwrap();
     assert!((k(&s.json("/textures/plain").await) - 0.2).abs() < 1e-4);
     assert_eq!(k(&s.json("/textures/coherent").await), 1.0);
@@ -179,6 +179,6 @@ async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     assert!(status.success());
     assert_eq!(std::fs::read(&out).unwrap(), coherent);
     // The shipped configuration gives gravel κ = 0.5.
-    let d = Server::start(&[]);
+    let d = Server::builder().start();
     assert_eq!(k(&d.json("/textures/gravel").await), 0.5);
 }

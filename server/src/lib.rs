@@ -24,7 +24,6 @@ pub mod metrics;
 pub mod pipeline;
 pub mod queue;
 pub mod request;
-pub mod serve;
 pub mod state;
 pub mod textures;
 
@@ -33,8 +32,8 @@ pub fn run() -> std::process::ExitCode {
     use clap::Parser;
     let cli = cli::Cli::parse();
     let result = match cli.command {
-        None => serve::run(cli.serve),
-        Some(cli::Command::Serve(a)) => serve::run(a),
+        None => http::serve::run(cli.serve),
+        Some(cli::Command::Serve(a)) => http::serve::run(a),
         Some(cli::Command::Analyze(a)) => commands::analyze(a),
         Some(cli::Command::Render(a)) => commands::render(a),
         Some(cli::Command::Info(a)) => commands::info(a),

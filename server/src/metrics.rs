@@ -8,6 +8,9 @@ use prometheus::{
 };
 use textile_core::PyramidStats;
 
+/// Label under which glTF documents are counted in the per-mode metrics, besides the modes.
+pub const GLTF_LABEL: &str = "gltf";
+
 /// Every metric of the service.
 pub struct Metrics {
     registry: Registry,

@@ -17,9 +17,6 @@ use crate::request::{TileSpec, WindowSpec};
 use crate::state::AppState;
 use crate::textures::Texture;
 
-/// Label under which glTF/X3D documents are counted (besides the modes' names).
-pub const GLTF_LABEL: &str = "gltf";
-
 /// Version of everything besides the analysis and the mode that determines bytes (each mode's
 /// version is part of its parameters' canonical text).
 pub fn engine_version() -> String {

@@ -70,7 +70,7 @@ impl AppState {
     pub fn syntheses(&self) -> u64 {
         textile_core::MODE_NAMES
             .iter()
-            .chain(&[crate::pipeline::GLTF_LABEL])
+            .chain(&[crate::metrics::GLTF_LABEL])
             .map(|m| self.metrics.syntheses.with_label_values(&[m]).get())
             .sum()
     }

@@ -43,30 +43,68 @@ pub struct Server {
     log: PathBuf,
 }
 
+/// How to start a server: `Server::builder().args(&[…]).queueing().start()`.
+#[derive(Default)]
+pub struct Builder {
+    args: Vec<std::ffi::OsString>,
+    env: Vec<(String, String)>,
+    data_dir: Option<PathBuf>,
+    bare: bool,
+}
+
+impl Builder {
+    /// Extra command-line arguments of `serve`.
+    pub fn args(mut self, args: &[&str]) -> Self {
+        self.args.extend(args.iter().map(|a| a.into()));
+        self
+    }
+
+    /// An environment variable.
+    pub fn env(mut self, key: &str, value: &str) -> Self {
+        self.env.push((key.into(), value.into()));
+        self
+    }
+
+    /// Another data directory than the tests' shared one.
+    pub fn data_dir(mut self, dir: &Path) -> Self {
+        self.data_dir = Some(dir.to_path_buf());
+        self
+    }
+
+    /// Lift the queue-wait bound: for tests that send many cold tiles at once and need every one
+    /// answered 200 even on a slow machine (shedding has tests of its own).
+    pub fn queueing(self) -> Self {
+        self.env("TEXTILE_MAX_QUEUE_WAIT_MS", "600000")
+    }
+
+    /// Run the bare binary with only the given arguments and environment (no `serve --bind
+    /// --data-dir`): the environment must make it bind a free port.
+    pub fn bare(mut self) -> Self {
+        self.bare = true;
+        self
+    }
+
+    /// Start it and wait until it is ready.
+    pub fn start(self) -> Server {
+        let mut args: Vec<std::ffi::OsString> = Vec::new();
+        if !self.bare {
+            let dir = self.data_dir.unwrap_or_else(shared_data_dir);
+            args.extend(["serve".into(), "--bind".into(), "127.0.0.1:0".into(), "--data-dir".into()]);
+            args.push(dir.into_os_string());
+        }
+        args.extend(self.args);
+        let env: Vec<(&str, &str)> = self.env.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
+        Server::spawn(&args, &env)
+    }
+}
+
 impl Server {
-    /// Start with the shared data dir and extra arguments.
-    pub fn start(extra: &[&str]) -> Server {
-        let dir = shared_data_dir();
-        Self::start_in(&dir, extra, &[])
+    /// A builder of a server (shared data dir, `serve` on a free port).
+    pub fn builder() -> Builder {
+        Builder::default()
     }
 
-    /// Start with the shared data dir and extra arguments, with the queue-wait bound lifted: for
-    /// tests that send many cold tiles at once and need every one answered 200 even on a slow
-    /// machine (shedding has tests of its own).
-    pub fn start_queueing(extra: &[&str]) -> Server {
-        Self::start_in(&shared_data_dir(), extra, &[("TEXTILE_MAX_QUEUE_WAIT_MS", "600000")])
-    }
-
-    /// Start with a given data dir, extra arguments and environment.
-    pub fn start_in(data_dir: &Path, extra: &[&str], env: &[(&str, &str)]) -> Server {
-        let mut args: Vec<std::ffi::OsString> = vec!["serve".into(), "--bind".into(), "127.0.0.1:0".into()];
-        args.extend(["--data-dir".into(), data_dir.as_os_str().to_owned()]);
-        args.extend(extra.iter().map(|a| a.into()));
-        Self::spawn(&args, env)
-    }
-
-    /// Start the binary with exactly these arguments and environment (it must bind a free port).
-    pub fn spawn(args: &[std::ffi::OsString], env: &[(&str, &str)]) -> Server {
+    fn spawn(args: &[std::ffi::OsString], env: &[(&str, &str)]) -> Server {
         let log_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("server-logs");
         std::fs::create_dir_all(&log_dir).expect("log dir");
         static STARTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);

@@ -1,7 +1,7 @@
 //! The HTTP service: routes, middleware (CORS, compression of JSON, panic → 500 JSON) and the
 //! modules behind them: errors as HTTP answers, content headers, request extraction, and the
 //! route modules (images, descriptive endpoints, 3D assets, static files, OpenAPI), which import
-//! nothing from each other. Nothing outside this folder names it but the server's start-up.
+//! nothing from each other. Nothing outside this folder names it: the crate root dispatches `textile serve` to [`serve`].
 
 pub mod content;
 pub mod error;
@@ -10,6 +10,7 @@ pub mod images;
 pub mod meta;
 pub mod models;
 pub mod openapi;
+pub mod serve;
 pub mod static_files;
 
 use std::sync::Arc;

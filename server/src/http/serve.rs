@@ -52,7 +52,7 @@ async fn serve(cfg: Config) -> CliResult {
     let addr = listener.local_addr()?;
     crate::memory::tune_allocator();
     let state = Arc::new(AppState::new(cfg));
-    let app = crate::http::router(state.clone());
+    let app = super::router(state.clone());
     info!("listening on http://{addr}/ (loading textures)");
     let loader = {
         let state = state.clone();
