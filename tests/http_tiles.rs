@@ -182,3 +182,49 @@ async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     let d = Server::builder().start();
     assert_eq!(k(&d.json("/textures/gravel").await), 0.5);
 }
+
+#[tokio::test]
+async fn every_listed_mode_is_served_and_its_tiles_equal_one_window() {
+    // Whatever modes the server lists (a new mode is covered without editing this test): 2×2
+    // tiles equal the same area as one window, at native zoom and one step out; a mode's key
+    // given to another mode is refused naming the mode it belongs to; /metrics counts each.
+    let s = Server::builder().start();
+    let meta = s.json("/textures/brick").await;
+    let modes: Vec<String> =
+        meta["modes"].as_array().unwrap().iter().map(|m| m.as_str().unwrap().to_string()).collect();
+    assert!(modes.len() >= 2, "{modes:?}");
+    for mode in &modes {
+        for (z, x0, y0) in [(7, -1, 2), (6, 3, -4)] {
+            let mut stitched = image::RgbImage::new(512, 512);
+            for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let tile = s.image(&format!("/tiles/brick/{z}/{}/{}.png?mode={mode}&seed=5", x0 + i, y0 + j)).await;
+                support::paste(&mut stitched, &tile, 256 * i as u32, 256 * j as u32);
+            }
+            let window = s
+                .image(&format!(
+                    "/windows/brick.png?mode={mode}&seed=5&x={}&y={}&w=512&h=512&z={z}",
+                    256 * x0,
+                    256 * y0
+                ))
+                .await;
+            assert!(window == stitched, "mode={mode}: 2x2 tiles at z={z} differ from one window");
+        }
+        for (name, spec) in meta["parameters"].as_object().unwrap() {
+            let Some(owners) = spec["modes"].as_array() else { continue };
+            if owners.iter().any(|m| m == mode.as_str()) {
+                continue;
+            }
+            let r = s.get(&format!("/tiles/brick/7/0/0.png?mode={mode}&{name}=1")).await;
+            assert_eq!(r.status(), 400, "{name} given to mode={mode}");
+            let body: serde_json::Value = r.json().await.unwrap();
+            assert!(
+                body["message"].as_str().unwrap().contains(&format!("mode={}", owners[0].as_str().unwrap())),
+                "{body}"
+            );
+        }
+    }
+    let metrics = s.get("/metrics").await.text().await.unwrap();
+    for mode in &modes {
+        assert!(metrics.contains(&format!("textile_syntheses_total{{mode=\"{mode}\"}}")), "{mode} not counted");
+    }
+}
