@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Quality benchmark (issue: core engine). Synthesizes 512×512 from each development exemplar
 # (../shared/exemplars/NAME.png, 128×128) with four settings — default parameters, correction
-# off, plain tiling (randomness 0), and the cheap chaos-mosaic mode — scores them with ../shared/tools/texq.py and writes
+# off, plain tiling (mode=tiling), and the cheap chaos-mosaic mode — scores them with ../shared/tools/texq.py and writes
 #   bench/out/quality/scores.md     the texq table (one block per setting, mean rows)
 #   docs/contact-sheet.png          exemplar beside the default output, for every exemplar
 # Usage: bench/quality.sh [extra render args, e.g. --seed 3]
@@ -20,7 +20,7 @@ for f in "$SHARED"/exemplars/*.png; do
   cp "$f" "$OUT/exemplars/"
   "$BIN" render --exemplar "$f" "$WIN" "$@" -o "$OUT/default/$name.png" >/dev/null
   "$BIN" render --exemplar "$f" "$WIN" --param passes=0 "$@" -o "$OUT/no_correction/$name.png" >/dev/null
-  "$BIN" render --exemplar "$f" "$WIN" --param randomness=0 --param passes=0 -o "$OUT/tiling/$name.png" >/dev/null
+  "$BIN" render --exemplar "$f" "$WIN" --mode tiling -o "$OUT/tiling/$name.png" >/dev/null
   "$BIN" render --exemplar "$f" "$WIN" --mode mosaic "$@" -o "$OUT/mosaic/$name.png" >/dev/null
 done
 python3 "$SHARED/tools/texq.py" table --exemplar-dir "$OUT/exemplars" \

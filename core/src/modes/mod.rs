@@ -214,6 +214,7 @@ macro_rules! modes {
 modes! {
     Synth => synth::Synth,
     Mosaic => mosaic::Mosaic,
+    Tiling => tiling::Tiling,
 }
 
 impl ModeParams {

@@ -1,0 +1,89 @@
+//! `mode=tiling`: the exemplar repeated, as it is — the reference every synthesis is compared
+//! with (quality tables, "better-looking than tiling"). Native pixels are exemplar texels at
+//! `(x mod m, y mod m)`; a zoomed-out pixel is the exact box average of the texels it covers,
+//! which for an aligned power-of-two block is the exemplar's box mip, and the exemplar's mean
+//! once a pixel covers a whole period. Needs only the exemplar; seed and world change nothing
+//! (its period, the exemplar side, divides every allowed world).
+
+use serde_json::{json, Map, Value};
+
+use crate::cache::Pyramid;
+use crate::error::{CoreError, Result};
+use crate::image::{box_mip, Rendered, RgbWindow};
+use crate::modes::params::{check_period, Common, ParamReader, ParamSpec};
+use crate::modes::{Cost, Mode, Needs, Source, View};
+
+/// Largest window, in pixels, one call may render (2^26).
+pub const MAX_PIXELS: i64 = 1 << 26;
+
+/// The tiling mode.
+pub struct Tiling;
+
+/// Tiling parameters: only the common ones, kept so that requests stay canonical.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
+pub struct TilingParams {
+    /// Accepted like every mode's; the tiling does not depend on it.
+    pub seed: u64,
+    /// Accepted like every mode's; every allowed period is a multiple of the exemplar side.
+    pub period: Option<i64>,
+}
+
+impl Mode for Tiling {
+    const NAME: &'static str = "tiling";
+    const VERSION: u32 = 1;
+    const SUMMARY: &'static str = "the exemplar repeated as it is: the reference that synthesis improves on";
+    const NEEDS: Needs = Needs::Exemplar;
+    const COST: Cost = Cost::Light;
+    type Params = TilingParams;
+
+    fn specs() -> &'static [ParamSpec] {
+        &[]
+    }
+
+    fn defaults() -> TilingParams {
+        TilingParams::default()
+    }
+
+    fn parse(base: &TilingParams, common: &Common, _: &mut ParamReader, src: &Source) -> Result<TilingParams> {
+        let mut p = base.clone();
+        common.apply(&mut p.seed, &mut p.period);
+        check_period(p.period, src.side())?;
+        Ok(p)
+    }
+
+    fn values(p: &TilingParams, _: &Source) -> Map<String, Value> {
+        let mut m = Map::new();
+        m.insert("seed".into(), json!(p.seed));
+        m
+    }
+
+    fn canonical(_: &TilingParams) -> String {
+        String::new()
+    }
+
+    fn render(_: &TilingParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
+        let rect = view.rect;
+        if rect.is_empty() || rect.area() > MAX_PIXELS {
+            return Err(CoreError::Window {
+                width: rect.width(),
+                height: rect.height(),
+                message: format!("must be non-empty with at most {MAX_PIXELS} pixels"),
+            });
+        }
+        let ex = src.exemplar;
+        let n = ex.side as usize;
+        let lvl = view.zoom_out.min(src.levels()) as usize;
+        let mip = if lvl == 0 { ex.pixels.clone() } else { box_mip(&ex.pixels, n, lvl) };
+        let side = (n >> lvl) as i64;
+        let (w, h) = (rect.width() as usize, rect.height() as usize);
+        let mut pixels = Vec::with_capacity(3 * w * h);
+        for y in rect.y0..rect.y1 {
+            let row = y.rem_euclid(side) as usize * side as usize;
+            for x in rect.x0..rect.x1 {
+                pixels.extend_from_slice(&mip[row + x.rem_euclid(side) as usize]);
+            }
+        }
+        let image = RgbWindow { width: w as u32, height: h as u32, pixels };
+        Ok(Rendered { image, synthesized: rect.area() as u64 })
+    }
+}
