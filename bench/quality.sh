@@ -8,6 +8,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHARED=${SHARED:-../shared}
+if [ ! -d "$SHARED/exemplars" ] || [ ! -f "$SHARED/tools/texq.py" ]; then
+  echo "bench/quality.sh: needs the development set and texq.py in $SHARED (set SHARED=DIR); not found" >&2
+  exit 1
+fi
 OUT=bench/out/quality
 python3 -c 'import numpy, scipy, PIL' 2>/dev/null || pip install -q numpy scipy pillow
 cargo build --release -q -p textile-server

@@ -101,6 +101,11 @@ fn invalid_configuration_stops_start_up_naming_the_key() {
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
     assert_ne!(code, Some(0));
     assert!(err.contains("cache_mb"), "{err}");
+    // A bad value names the key and the file it came from.
+    std::fs::write(&cfg, "cache_mib = \"lots\"\n").unwrap();
+    let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("key 'cache_mib'") && err.contains(cfg.to_str().unwrap()), "{err}");
     std::fs::write(&cfg, "[[textures]]\nid = \"x\"\nname = \"X\"\nexemplar = \"e.png\"\ndefault_mode = \"magic\"\n")
         .unwrap();
     let (code, err) = run(&["serve", "--config", cfg.to_str().unwrap()], &[]);

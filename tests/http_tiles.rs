@@ -171,12 +171,12 @@ async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     );
     // `textile render --texture` uses the texture's κ too.
     let out = dir.path().join("tile.png");
-    let status = std::process::Command::new(binary())
+    let run = std::process::Command::new(binary())
         .args(["render", "--config", cfg.to_str().unwrap(), "--data-dir", data.to_str().unwrap()])
         .args(["--texture", "coherent", "--x", "1", "--y", "2", "-o", out.to_str().unwrap()])
-        .status()
+        .output()
         .unwrap();
-    assert!(status.success());
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     assert_eq!(std::fs::read(&out).unwrap(), coherent);
     // The shipped configuration gives gravel κ = 0.5.
     let d = Server::builder().start();
@@ -227,4 +227,38 @@ async fn every_listed_mode_is_served_and_its_tiles_equal_one_window() {
     for mode in &modes {
         assert!(metrics.contains(&format!("textile_syntheses_total{{mode=\"{mode}\"}}")), "{mode} not counted");
     }
+}
+
+#[tokio::test]
+async fn a_users_texture_beside_the_built_ins() {
+    // The README's worked example: one [[textures]] entry with only id and exemplar (a
+    // non-square image, path relative to the configuration file), keeping the built-ins.
+    let dir = tempfile::tempdir().unwrap();
+    let img = image::RgbImage::from_fn(300, 200, |x, y| {
+        image::Rgb([(x * 7 % 256) as u8, (y * 11 % 256) as u8, ((x ^ y) % 256) as u8])
+    });
+    std::fs::create_dir(dir.path().join("textures")).unwrap();
+    img.save(dir.path().join("textures/mine.png")).unwrap();
+    let cfg = dir.path().join("textile.toml");
+    std::fs::write(
+        &cfg,
+        "include_default_textures = true\n\n[[textures]]\nid = \"mine\"\nexemplar = \"textures/mine.png\"\n",
+    )
+    .unwrap();
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    let ids: Vec<String> = s.json("/catalog").await["textures"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["id"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(ids, ["gravel", "grass", "brick", "mine"]);
+    let meta = s.json("/textures/mine").await;
+    assert_eq!(meta["name"], "mine", "name defaults to the id");
+    let e = &meta["exemplar"];
+    assert_eq!(
+        (e["input_width"].as_u64(), e["input_height"].as_u64(), e["crop_side"].as_u64()),
+        (Some(300), Some(200), Some(200))
+    );
+    assert_eq!(s.image("/tiles/mine/7/0/0.png").await.dimensions(), (256, 256));
 }

@@ -17,7 +17,13 @@ fn exemplar(side: u32) -> Exemplar {
     // The 256² gravel of the development set, area-resampled to the side wanted.
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/exemplars/gravel_256.png");
     let bytes = std::fs::read(&path)
-        .or_else(|_| std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png")))
+        .or_else(|_| {
+            eprintln!(
+                "{} not found (the development set beside the repository); using the embedded 128² gravel",
+                path.display()
+            );
+            std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png"))
+        })
         .expect("an exemplar");
     let img = image::load_from_memory(&bytes).expect("decode").to_rgba8();
     let img = image::imageops::resize(&img, side, side, image::imageops::FilterType::Triangle);

@@ -4,12 +4,16 @@
 mod common;
 
 use textile_core::modes::synth::{render, Randomness, SynthParams};
-use textile_core::{ExemplarOptions, Rect};
+use textile_core::{Analysis, NoProgress, Rect};
+
+fn toroidal(side: u32, salt: u64) -> Analysis {
+    Analysis::build(&common::toroidal_exemplar(side, salt), &NoProgress)
+}
 
 #[test]
 fn zero_randomness_on_toroidal_exemplars_is_exact_tiling() {
-    for name in ["smallstone_tile.png", "leaves_tile.png"] {
-        let an = common::analyse(&common::shared_exemplar(name), ExemplarOptions::default());
+    for (name, side, salt) in [("64² waves", 64, 1), ("128² waves", 128, 2)] {
+        let an = toroidal(side, salt);
         assert!(an.header.toroidal, "{name} should be detected as toroidal");
         let p = SynthParams { randomness: Randomness::Uniform(0), ..SynthParams::default() };
         let m = an.side() as i64;
@@ -26,7 +30,7 @@ fn zero_randomness_on_toroidal_exemplars_is_exact_tiling() {
 
 #[test]
 fn randomness_changes_the_tiling() {
-    let an = common::analyse(&common::shared_exemplar("smallstone_tile.png"), ExemplarOptions::default());
+    let an = toroidal(64, 3);
     let m = an.side() as i64;
     let r = Rect::new(0, 0, 2 * m, 2 * m);
     let tiled =

@@ -40,9 +40,9 @@ pub enum Command {
 #[derive(Debug, Args, Clone, Default)]
 pub struct ConfigArgs {
     /// Configuration file (TOML), layered over the built-in defaults.
-    #[arg(long, value_name = "FILE", env = "TEXTILE_CONFIG")]
+    #[arg(long, value_name = "FILE", env = "TEXTILE_CONFIG", hide_env_values = true)]
     pub config: Option<PathBuf>,
-    /// Directory where analyses are stored [env TEXTILE_DATA_DIR].
+    /// Directory where analyses are stored [env: TEXTILE_DATA_DIR].
     #[arg(long, value_name = "DIR")]
     pub data_dir: Option<String>,
 }
@@ -52,19 +52,19 @@ pub struct ConfigArgs {
 pub struct ServeArgs {
     #[command(flatten)]
     pub config: ConfigArgs,
-    /// Address to listen on, e.g. 127.0.0.1:8080 (port 0: any free port) [env TEXTILE_BIND].
+    /// Address to listen on, e.g. 127.0.0.1:8080 (port 0: any free port) [env: TEXTILE_BIND].
     #[arg(long, value_name = "ADDR")]
     pub bind: Option<String>,
-    /// Tile cache size in MiB [env TEXTILE_CACHE_MIB].
+    /// Tile cache size in MiB [env: TEXTILE_CACHE_MIB].
     #[arg(long, value_name = "MIB")]
     pub cache_mib: Option<u64>,
-    /// Pyramidal cache size in MiB, 0 = off [env TEXTILE_LEVEL_CACHE_MIB].
+    /// Pyramidal cache size in MiB, 0 = off [env: TEXTILE_LEVEL_CACHE_MIB].
     #[arg(long, value_name = "MIB")]
     pub level_cache_mib: Option<u64>,
-    /// Synthesis threads, 0 = one per core [env TEXTILE_WORKER_THREADS].
+    /// Synthesis threads, 0 = one per core [env: TEXTILE_WORKER_THREADS].
     #[arg(long, value_name = "N")]
     pub workers: Option<usize>,
-    /// Syntheses in flight before answering 503 [env TEXTILE_MAX_IN_FLIGHT].
+    /// Syntheses in flight before answering 503 [env: TEXTILE_MAX_IN_FLIGHT].
     #[arg(long, value_name = "N")]
     pub max_in_flight: Option<usize>,
     /// Print the effective configuration as TOML and exit.

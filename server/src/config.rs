@@ -60,7 +60,8 @@ impl Toroidal {
 pub struct TextureConfig {
     /// URL id: 1–64 of `a-z 0-9 _ -`.
     pub id: String,
-    /// Display name.
+    /// Display name (default: the id).
+    #[serde(default)]
     pub name: String,
     /// Exemplar path (relative to the config file) or `embedded:NAME`.
     pub exemplar: String,
@@ -150,6 +151,10 @@ pub struct Config {
     pub max_queue_wait_ms: u64,
     /// Largest exemplar side accepted.
     pub max_exemplar_side: u32,
+    /// Keep the built-in textures beside a configuration file's own `[[textures]]` (which
+    /// otherwise replace them); a texture of the same id replaces the built-in one.
+    #[serde(default)]
+    pub include_default_textures: bool,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
     /// Directory relative exemplar paths are resolved against (set by the loader).
@@ -194,19 +199,46 @@ impl Config {
             if !path.is_file() {
                 return Err(ConfigError(format!("config file {} does not exist", path.display())));
             }
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| ConfigError(format!("config file {}: {e}", path.display())))?;
-            fig = fig.merge(Toml::string(&text));
+            std::fs::read_to_string(path).map_err(|e| ConfigError(format!("config file {}: {e}", path.display())))?;
+            fig = fig.merge(Toml::file_exact(path));
             if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
                 base_dir = dir.to_path_buf();
             }
         }
         fig = fig.merge(Env::prefixed("TEXTILE_").only(ENV_KEYS)).merge(Serialized::defaults(overrides));
         let mut cfg: Config = fig.extract().map_err(|e| {
-            let msgs: Vec<String> = e.into_iter().map(|e| e.to_string()).collect();
+            let msgs: Vec<String> = e
+                .into_iter()
+                .map(|e| {
+                    let from = match e.metadata.as_ref() {
+                        Some(m) => m.source.as_ref().map(|s| s.to_string()).unwrap_or_else(|| m.name.to_string()),
+                        None => "the configuration".into(),
+                    };
+                    let from =
+                        if from.contains("TOML source string") { "the built-in configuration".into() } else { from };
+                    match e.path.is_empty() {
+                        true => format!("{} (in {from})", e.kind),
+                        false => format!("key '{}' (in {from}): {}", e.path.join("."), e.kind),
+                    }
+                })
+                .collect();
             ConfigError(msgs.join("; "))
         })?;
         cfg.base_dir = base_dir;
+        for t in &mut cfg.textures {
+            if t.name.is_empty() {
+                t.name = t.id.clone();
+            }
+        }
+        if cfg.include_default_textures {
+            let builtin: Config = Figment::from(Toml::string(DEFAULT_CONFIG))
+                .extract()
+                .map_err(|e| ConfigError(format!("the built-in configuration: {e}")))?;
+            let mine: Vec<String> = cfg.textures.iter().map(|t| t.id.clone()).collect();
+            let mut all: Vec<TextureConfig> = builtin.textures.into_iter().filter(|t| !mine.contains(&t.id)).collect();
+            all.append(&mut cfg.textures);
+            cfg.textures = all;
+        }
         cfg.validate()?;
         Ok(cfg)
     }

@@ -223,7 +223,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             "latency_ms_200": { "p50": pct(&ok, 0.5), "p90": pct(&ok, 0.9), "p99": pct(&ok, 0.99), "max": pct(&ok, 1.0) },
             "status": statuses, "bytes": bytes,
             "server_cache_hit_ratio": if hits + misses > 0.0 { hits / (hits + misses) } else { 0.0 },
-            "server_syntheses": textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_syntheses_total{{mode=\"{m}\"}}"))).sum::<f64>(),
+            "server_syntheses": textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_syntheses_total{{mode=\"{m}\"}}"))).sum::<f64>() as u64,
             "server_computation_ratio": ratio,
         });
         // Write the report; a reader that went away (a closed pipe) is not an error worth a panic.

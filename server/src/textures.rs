@@ -150,6 +150,22 @@ pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress
         let bytes = exemplar_bytes(cfg, t)?;
         let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
         let ex = Exemplar::from_bytes(&bytes, &opts).map_err(core)?;
+        let prep = &ex.preparation;
+        if prep.input_width != prep.input_height || prep.crop_side != ex.side {
+            log(format!(
+                "texture '{}': exemplar {}x{} {}resized to {}x{} (exemplars are used as power-of-two squares)",
+                t.id,
+                prep.input_width,
+                prep.input_height,
+                if prep.input_width != prep.input_height {
+                    format!("cropped to its central {0}x{0} and ", prep.crop_side)
+                } else {
+                    String::new()
+                },
+                ex.side,
+                ex.side
+            ));
+        }
         let path = data_dir.join(format!("{}.tex", t.id));
         let expected = Analysis::id_for(&ex);
         let analysis = match Analysis::load(&path) {

@@ -212,3 +212,37 @@ pub async fn assert_error(s: &Server, path: &str, status: u16, code: &str) {
 pub fn paste(dst: &mut image::RgbImage, src: &image::RgbImage, x: u32, y: u32) {
     image::imageops::replace(dst, src, x as i64, y as i64);
 }
+
+/// Make the npm packages of a test folder ready: `npm ci` (pinned by its lockfile) when
+/// `node_modules/<package>` is missing. `Err` says why it cannot be (no node or npm, no
+/// registry), for [`skip`].
+pub fn npm_ready(dir: &Path, package: &str) -> Result<(), String> {
+    let works = |cmd: &str| Command::new(cmd).arg("--version").output().is_ok_and(|o| o.status.success());
+    if !works("node") {
+        return Err("node is not installed (Debian: apt-get install nodejs npm)".into());
+    }
+    if dir.join("node_modules").join(package).exists() {
+        return Ok(());
+    }
+    if !works("npm") {
+        return Err(format!("npm is not installed, and {} has no node_modules", dir.display()));
+    }
+    let out = Command::new("npm")
+        .args(["ci", "--no-audit", "--no-fund", "--loglevel=error"])
+        .current_dir(dir)
+        .output()
+        .map_err(|e| format!("npm ci: {e}"))?;
+    if !out.status.success() || !dir.join("node_modules").join(package).exists() {
+        return Err(format!("`npm ci` in {} failed: {}", dir.display(), String::from_utf8_lossy(&out.stderr).trim()));
+    }
+    Ok(())
+}
+
+/// A suite that cannot run here: under `CI` that is a failure; elsewhere the notice goes to the
+/// terminal itself (cargo's output capture swallows `eprintln!` of passing tests), so the
+/// README's test command shows what it skipped and why.
+pub fn skip(test: &str, why: &str) {
+    assert!(std::env::var_os("CI").is_none(), "{test} cannot run under CI: {why}");
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "\n    SKIPPED {test}: {why}\n");
+}

@@ -35,9 +35,13 @@ pub fn run(args: ServeArgs) -> CliResult {
         print!("{}", toml::to_string_pretty(&cfg)?);
         return Ok(());
     }
+    let filter = tracing_subscriber::EnvFilter::try_from_env("TEXTILE_LOG")
+        .or_else(|_| tracing_subscriber::EnvFilter::try_from_default_env())
+        .unwrap_or_else(|_| "info".into());
     tracing_subscriber::fmt()
-        .with_env_filter(tracing_subscriber::EnvFilter::try_from_env("TEXTILE_LOG").unwrap_or_else(|_| "info".into()))
+        .with_env_filter(filter)
         .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .init();
     rayon::ThreadPoolBuilder::new()
         .num_threads(cfg.worker_threads)
@@ -69,7 +73,8 @@ async fn serve(cfg: Config) -> CliResult {
     match loader.await? {
         Ok(()) => {
             let n = state.registry.get().map(|r| r.list.len()).unwrap_or(0);
-            println!("textile ready: viewer at http://{addr}/ ({n} textures)");
+            let plural = if n == 1 { "" } else { "s" };
+            println!("textile ready: viewer at http://{addr}/ ({n} texture{plural})");
             use std::io::Write;
             let _ = std::io::stdout().flush();
         }
