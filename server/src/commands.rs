@@ -89,9 +89,12 @@ pub fn info(a: InfoArgs) -> CliResult {
     Ok(())
 }
 
-/// Every mode's parameters, one per line, for `textile render --list-params`.
-fn list_params() {
-    let line = |s: &textile_core::ParamSpec, who: &str| {
+/// Every mode's parameters, one per line, for `textile render --list-params` (a closed pipe,
+/// as with `| head`, ends the listing quietly).
+fn list_params() -> std::io::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let line = |out: &mut std::io::StdoutLock, s: &textile_core::ParamSpec, who: &str| {
         let d = s.describe();
         let range = match (d.get("min"), d.get("max"), d.get("values")) {
             (_, _, Some(v)) if v.is_array() => format!("one of {v}"),
@@ -99,30 +102,29 @@ fn list_params() {
             _ => String::new(),
         };
         let scope = if s.scope == Scope::Texture { ", texture setting" } else { "" };
-        println!(
-            "  {:<12} {who:<8} {} {range}{scope}\n               {}",
-            s.name,
-            d["type"].as_str().unwrap_or(""),
-            s.help
-        );
+        let kind = d["type"].as_str().unwrap_or("");
+        writeln!(out, "  {:<12} {who:<8} {kind} {range}{scope}\n               {}", s.name, s.help)
     };
-    println!("common (--mode, --seed, --world, or --param):");
+    writeln!(out, "common (--mode, --seed, --world, or --param):")?;
     for s in COMMON {
-        line(s, "");
+        line(&mut out, s, "")?;
     }
     for m in textile_core::modes::all() {
-        println!("mode={} (v{}): {}", m.name, m.version, m.summary);
+        writeln!(out, "mode={} (v{}): {}", m.name, m.version, m.summary)?;
         for s in m.specs {
-            line(s, m.name);
+            line(&mut out, s, m.name)?;
         }
     }
+    Ok(())
 }
 
 /// `textile render`.
 pub fn render(a: RenderArgs) -> CliResult {
     if a.list_params {
-        list_params();
-        return Ok(());
+        return match list_params() {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+            _ => Ok(()),
+        };
     }
     let output = a.output.clone().ok_or("--output is required")?;
     let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
