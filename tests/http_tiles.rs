@@ -150,12 +150,12 @@ async fn health_ready_viewer_and_openapi() {
 #[tokio::test]
 async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = gravel_textures_config(dir.path(), &[("plain", ""), ("coherent", "[textures.synth]\nkappa = 1.0")]);
+    let cfg = gravel_textures_config(dir.path(), &[("plain", ""), ("coherent", "[textures.synth]\nkappa = 0.3")]);
     let data = shared_data_dir();
     let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
     let k = |v: &serde_json::Value| v["settings"]["synth"]["kappa"].as_f64().unwrap();
-    assert!((k(&s.json("/textures/plain").await) - 0.2).abs() < 1e-4);
-    assert_eq!(k(&s.json("/textures/coherent").await), 1.0);
+    assert_eq!(k(&s.json("/textures/plain").await), 1.0, "the default κ");
+    assert_eq!(k(&s.json("/textures/coherent").await), 0.3);
     let (plain, coherent) = (s.get("/tiles/plain/7/1/2.png").await, s.get("/tiles/coherent/7/1/2.png").await);
     assert_ne!(plain.headers()["etag"], coherent.headers()["etag"]);
     let coherent = coherent.bytes().await.unwrap();
@@ -178,9 +178,10 @@ async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
         .unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     assert_eq!(std::fs::read(&out).unwrap(), coherent);
-    // The shipped configuration gives gravel κ = 0.5.
+    // The shipped configuration gives brick κ = 0.5, gravel the default.
     let d = Server::builder().start();
-    assert_eq!(k(&d.json("/textures/gravel").await), 0.5);
+    assert_eq!(k(&d.json("/textures/brick").await), 0.5);
+    assert_eq!(k(&d.json("/textures/gravel").await), 1.0);
 }
 
 #[tokio::test]

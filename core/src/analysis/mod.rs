@@ -17,11 +17,16 @@ use crate::analysis::features::{
 use crate::analysis::stack::{build_stack, to_u8};
 use crate::exemplar::{Exemplar, Preparation};
 
-/// Version of the synthesis algorithm (hash, tags, filters, schedules). Part of every ETag:
-/// bump it whenever any output pixel could change.
-pub const ALGORITHM_VERSION: u32 = 1;
-/// First pyramid level that is corrected (LH05: levels 0–2 are not).
-pub const FIRST_CORRECTED_LEVEL: u32 = 3;
+/// Version of the analysis (its content and file layout; part of the analysis id, so a change
+/// recomputes stored analyses). Each mode's output has its own version (`Mode::VERSION`).
+pub const ALGORITHM_VERSION: u32 = 2;
+/// First pyramid level that is corrected. LH05 leaves levels 0–2 uncorrected; we also leave
+/// level 3, whose 5×5 neighbourhood at stride `h_3 = m/8` spans over half the exemplar: there,
+/// correction grows coherent runs that can only repeat the few positions the exemplar offers
+/// at that scale, and the repetition shows as regular streaks 64–100 texels apart when zoomed
+/// out (texq `streak` 3.5–6.6 on the development set; 1.5–2.6 without, bench/README.md).
+/// From level 4 on (`h ≤ m/16`) neighbourhoods span at most a quarter of the exemplar.
+pub const FIRST_CORRECTED_LEVEL: u32 = 4;
 
 /// Receives progress from long computations (analysis), so front ends can show it.
 pub trait Progress: Sync {

@@ -40,7 +40,7 @@ const KAPPA: ParamSpec = ParamSpec {
     name: "kappa",
     kind: Kind::Unit,
     scope: Scope::Texture,
-    help: "κ, the penalty on jumps to a pixel's second candidate: higher keeps exemplar patches more coherent",
+    help: "κ, the penalty on jumps to a pixel's second candidate (default 1): higher keeps exemplar patches more coherent and the colour distribution closer to the exemplar's",
 };
 const PASSES: ParamSpec = ParamSpec {
     name: "passes",
@@ -63,7 +63,7 @@ fn unit_value(v: u32) -> f64 {
 
 impl Mode for Synth {
     const NAME: &'static str = "synth";
-    const VERSION: u32 = 1;
+    const VERSION: u32 = 2;
     const SUMMARY: &'static str = "parallel controllable texture synthesis (Lefebvre & Hoppe 2005)";
     const NEEDS: Needs = Needs::Analysis;
     const COST: Cost = Cost::Heavy;

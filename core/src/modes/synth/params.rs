@@ -89,7 +89,7 @@ impl Default for SynthParams {
             randomness: Randomness::Default,
             passes: 2,
             subpasses: 4,
-            kappa: (0.2 * ONE_Q16 as f64).round() as u32,
+            kappa: ONE_Q16,
             period: None,
         }
     }

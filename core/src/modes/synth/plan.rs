@@ -119,7 +119,9 @@ mod tests {
         (r.width(), r.height())
     }
 
-    /// The worked example of design note §1.6 (m = 128, L = 7, tile [0,256)²).
+    /// The worked example of design note §1.6 (m = 128, L = 7, tile [0,256)²), with one change:
+    /// level 3 is no longer corrected (`FIRST_CORRECTED_LEVEL` = 4), so it needs no padding and
+    /// the coarser levels need less. Levels 7–4 are the note's table exactly.
     #[test]
     fn plan_matches_design_table_for_tile_at_origin() {
         let plans = plan_window(7, Rect::new(0, 0, 256, 256), &schedule(2, 4));
@@ -128,10 +130,10 @@ mod tests {
             (6, (-5, 133, -5, 134), (157, 161)),
             (5, (-7, 72, -8, 73), (97, 101)),
             (4, (-8, 41, -9, 42), (69, 73)),
-            (3, (-9, 26, -10, 27), (53, 57)),
-            (2, (-9, 18, -10, 19), (27, 29)),
-            (1, (-5, 9, -5, 10), (14, 15)),
-            (0, (-3, 5, -3, 5), (8, 8)),
+            (3, (-9, 26, -10, 27), (35, 37)),
+            (2, (-5, 13, -5, 14), (18, 19)),
+            (1, (-3, 7, -3, 7), (10, 10)),
+            (0, (-2, 4, -2, 4), (6, 6)),
         ];
         for (l, (x0, x1, y0, y1), size) in expect {
             let p = &plans[l];
