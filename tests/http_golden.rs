@@ -16,8 +16,8 @@ const GOLDEN: &[(&str, &str, &str)] = &[
     ("/tiles/grass/6/1/-1.jpg?randomness=0.5", "ee8c0b8659ae8c36", "\"84d697e260231728f90b8015aec15e62\""),
     ("/tiles/brick/7/-2/3@2x.png", "7366f6b1c9991301", "\"035f0b23fbf745b8d491ad7700590e56\""),
     ("/tiles/brick/6/1/1@2x.webp?world=4", "0f9114787a7d266a", "\"a73d92bfbdaf3cff0e7afcb9b9a0fd08\""),
-    ("/tiles/gravel/7/4/-4.png?mode=mosaic", "095cf9b2dad29c4e", "\"bd6e2685aa5255e967336c7cd2fcb8d6\""),
-    ("/tiles/brick/3/0/0.png?mode=mosaic&iterations=3&block_area=0.3,0.6&smoothing=1", "bf40f43dd27957a4", "\"ff384c1bc629724f75861650d09b0dca\""),
+    ("/tiles/gravel/7/4/-4.png?mode=mosaic", "095cf9b2dad29c4e", "\"e83c8b3a43aab0b71ff1c15e996d7764\""),
+    ("/tiles/brick/3/0/0.png?mode=mosaic&iterations=3&block_area=0.3,0.6&smoothing=1", "bf40f43dd27957a4", "\"de3fdb2bad197a8664fbb6cb7f4fcd44\""),
     ("/windows/grass.png?x=-100&y=50&w=300&h=200&z=6", "4cea7bf8d6ae23cf", "\"9d3e60d1f1782efb47a45407e01271a9\""),
 ];
 

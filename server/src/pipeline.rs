@@ -8,7 +8,7 @@
 use std::sync::Arc;
 
 use axum::body::Bytes;
-use textile_core::modes::Cost;
+use textile_core::modes::{Cost, Needs};
 use textile_core::{ModeParams, Pyramid, Rect, Rendered, RgbWindow, View, TILE_SIZE};
 
 use crate::encode::{encode, Effort, Format, ENCODER_VERSION};
@@ -28,10 +28,15 @@ pub fn etag_for(key: &str) -> String {
     format!("\"{}\"", &blake3::hash(key.as_bytes()).to_hex()[..32])
 }
 
-/// A cache key: everything that determines an answer's bytes — engine, texture and analysis,
-/// the mode's canonical parameters (name and version included) — then `what` it is.
+/// A cache key: everything that determines an answer's bytes — engine, texture, what the mode
+/// renders from (the analysis file, or only the exemplar for modes that need nothing more), the
+/// mode's canonical parameters (name and version included) — then `what` it is.
 pub fn cache_key(tex: &Texture, p: &ModeParams, what: std::fmt::Arguments) -> String {
-    format!("{}|{}|{}|{}|{what}", engine_version(), tex.config.id, tex.file_hash, p.canonical())
+    let source = match p.info().needs {
+        Needs::Analysis => &tex.file_hash,
+        Needs::Exemplar => &tex.exemplar_hash,
+    };
+    format!("{}|{}|{source}|{}|{what}", engine_version(), tex.config.id, p.canonical())
 }
 
 /// What part of the texture an image shows.
@@ -162,4 +167,39 @@ fn upscale2(img: &RgbWindow) -> RgbWindow {
         }
     }
     RgbWindow { width: 2 * img.width, height: 2 * img.height, pixels: px }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::TextureConfig;
+    use crate::encode::Format;
+    use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress, ParamReader};
+
+    #[test]
+    fn only_modes_that_need_the_analysis_are_keyed_by_it() {
+        let bytes = crate::textures::embedded("gravel.png").unwrap_or_default();
+        let ex = Exemplar::from_bytes(bytes, &ExemplarOptions::default()).expect("embedded exemplar");
+        let an = Analysis::build(&ex, &NoProgress);
+        let tex = Texture::new(TextureConfig::new("gravel", "embedded:gravel.png"), 0, ex, an).expect("texture");
+        let target = Target::Tile(TileSpec { z: 7, x: 1, y: -2, scale: 1, format: Format::Png });
+        let key = |tex: &Arc<Texture>, mode: &str| {
+            let params = tex.defaults.request(&tex.source(), ParamReader::request([("mode", mode)]).unwrap()).unwrap();
+            ImageJob { tex: tex.clone(), params, target }.key()
+        };
+        let a = Arc::new(tex);
+        // The same texture with another analysis file (e.g. a new analysis version).
+        let b = Arc::new(Texture {
+            config: a.config.clone(),
+            exemplar: a.exemplar.clone(),
+            analysis: a.analysis.clone(),
+            file_hash: "another analysis".into(),
+            exemplar_hash: a.exemplar_hash.clone(),
+            exemplar_png: Vec::new(),
+            defaults: a.defaults.clone(),
+        });
+        assert_ne!(key(&a, "synth"), key(&b, "synth"));
+        assert_eq!(key(&a, "mosaic"), key(&b, "mosaic"));
+        assert_eq!(key(&a, "tiling"), key(&b, "tiling"));
+    }
 }

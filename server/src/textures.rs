@@ -30,8 +30,12 @@ pub struct Texture {
     pub exemplar: Exemplar,
     /// The exemplar analysis.
     pub analysis: Arc<Analysis>,
-    /// Hash of the stored analysis bytes (part of every ETag and the TileJSON version).
+    /// Hash of the stored analysis bytes (part of the ETags of modes that need the analysis, and
+    /// of the TileJSON version).
     pub file_hash: String,
+    /// Hash of the prepared exemplar (side, toroidal flag, pixels): part of the ETags of modes
+    /// that need only the exemplar, so a new analysis never expires their tiles.
+    pub exemplar_hash: String,
     /// The prepared exemplar as PNG.
     pub exemplar_png: Vec<u8>,
     /// Parameters a request starts from: default mode, and each mode's configured defaults.
@@ -53,7 +57,14 @@ impl Texture {
         let src = Source::new(&exemplar, &analysis);
         let defaults = Defaults::configure(&src, &config.default_mode, config.default_seed, &config.mode_tables())
             .map_err(|source| LoadError::Defaults { id: config.id.clone(), index, source })?;
-        Ok(Texture { config, exemplar, analysis: Arc::new(analysis), file_hash, exemplar_png, defaults })
+        let mut h = blake3::Hasher::new();
+        h.update(&exemplar.side.to_le_bytes());
+        h.update(&[exemplar.toroidal as u8]);
+        for p in &exemplar.pixels {
+            h.update(p);
+        }
+        let exemplar_hash = h.finalize().to_hex()[..16].to_string();
+        Ok(Texture { config, exemplar, analysis: Arc::new(analysis), file_hash, exemplar_hash, exemplar_png, defaults })
     }
 
     /// What the modes render from.
