@@ -263,3 +263,39 @@ async fn a_users_texture_beside_the_built_ins() {
     );
     assert_eq!(s.image("/tiles/mine/7/0/0.png").await.dimensions(), (256, 256));
 }
+
+#[tokio::test]
+async fn modes_that_need_only_the_exemplar_serve_while_the_analysis_is_computed() {
+    // A 512² exemplar takes far longer to analyse than these requests take.
+    let dir = tempfile::tempdir().unwrap();
+    let img = image::RgbImage::from_fn(512, 512, |x, y| {
+        let h = (x.wrapping_mul(2_654_435_761) ^ y.wrapping_mul(40_503)).wrapping_mul(2_246_822_519) >> 24;
+        image::Rgb([(h & 0xFF) as u8, ((x / 8 + y / 5) % 256) as u8, ((x ^ y) % 256) as u8])
+    });
+    img.save(dir.path().join("big.png")).unwrap();
+    let cfg = dir.path().join("textile.toml");
+    std::fs::write(&cfg, "[[textures]]\nid = \"big\"\nexemplar = \"big.png\"\n").unwrap();
+    let data = dir.path().join("data");
+    let s = Server::builder().data_dir(&data).args(&["--config", cfg.to_str().unwrap()]).start_loading().await;
+    // The registry appears as soon as the exemplar is decoded.
+    let mut meta = serde_json::Value::Null;
+    for _ in 0..200 {
+        let r = s.get("/textures/big").await;
+        if r.status() == 200 {
+            meta = r.json().await.unwrap();
+            break;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+    }
+    assert_eq!(meta["analysis"]["status"], "analysing", "{meta}");
+    assert_eq!(meta["native_zoom"], 9);
+    assert_eq!(s.get("/ready").await.status(), 503);
+    assert_eq!(s.image("/tiles/big/9/0/-1.png?mode=mosaic").await.dimensions(), (256, 256));
+    assert_eq!(s.image("/tiles/big/6/2/2.png?mode=tiling").await.dimensions(), (256, 256));
+    let r = s.get("/tiles/big/9/0/0.png").await;
+    assert_eq!(r.status(), 503, "synth needs the analysis");
+    assert!(r.headers().contains_key("retry-after"));
+    let body: serde_json::Value = r.json().await.unwrap();
+    assert_eq!(body["error"], "not_ready", "{body}");
+    assert!(body["message"].as_str().unwrap().contains("mode=synth"), "{body}");
+}

@@ -33,7 +33,7 @@ pub fn etag_for(key: &str) -> String {
 /// mode's canonical parameters (name and version included) — then `what` it is.
 pub fn cache_key(tex: &Texture, p: &ModeParams, what: std::fmt::Arguments) -> String {
     let source = match p.info().needs {
-        Needs::Analysis => &tex.file_hash,
+        Needs::Analysis => tex.file_hash().unwrap_or("analysing"),
         Needs::Exemplar => &tex.exemplar_hash,
     };
     format!("{}|{}|{source}|{}|{what}", engine_version(), tex.config.id, p.canonical())
@@ -189,11 +189,12 @@ mod tests {
         };
         let a = Arc::new(tex);
         // The same texture with another analysis file (e.g. a new analysis version).
+        let other = std::sync::OnceLock::new();
+        let _ = other.set((a.analysis().cloned().expect("analysed"), "another analysis".to_string()));
         let b = Arc::new(Texture {
             config: a.config.clone(),
             exemplar: a.exemplar.clone(),
-            analysis: a.analysis.clone(),
-            file_hash: "another analysis".into(),
+            analysis: other,
             exemplar_hash: a.exemplar_hash.clone(),
             exemplar_png: Vec::new(),
             defaults: a.defaults.clone(),

@@ -5,6 +5,7 @@
 //! geometry), then the texture's [`textile_core::Defaults`] read `mode`, `seed`, `world` and the
 //! mode's own keys, and whatever is left is refused, naming the mode it belongs to.
 
+use textile_core::modes::Needs;
 use textile_core::{ModeParams, ParamReader};
 
 use crate::encode::Format;
@@ -33,12 +34,18 @@ pub fn query_reader(raw: Option<&str>) -> Result<ParamReader, ApiError> {
 }
 
 /// Resolve a request's parameters against a texture's defaults: takes `v` (checked, not part
-/// of the content), then the texture reads the rest and refuses leftovers.
+/// of the content), then the texture reads the rest and refuses leftovers. A mode that needs
+/// the texture's analysis answers 503 `not_ready` (with `Retry-After`) while it is computed.
 pub fn params(tex: &Texture, mut r: ParamReader) -> Result<ModeParams, ApiError> {
     if r.take("v").is_some_and(|v| v.len() > MAX_V) {
         return Err(ApiError::bad_request("invalid_parameter", format!("parameter 'v': at most {MAX_V} characters")));
     }
-    Ok(tex.defaults.request(&tex.source(), r)?)
+    let p = tex.defaults.request(&tex.source(), r)?;
+    if p.info().needs == Needs::Analysis && tex.analysis().is_none() {
+        let mode = p.name();
+        return Err(textile_core::CoreError::NotAnalysed { mode }.into());
+    }
+    Ok(p)
 }
 
 /// A tile address.

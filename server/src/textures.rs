@@ -1,10 +1,12 @@
 //! The texture registry: for each configured texture, its exemplar (embedded or from disk), its
 //! analysis (loaded from the data directory when current, recomputed and stored atomically when
-//! missing, stale or damaged) and the defaults requests fall back to.
+//! missing, stale or damaged) and the defaults requests fall back to. Loading has two phases:
+//! [`prepare_registry`] decodes every exemplar (fast: modes that need only the exemplar can
+//! serve at once), then [`analyse_registry`] loads or computes each analysis.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, Progress, Source};
 
@@ -28,11 +30,9 @@ pub struct Texture {
     pub config: TextureConfig,
     /// The prepared exemplar.
     pub exemplar: Exemplar,
-    /// The exemplar analysis.
-    pub analysis: Arc<Analysis>,
-    /// Hash of the stored analysis bytes (part of the ETags of modes that need the analysis, and
-    /// of the TileJSON version).
-    pub file_hash: String,
+    /// The exemplar analysis and the hash of its stored bytes (part of the ETags of modes that
+    /// need the analysis, and of the TileJSON version), once loaded or computed.
+    pub analysis: OnceLock<(Arc<Analysis>, String)>,
     /// Hash of the prepared exemplar (side, toroidal flag, pixels): part of the ETags of modes
     /// that need only the exemplar, so a new analysis never expires their tiles.
     pub exemplar_hash: String,
@@ -43,18 +43,17 @@ pub struct Texture {
 }
 
 impl Texture {
-    /// A texture from its configuration (`index`: its place in the configuration, for errors),
-    /// prepared exemplar and analysis.
-    pub fn new(config: TextureConfig, index: usize, exemplar: Exemplar, analysis: Analysis) -> Result<Self, LoadError> {
-        let file_hash = analysis.file_hash();
-        let m = analysis.side();
-        let rgb: Vec<u8> = analysis.exemplar.iter().flatten().copied().collect();
+    /// A texture from its configuration (`index`: its place in the configuration, for errors)
+    /// and prepared exemplar, without its analysis yet.
+    pub fn prepare(config: TextureConfig, index: usize, exemplar: Exemplar) -> Result<Self, LoadError> {
+        let m = exemplar.side;
+        let rgb: Vec<u8> = exemplar.pixels.iter().flatten().copied().collect();
         let exemplar_png = crate::encode::encode(&rgb, m, m, crate::encode::Format::Png, crate::encode::Effort::Tight)
             .map_err(|e| LoadError::Core {
                 id: config.id.clone(),
                 source: textile_core::CoreError::ExemplarUndecodable(e.to_string()),
             })?;
-        let src = Source::new(&exemplar, &analysis);
+        let src = Source { exemplar: &exemplar, analysis: None };
         let defaults = Defaults::configure(&src, &config.default_mode, config.default_seed, &config.mode_tables())
             .map_err(|source| LoadError::Defaults { id: config.id.clone(), index, source })?;
         let mut h = blake3::Hasher::new();
@@ -64,16 +63,39 @@ impl Texture {
             h.update(p);
         }
         let exemplar_hash = h.finalize().to_hex()[..16].to_string();
-        Ok(Texture { config, exemplar, analysis: Arc::new(analysis), file_hash, exemplar_hash, exemplar_png, defaults })
+        Ok(Texture { config, exemplar, analysis: OnceLock::new(), exemplar_hash, exemplar_png, defaults })
+    }
+
+    /// A texture with its analysis.
+    pub fn new(config: TextureConfig, index: usize, exemplar: Exemplar, analysis: Analysis) -> Result<Self, LoadError> {
+        let t = Texture::prepare(config, index, exemplar)?;
+        t.set_analysis(analysis);
+        Ok(t)
+    }
+
+    /// Attach the analysis (once; later calls are ignored).
+    pub fn set_analysis(&self, analysis: Analysis) {
+        let hash = analysis.file_hash();
+        let _ = self.analysis.set((Arc::new(analysis), hash));
+    }
+
+    /// The analysis, once available.
+    pub fn analysis(&self) -> Option<&Arc<Analysis>> {
+        self.analysis.get().map(|(a, _)| a)
+    }
+
+    /// The hash of the stored analysis, once available.
+    pub fn file_hash(&self) -> Option<&str> {
+        self.analysis.get().map(|(_, h)| h.as_str())
     }
 
     /// What the modes render from.
     pub fn source(&self) -> Source<'_> {
-        Source::new(&self.exemplar, &self.analysis)
+        Source { exemplar: &self.exemplar, analysis: self.analysis().map(|a| a.as_ref()) }
     }
     /// Zoom at which one tile pixel is one texel.
     pub fn native_zoom(&self) -> u32 {
-        self.analysis.levels()
+        self.exemplar.side.trailing_zeros()
     }
     /// Smallest zoom served.
     pub fn min_zoom(&self) -> u32 {
@@ -96,6 +118,11 @@ impl Registry {
     /// The texture with this id.
     pub fn get(&self, id: &str) -> Option<&Arc<Texture>> {
         self.by_id.get(id)
+    }
+
+    /// Has every texture its analysis?
+    pub fn analysed(&self) -> bool {
+        self.list.iter().all(|t| t.analysis().is_some())
     }
 }
 
@@ -151,10 +178,9 @@ pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadEr
     std::fs::read(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path, source })
 }
 
-/// Load or compute the analysis of every configured texture. `log` receives one line per
-/// event; `progress` receives analysis progress.
-pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress) -> Result<Registry, LoadError> {
-    let data_dir = cfg.data_dir();
+/// Decode every configured texture's exemplar: a registry whose textures have no analysis yet.
+/// `log` receives one line per event.
+pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, LoadError> {
     let mut list = Vec::new();
     for (index, t) in cfg.textures.iter().enumerate() {
         let core = |source| LoadError::Core { id: t.id.clone(), source };
@@ -177,8 +203,28 @@ pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress
                 ex.side
             ));
         }
+        list.push(Arc::new(Texture::prepare(t.clone(), index, ex)?));
+    }
+    let by_id = list.iter().map(|t| (t.config.id.clone(), t.clone())).collect();
+    Ok(Registry { list, by_id })
+}
+
+/// Load or compute the analysis of every texture of a prepared registry, in configuration order
+/// (each texture serves its analysis-needing modes as soon as its own is attached). `progress`
+/// receives analysis progress.
+pub fn analyse_registry(
+    cfg: &Config,
+    reg: &Registry,
+    log: &dyn Fn(String),
+    progress: &dyn Progress,
+) -> Result<(), LoadError> {
+    let data_dir = cfg.data_dir();
+    for tex in &reg.list {
+        let t = &tex.config;
+        let ex = &tex.exemplar;
+        let core = |source| LoadError::Core { id: t.id.clone(), source };
         let path = data_dir.join(format!("{}.tex", t.id));
-        let expected = Analysis::id_for(&ex);
+        let expected = Analysis::id_for(ex);
         let analysis = match Analysis::load(&path) {
             Ok(a) if a.header.id == expected => {
                 log(format!("texture '{}': loaded analysis {} from {}", t.id, a.header.id, path.display()));
@@ -195,7 +241,7 @@ pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress
                     Err(e) => log(format!("texture '{}': {e}; recomputing", t.id)),
                 }
                 let started = std::time::Instant::now();
-                let a = Analysis::build(&ex, progress);
+                let a = Analysis::build(ex, progress);
                 a.save(&path).map_err(core)?;
                 log(format!(
                     "texture '{}': analysed {}x{} in {:.2}s, stored {}",
@@ -208,8 +254,14 @@ pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress
                 a
             }
         };
-        list.push(Arc::new(Texture::new(t.clone(), index, ex, analysis)?));
+        tex.set_analysis(analysis);
     }
-    let by_id = list.iter().map(|t| (t.config.id.clone(), t.clone())).collect();
-    Ok(Registry { list, by_id })
+    Ok(())
+}
+
+/// Both phases: every texture with its analysis.
+pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress) -> Result<Registry, LoadError> {
+    let reg = prepare_registry(cfg, log)?;
+    analyse_registry(cfg, &reg, log, progress)?;
+    Ok(reg)
 }

@@ -84,6 +84,37 @@ impl Builder {
         self
     }
 
+    /// Start it on a free port and return as soon as it answers `/health`, before its textures
+    /// are analysed (the "ready" line comes only after every analysis).
+    pub async fn start_loading(self) -> Server {
+        let port = std::net::TcpListener::bind("127.0.0.1:0").expect("free port").local_addr().expect("addr").port();
+        let dir = self.data_dir.unwrap_or_else(shared_data_dir);
+        let mut args: Vec<std::ffi::OsString> =
+            vec!["serve".into(), "--bind".into(), format!("127.0.0.1:{port}").into()];
+        args.extend(["--data-dir".into(), dir.into_os_string()]);
+        args.extend(self.args);
+        let log_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("server-logs");
+        std::fs::create_dir_all(&log_dir).expect("log dir");
+        let log = log_dir.join(format!("{}-loading-{port}.log", std::process::id()));
+        let stderr = std::fs::File::create(&log).expect("log file");
+        let child = Command::new(binary())
+            .args(&args)
+            .envs(self.env.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+            .stdout(Stdio::null())
+            .stderr(stderr)
+            .stdin(Stdio::null())
+            .spawn()
+            .expect("start textile");
+        let server = Server { child, base: format!("http://127.0.0.1:{port}"), client: reqwest::Client::new(), log };
+        for _ in 0..600 {
+            if server.client.get(server.url("/health")).send().await.is_ok_and(|r| r.status() == 200) {
+                return server;
+            }
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+        panic!("textile did not answer /health within 30 s");
+    }
+
     /// Start it and wait until it is ready.
     pub fn start(self) -> Server {
         let mut args: Vec<std::ffi::OsString> = Vec::new();

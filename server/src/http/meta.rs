@@ -29,7 +29,7 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
         "status": "ok",
         "version": env!("CARGO_PKG_VERSION"),
         "engine": engine_version(),
-        "ready": st.registry.get().is_some(),
+        "ready": st.registry.get().is_some_and(|r| r.analysed()),
         "textures": st.registry.get().map(|r| r.list.len()).unwrap_or(0),
         "tiles_synthesized": st.syntheses(),
         "shed": st.metrics.shed.get(),
@@ -46,11 +46,14 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
     }))
 }
 
-/// Readiness: 200 once every texture is loaded, 503 before.
+/// Readiness: 200 once every texture is loaded and analysed, 503 before (modes that need only
+/// the exemplar already serve while analyses are computed).
 #[utoipa::path(get, path = "/ready", tag = "service",
-    responses((status = 200, description = "ready"), (status = 503, description = "still loading")))]
+    responses((status = 200, description = "ready"), (status = 503, description = "still loading or analysing")))]
 pub async fn ready(State(st): State<Arc<AppState>>) -> Result<Json<Value>, ApiError> {
-    st.ready()?;
+    if !st.ready()?.analysed() {
+        return Err(ApiError::not_ready());
+    }
     Ok(Json(json!({"status": "ready"})))
 }
 
@@ -84,17 +87,23 @@ pub async fn texture_meta(
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
     let t = texture(reg, &id)?;
-    let h = &t.analysis.header;
+    let (ex, prep) = (&t.exemplar, &t.exemplar.preparation);
+    let analysis = match (t.analysis(), t.file_hash()) {
+        (Some(a), Some(hash)) => json!({
+            "status": "ready", "id": a.header.id, "file_hash": hash, "algorithm_version": a.header.algorithm_version,
+        }),
+        _ => json!({ "status": "analysing" }),
+    };
     Ok(Json(json!({
         "id": t.config.id,
         "name": t.config.name,
         "attribution": t.config.attribution,
         "exemplar": {
-            "width": h.side, "height": h.side, "toroidal": h.toroidal,
-            "input_width": h.preparation.input_width, "input_height": h.preparation.input_height,
-            "crop_side": h.preparation.crop_side, "toroidal_forced": h.preparation.toroidal_forced,
+            "width": ex.side, "height": ex.side, "toroidal": ex.toroidal,
+            "input_width": prep.input_width, "input_height": prep.input_height,
+            "crop_side": prep.crop_side, "toroidal_forced": prep.toroidal_forced,
         },
-        "analysis": { "id": h.id, "file_hash": t.file_hash, "algorithm_version": h.algorithm_version },
+        "analysis": analysis,
         "modes": MODE_NAMES,
         "default_mode": t.defaults.mode,
         "mode_info": mode_info(),
@@ -102,7 +111,7 @@ pub async fn texture_meta(
         "minzoom": t.min_zoom(),
         "maxzoom": t.max_zoom(),
         "tile_size": TILE_SIZE,
-        "levels": h.levels + 1,
+        "levels": t.native_zoom() + 1,
         "settings": settings(&t),
         "parameters": parameters(&t),
     })))
@@ -208,8 +217,10 @@ pub async fn tilejson(
     // Everything that decides a tile's bytes besides its own request: engine, analysis, and the
     // texture's configured defaults of every mode with the modes' versions (a changed default
     // seed or κ, or a new mode version, must not hit stale immutable copies).
-    let version = &blake3::hash(format!("{}|{}|{}", engine_version(), t.file_hash, t.defaults.canonical()).as_bytes())
-        .to_hex()[..12];
+    // While the analysis is computed the version lacks it, and changes once it is attached.
+    let file_hash = t.file_hash().unwrap_or("analysing");
+    let version =
+        &blake3::hash(format!("{}|{file_hash}|{}", engine_version(), t.defaults.canonical()).as_bytes()).to_hex()[..12];
     let mut qs = form_urlencoded::Serializer::new(String::new());
     qs.append_pair("v", version);
     let mut q = q;
@@ -231,7 +242,7 @@ pub async fn tilejson(
         "bounds": [-180.0, -85.051_128_779_806_59, 180.0, 85.051_128_779_806_59],
         "center": [0.0, 0.0, t.native_zoom()],
         "tileSize": TILE_SIZE,
-        "textile": { "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.analysis.side() },
+        "textile": { "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.side },
     })))
 }
 

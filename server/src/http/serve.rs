@@ -1,6 +1,7 @@
 //! `textile serve`: load the configuration, start listening at once (answering `/health`, and
-//! 503 elsewhere while textures load), load or compute analyses, announce the viewer URL, and
-//! drain in-flight requests on SIGINT/SIGTERM.
+//! 503 elsewhere while textures load), decode the exemplars (modes that need only the exemplar
+//! serve from then on), load or compute analyses, announce the viewer URL, and drain in-flight
+//! requests on SIGINT/SIGTERM.
 
 use std::sync::Arc;
 
@@ -10,7 +11,7 @@ use tracing::{info, warn};
 use crate::cli::{CliResult, ServeArgs};
 use crate::config::{Config, Overrides};
 use crate::state::AppState;
-use crate::textures::load_registry;
+use crate::textures::{analyse_registry, prepare_registry};
 
 struct LogProgress;
 
@@ -58,13 +59,14 @@ async fn serve(cfg: Config) -> CliResult {
     let state = Arc::new(AppState::new(cfg));
     let app = super::router(state.clone());
     info!("listening on http://{addr}/ (loading textures)");
+    // Exemplars first (modes that need only the exemplar serve at once), then the analyses.
     let loader = {
         let state = state.clone();
         tokio::task::spawn_blocking(move || {
             let log = |s: String| info!("{s}");
-            load_registry(&state.config, &log, &LogProgress).map(|reg| {
-                let _ = state.registry.set(Arc::new(reg));
-            })
+            let reg = Arc::new(prepare_registry(&state.config, &log)?);
+            let _ = state.registry.set(reg.clone());
+            analyse_registry(&state.config, &reg, &log, &LogProgress)
         })
     };
     let server =
