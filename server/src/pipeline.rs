@@ -141,14 +141,14 @@ where
     st.cache.get_or_compute(key, || st.synthesize(label, make)).await
 }
 
-/// A job's bytes through the tile cache and the pool, through the shared pyramidal cache; the
-/// pixels it synthesized and delivered are counted when it actually runs.
-pub async fn produce(st: &Arc<AppState>, job: ImageJob) -> (Result<Bytes, ApiError>, bool) {
+/// A job's bytes through the tile cache (keyed by `etag`, the job's [`ImageJob::etag`], which
+/// callers have already computed for `If-None-Match`) and the pool, through the shared pyramidal
+/// cache; the pixels it synthesized and delivered are counted when it actually runs.
+pub async fn produce(st: &Arc<AppState>, etag: &str, job: ImageJob) -> (Result<Bytes, ApiError>, bool) {
     let mode = job.params.name();
     let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
     let pyramid = st.pyramid.clone();
-    let etag = job.etag();
-    cached(st, &etag, mode, move || {
+    cached(st, etag, mode, move || {
         let (bytes, r) = job.bytes(&pyramid)?;
         synthesized.with_label_values(&[mode]).inc_by(r.synthesized);
         delivered.with_label_values(&[mode]).inc_by(r.image.width as u64 * r.image.height as u64);

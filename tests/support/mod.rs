@@ -32,6 +32,20 @@ pub fn gravel_textures_config(dir: &Path, textures: &[(&str, &str)]) -> PathBuf 
     path
 }
 
+/// Start the binary with these arguments and environment, its stderr (its log) in a file of its
+/// own; returns the child and the log's path.
+fn launch(args: &[std::ffi::OsString], env: &[(&str, &str)], stdout: Stdio) -> (Child, PathBuf) {
+    let log_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("server-logs");
+    std::fs::create_dir_all(&log_dir).expect("log dir");
+    static STARTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = STARTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let log = log_dir.join(format!("{}-{n}.log", std::process::id()));
+    let stderr = std::fs::File::create(&log).expect("log file");
+    let mut cmd = Command::new(binary());
+    cmd.args(args).envs(env.iter().copied()).stdout(stdout).stderr(stderr).stdin(Stdio::null());
+    (cmd.spawn().expect("start textile"), log)
+}
+
 /// A running server process.
 pub struct Server {
     child: Child,
@@ -93,18 +107,8 @@ impl Builder {
             vec!["serve".into(), "--bind".into(), format!("127.0.0.1:{port}").into()];
         args.extend(["--data-dir".into(), dir.into_os_string()]);
         args.extend(self.args);
-        let log_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("server-logs");
-        std::fs::create_dir_all(&log_dir).expect("log dir");
-        let log = log_dir.join(format!("{}-loading-{port}.log", std::process::id()));
-        let stderr = std::fs::File::create(&log).expect("log file");
-        let child = Command::new(binary())
-            .args(&args)
-            .envs(self.env.iter().map(|(k, v)| (k.as_str(), v.as_str())))
-            .stdout(Stdio::null())
-            .stderr(stderr)
-            .stdin(Stdio::null())
-            .spawn()
-            .expect("start textile");
+        let env: Vec<(&str, &str)> = self.env.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
+        let (child, log) = launch(&args, &env, Stdio::null());
         let server = Server { child, base: format!("http://127.0.0.1:{port}"), client: reqwest::Client::new(), log };
         for _ in 0..600 {
             if server.client.get(server.url("/health")).send().await.is_ok_and(|r| r.status() == 200) {
@@ -136,15 +140,7 @@ impl Server {
     }
 
     fn spawn(args: &[std::ffi::OsString], env: &[(&str, &str)]) -> Server {
-        let log_dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("server-logs");
-        std::fs::create_dir_all(&log_dir).expect("log dir");
-        static STARTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-        let n = STARTED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let log = log_dir.join(format!("{}-{n}.log", std::process::id()));
-        let stderr = std::fs::File::create(&log).expect("log file");
-        let mut cmd = Command::new(binary());
-        cmd.args(args).envs(env.iter().copied()).stdout(Stdio::piped()).stderr(stderr).stdin(Stdio::null());
-        let mut child = cmd.spawn().expect("start textile");
+        let (mut child, log) = launch(args, env, Stdio::piped());
         let stdout = child.stdout.take().expect("stdout");
         let (tx, rx) = mpsc::channel();
         std::thread::spawn(move || {

@@ -25,7 +25,7 @@ async fn answer(st: &Arc<AppState>, headers: &HeaderMap, job: ImageJob) -> Resul
         return Ok(not_modified(&etag, cc));
     }
     let content_type = job.format().content_type();
-    let (bytes, hit) = produce(st, job).await;
+    let (bytes, hit) = produce(st, &etag, job).await;
     Ok(image(bytes?, content_type, &etag, cc, hit))
 }
 

@@ -70,7 +70,6 @@ fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), Api
     }
 }
 
-#[derive(Clone)]
 struct TileRequest {
     tex: Arc<Texture>,
     spec: TileSpec,
@@ -81,14 +80,19 @@ struct TileRequest {
 impl TileRequest {
     /// The PNG tile this asset shows.
     fn image(&self) -> ImageJob {
-        let spec = TileSpec { format: Format::Png, scale: 1, ..self.spec };
+        self.image_at(self.spec)
+    }
+
+    /// The PNG tile at `spec` with this request's texture and parameters.
+    fn image_at(&self, spec: TileSpec) -> ImageJob {
+        let spec = TileSpec { format: Format::Png, scale: 1, ..spec };
         ImageJob { tex: self.tex.clone(), params: self.params.clone(), target: Target::Tile(spec) }
     }
 }
 
 /// The bytes of a PNG tile, through the pipeline.
-async fn tile_png(st: &Arc<AppState>, job: ImageJob) -> Result<Vec<u8>, ApiError> {
-    Ok(produce(st, job).await.0?.to_vec())
+async fn tile_png(st: &Arc<AppState>, etag: &str, job: ImageJob) -> Result<Vec<u8>, ApiError> {
+    Ok(produce(st, etag, job).await.0?.to_vec())
 }
 
 fn tile_request(
@@ -151,7 +155,7 @@ pub async fn gltf_tile(
         let found = hit.is_some();
         let bytes = match hit {
             Some(b) => b,
-            None => tile_png(&st, job).await?.into(),
+            None => tile_png(&st, &etag, job).await?.into(),
         };
         return Ok(image(bytes, "image/png", &etag, cc, found));
     }
@@ -176,7 +180,8 @@ pub async fn gltf_tile(
     if let Some(b) = st.cache.peek(&etag) {
         return Ok(image(b, "model/gltf-binary", &etag, cc, true));
     }
-    let png = tile_png(&st, r.image()).await?;
+    let job = r.image();
+    let png = tile_png(&st, &job.etag(), job).await?;
     let q = quad(&r.tex, &r.spec);
     let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move || Ok(glb(&[q], &[(png, "image/png")], &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
@@ -233,7 +238,8 @@ pub async fn gltf_patch(
     for j in 0..n {
         for i in 0..n {
             let spec = TileSpec { x: origin.x + i, y: origin.y + j, ..origin };
-            images.push((tile_png(&st, TileRequest { spec, ..r.clone() }.image()).await?, "image/png"));
+            let job = r.image_at(spec);
+            images.push((tile_png(&st, &job.etag(), job).await?, "image/png"));
             quads.push(quad(&tex, &spec));
         }
     }
