@@ -79,6 +79,17 @@ pub enum CoreError {
         /// What is allowed.
         message: String,
     },
+    /// A sample of a per-sample query is not usable.
+    #[error("sample {index}: {message}")]
+    Sample {
+        /// Its position in the request (0-based).
+        index: usize,
+        /// What was wrong and what is allowed.
+        message: String,
+    },
+    /// The work was abandoned because its requester went away.
+    #[error("cancelled: the requester went away")]
+    Cancelled,
 }
 
 /// Why an analysis file was refused.

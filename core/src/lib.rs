@@ -15,7 +15,9 @@
 //!    are declared once as [`modes::params::ParamSpec`]s and read by one
 //!    [`modes::params::ParamReader`];
 //! 4. [`cache`] — the pyramidal cache that lets neighbouring windows share work;
-//! 5. [`image`] — the RGB windows the modes produce.
+//! 5. [`image`] — the RGB windows the modes produce;
+//! 6. [`samples`] — per-sample queries (Wei & Levoy 2003): scattered texels and filtered
+//!    footprints in any order, equal to the tiles' pixels, through the same cache.
 //!
 //! ```
 //! use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, NoProgress, ParamReader, Pyramid, Rect, Source, View};
@@ -43,6 +45,7 @@ pub mod geom;
 pub mod hash;
 pub mod image;
 pub mod modes;
+pub mod samples;
 
 pub use analysis::{Analysis, AnalysisHeader, NoProgress, Progress, ALGORITHM_VERSION};
 pub use cache::{Pyramid, PyramidStats};
@@ -51,4 +54,5 @@ pub use exemplar::{Exemplar, ExemplarOptions};
 pub use geom::Rect;
 pub use image::{Rendered, RgbWindow};
 pub use modes::params::{ParamReader, ParamSpec, TILE_SIZE};
+pub use samples::{Footprint, Sampled, Texel};
 pub use modes::{Defaults, Mode, ModeInfo, ModeParams, Source, View, MODE_NAMES};

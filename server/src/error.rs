@@ -13,6 +13,10 @@ pub enum Kind {
     NotFound,
     /// The method is not allowed on an existing route.
     MethodNotAllowed,
+    /// The request body is larger than allowed.
+    TooLarge,
+    /// The request body is of a media type the route does not read.
+    UnsupportedMediaType,
     /// The content (an image) cannot be used.
     Unprocessable,
     /// Temporarily unable: loading, overloaded or too slow; retry after `retry_after`.
@@ -83,6 +87,8 @@ impl From<CoreError> for ApiError {
             CoreError::Param { .. } | CoreError::ParamKey { .. } => Self::bad_request("invalid_parameter", msg),
             CoreError::UnknownParam { .. } => Self::bad_request("unknown_parameter", msg),
             CoreError::Window { .. } => Self::bad_request("invalid_window", msg),
+            CoreError::Sample { .. } => Self::bad_request("invalid_sample", msg),
+            CoreError::Cancelled => Self::new(Kind::Unavailable, "cancelled", msg),
             CoreError::ExemplarUndecodable(_) => Self::new(Kind::Unprocessable, "undecodable_image", msg),
             CoreError::ExemplarSize { .. } => Self::new(Kind::Unprocessable, "image_size", msg),
             CoreError::NotAnalysed { .. } => {
