@@ -54,5 +54,5 @@ pub use exemplar::{Exemplar, ExemplarOptions};
 pub use geom::Rect;
 pub use image::{Rendered, RgbWindow};
 pub use modes::params::{ParamReader, ParamSpec, TILE_SIZE};
-pub use samples::{Footprint, Sampled, Texel};
 pub use modes::{Defaults, Mode, ModeInfo, ModeParams, Source, View, MODE_NAMES};
+pub use samples::{Footprint, Sampled, Texel};

@@ -69,8 +69,7 @@ fn a_batch_computes_shared_cones_once() {
     let src = Source::new(ex, an);
     let p = params(&src, "synth");
     // 64 texels spread over a 64×64 native area.
-    let pts: Vec<Texel> =
-        (0..64).map(|i| Texel { x: (i % 8) * 8 + 3, y: (i / 8) * 8 + 5, zoom_out: 0 }).collect();
+    let pts: Vec<Texel> = (0..64).map(|i| Texel { x: (i % 8) * 8 + 3, y: (i / 8) * 8 + 5, zoom_out: 0 }).collect();
     let batch = samples::texels(&p, &src, &Pyramid::new(16 << 20), &pts).unwrap();
     let apart: u64 = pts.iter().map(|t| samples::texels(&p, &src, &Pyramid::off(), &[*t]).unwrap().synthesized).sum();
     assert!(batch.synthesized * 4 < apart, "batch {} vs one cone per point {apart}", batch.synthesized);
@@ -100,9 +99,14 @@ fn filtered_samples_at_centres_equal_texels_and_blend_between_levels() {
     }
     // Halfway between two texels: their average (within rounding).
     let p = params(&src, "synth");
-    let c = samples::texels(&p, &src, &Pyramid::off(), &[Texel { x: 4, y: 9, zoom_out: 0 }, Texel { x: 5, y: 9, zoom_out: 0 }])
-        .unwrap()
-        .colors;
+    let c = samples::texels(
+        &p,
+        &src,
+        &Pyramid::off(),
+        &[Texel { x: 4, y: 9, zoom_out: 0 }, Texel { x: 5, y: 9, zoom_out: 0 }],
+    )
+    .unwrap()
+    .colors;
     let mid = samples::footprints(&p, &src, &Pyramid::off(), &[Footprint { u: 5.0, v: 9.5, lod: 0.0 }], 6).unwrap();
     for ch in 0..3 {
         let avg = (c[0][ch] as i32 + c[1][ch] as i32 + 1) / 2;

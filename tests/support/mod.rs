@@ -185,6 +185,19 @@ impl Server {
         (s, r.bytes().await.expect("body").to_vec())
     }
 
+    /// POST a body of a content type to a path; status, headers and body bytes.
+    pub async fn post(
+        &self,
+        path: &str,
+        content_type: &str,
+        body: Vec<u8>,
+    ) -> (u16, reqwest::header::HeaderMap, Vec<u8>) {
+        let r = self.client.post(self.url(path)).header("content-type", content_type).body(body).send().await;
+        let r = r.expect("request");
+        let (s, h) = (r.status().as_u16(), r.headers().clone());
+        (s, h, r.bytes().await.expect("body").to_vec())
+    }
+
     /// GET a path expecting 200 JSON.
     pub async fn json(&self, path: &str) -> serde_json::Value {
         let r = self.get(path).await;

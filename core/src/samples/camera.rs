@@ -41,7 +41,7 @@ impl GroundCamera {
         if !finite {
             return Err("camera values must be finite numbers".into());
         }
-        if !(self.height > 0.0) {
+        if self.height <= 0.0 {
             return Err("camera height must be above the plane (> 0)".into());
         }
         if !(-90.0..=90.0).contains(&self.pitch) {

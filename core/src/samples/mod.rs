@@ -54,6 +54,9 @@ pub struct Sampled {
     pub windows: u64,
 }
 
+/// The samples read from one window (index in the request, colour) and the pixels it computed.
+type WindowSamples = (Vec<(u32, [u8; 3])>, u64);
+
 /// The cell of a texel, and a sort key that keeps neighbouring cells together (cells ordered
 /// in 8 × 8 super-cells), so that consecutive windows share their cones through the cache.
 fn cell(t: &Texel) -> (u32, i64, i64, i64, i64) {
@@ -91,7 +94,7 @@ pub fn texels_until(
             start = i;
         }
     }
-    let rendered: Vec<Result<(Vec<(u32, [u8; 3])>, u64)>> = runs
+    let rendered: Vec<Result<WindowSamples>> = runs
         .par_iter()
         .with_max_len(4)
         .map(|&(a, b)| {

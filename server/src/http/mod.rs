@@ -10,6 +10,7 @@ pub mod images;
 pub mod meta;
 pub mod models;
 pub mod openapi;
+pub mod samples;
 pub mod serve;
 pub mod static_files;
 
@@ -19,7 +20,7 @@ use axum::extract::{MatchedPath, Request, State};
 use axum::http::{header, HeaderValue, Method};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
-use axum::routing::get;
+use axum::routing::{get, post};
 use axum::Router;
 use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::compression::CompressionLayer;
@@ -55,6 +56,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/tiles/{id}/tilejson.json", get(meta::tilejson))
         .route("/tiles/{id}/{z}/{x}/{y}", get(images::tile))
         .route("/windows/{file}", get(images::window))
+        .route("/samples/{id}", post(samples::samples))
         .route("/gltf/{id}/patch.glb", get(models::gltf_patch))
         .route("/gltf/{id}/{z}/{x}/{y}", get(models::gltf_tile))
         .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile));
@@ -65,9 +67,14 @@ pub fn router(state: Arc<AppState>) -> Router {
 /// metrics, JSON compression, CORS, and panics turned into a 500 JSON error.
 fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Router {
     let cors = CorsLayer::new()
-        .allow_methods([Method::GET, Method::HEAD])
-        .allow_headers([header::IF_NONE_MATCH])
-        .expose_headers([header::ETAG, header::HeaderName::from_static("x-cache")])
+        .allow_methods([Method::GET, Method::HEAD, Method::POST])
+        .allow_headers([header::IF_NONE_MATCH, header::CONTENT_TYPE])
+        .expose_headers([
+            header::ETAG,
+            header::HeaderName::from_static("x-cache"),
+            header::HeaderName::from_static("x-textile-computed"),
+            header::HeaderName::from_static("x-textile-windows"),
+        ])
         .allow_origin(if state.config.cors_origins.iter().any(|o| o == "*") {
             AllowOrigin::any()
         } else {

@@ -24,6 +24,7 @@ use utoipa::{Modify, OpenApi};
         crate::http::meta::tilejson,
         crate::http::images::tile,
         crate::http::images::window,
+        crate::http::samples::samples,
         openapi,
         crate::http::meta::metrics,
         crate::http::static_files::index,
@@ -39,6 +40,7 @@ pub struct ApiDoc;
 const WITH_MODE_PARAMETERS: &[&str] = &[
     "/tiles/{id}/{z}/{x}/{y}.{fmt}",
     "/windows/{id}.{fmt}",
+    "/samples/{id}",
     "/tiles/{id}/tilejson.json",
     "/gltf/{id}/{z}/{x}/{y}.{ext}",
     "/gltf/{id}/patch.glb",
@@ -91,7 +93,7 @@ impl Modify for ModeParameters {
             if !WITH_MODE_PARAMETERS.contains(&path.as_str()) {
                 continue;
             }
-            if let Some(op) = item.get.as_mut() {
+            for op in [item.get.as_mut(), item.post.as_mut()].into_iter().flatten() {
                 op.parameters.get_or_insert_with(Vec::new).extend(params.iter().cloned());
             }
         }

@@ -1,0 +1,98 @@
+//! `POST /samples/{id}`: per-sample queries for renderers. The body — JSON
+//! (`application/json`) or binary records (`application/octet-stream`, kind chosen by
+//! `records=`) — is read up to its limit and parsed by [`crate::sampling`]; the answer is JSON
+//! colours or packed RGB, in request order, with the work it took in `X-Textile-Computed`
+//! (pixels computed at all levels) and `X-Textile-Windows`.
+
+use std::sync::Arc;
+
+use axum::body::{to_bytes, Body};
+use axum::extract::rejection::PathRejection;
+use axum::extract::{Path, RawQuery, State};
+use axum::http::{header, HeaderMap, HeaderValue};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+
+use crate::error::{ApiError, Kind};
+use crate::http::extract::{path_error, texture};
+use crate::request::{params, query_reader};
+use crate::sampling::{self, parse_binary, parse_json, Records, MAX_BODY};
+use crate::state::AppState;
+
+/// The media type of a request body, without parameters.
+fn media_type(headers: &HeaderMap) -> String {
+    let ct = headers.get(header::CONTENT_TYPE).and_then(|v| v.to_str().ok()).unwrap_or("");
+    ct.split(';').next().unwrap_or("").trim().to_ascii_lowercase()
+}
+
+/// Colours of scattered samples of the texture, equal to the pixels of the tiles that hold them.
+#[utoipa::path(post, path = "/samples/{id}", tag = "tiles",
+    params(("id" = String, Path, description = "texture id"),
+           ("records" = Option<String>, Query, description = "binary bodies: `texels` (default; 20-byte records i64 x, i64 y, u32 z, little-endian: pixel (x, y) of the tile grid at zoom z) or `footprints` (20-byte records f64 u, f64 v, f32 lod: a position in native texels, filtered bilinearly within a level and linearly between levels)"),
+           ("v" = Option<String>, Query, description = "cache-busting version (content unchanged)")),
+    request_body(description = "JSON `{\"points\": [[x, y], …], \"z\": Z}` (a point may be [x, y, z]; z defaults to the native zoom) or `{\"footprints\": [[u, v, lod], …]}`; or binary records (application/octet-stream). At most 262144 samples and 8 MiB.",
+        content(("application/json"), ("application/octet-stream"))),
+    responses((status = 200, description = "JSON `{\"colors\": [[r, g, b], …]}`, or packed RGB8 (3 bytes per sample) for a binary request; X-Textile-Computed: pixels computed for it"),
+              (status = 400, description = "malformed body, sample outside the tile range or bad parameters"),
+              (status = 404, description = "unknown texture"),
+              (status = 413, description = "more than 262144 samples or a body over 8 MiB"),
+              (status = 415, description = "body neither application/json nor application/octet-stream"),
+              (status = 503, description = "overloaded or loading; see Retry-After")))]
+pub async fn samples(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<String>, PathRejection>,
+    RawQuery(q): RawQuery,
+    headers: HeaderMap,
+    body: Body,
+) -> Result<Response, ApiError> {
+    let reg = st.ready()?;
+    let Path(id) = path.map_err(path_error)?;
+    let tex = texture(reg, &id)?;
+    let mut r = query_reader(q.as_deref())?;
+    let records = r.take("records").map(|s| Records::parse(&s)).transpose()?;
+    let params = params(&tex, r)?;
+    let binary = match media_type(&headers).as_str() {
+        "application/json" => false,
+        "application/octet-stream" => true,
+        other => {
+            return Err(ApiError::new(
+                Kind::UnsupportedMediaType,
+                "unsupported_media_type",
+                format!("Content-Type '{}': use application/json or application/octet-stream", other.escape_debug()),
+            ))
+        }
+    };
+    if records.is_some() && !binary {
+        return Err(ApiError::bad_request("invalid_parameter", "parameter 'records' applies to binary bodies only"));
+    }
+    let too_large =
+        || ApiError::new(Kind::TooLarge, "body_too_large", format!("the body is over {MAX_BODY} bytes (8 MiB)"));
+    let declared = headers.get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()?.parse::<u64>().ok());
+    if declared.is_some_and(|n| n > MAX_BODY as u64) {
+        return Err(too_large());
+    }
+    let bytes = to_bytes(body, MAX_BODY).await.map_err(|e| {
+        if e.to_string().contains("length limit") {
+            too_large()
+        } else {
+            ApiError::bad_request("invalid_body", format!("the body could not be read: {e}"))
+        }
+    })?;
+    let points = if binary {
+        parse_binary(&tex, &bytes, records.unwrap_or(Records::Texels))?
+    } else {
+        parse_json(&tex, &bytes)?
+    };
+    let a = sampling::run(&st, tex, params, points).await?;
+    let mut resp = if binary {
+        ([(header::CONTENT_TYPE, "application/octet-stream")], a.rgb).into_response()
+    } else {
+        let colors: Vec<[u8; 3]> = a.rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        Json(serde_json::json!({ "colors": colors })).into_response()
+    };
+    let h = resp.headers_mut();
+    h.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    h.insert("x-textile-computed", HeaderValue::from(a.computed));
+    h.insert("x-textile-windows", HeaderValue::from(a.windows));
+    Ok(resp)
+}
