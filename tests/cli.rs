@@ -112,3 +112,53 @@ fn help_describes_every_command() {
         assert!(out.contains(p), "{p}: {out}");
     }
 }
+
+#[tokio::test]
+async fn camera_view_is_made_of_samples_equal_to_the_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = shared_data_dir();
+    let data = data.to_str().unwrap();
+    // Straight down with a 90° lens from 32 texels up: 64×64 pixels see 64×64 texels, each
+    // pixel's centre a texel centre at level 0 — the window under the camera.
+    let down = dir.path().join("down.png");
+    let args = ["render", "--texture", "gravel", "--data-dir", data, "--seed", "4", "--size", "64x64"];
+    let (code, out, err) =
+        run(&[&args[..], &["--camera", "32,90,0,90", "--at=10,-20", "-o", down.to_str().unwrap()]].concat());
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("4096 ground samples"), "{out}");
+    let s = Server::builder().start();
+    let win = s.image("/windows/gravel.png?x=-22&y=-52&w=64&h=64&seed=4").await;
+    assert!(image::open(&down).unwrap().to_rgb8() == win, "the camera looking down sees the window below it");
+    // A level view: sky above the horizon, the plane below.
+    let level = dir.path().join("level.png");
+    let (code, _, err) = run(&[&args[..], &["--camera", "20,0,45,60", "-o", level.to_str().unwrap()]].concat());
+    assert_eq!(code, 0, "{err}");
+    let img = image::open(&level).unwrap().to_rgb8();
+    assert_eq!(img.get_pixel(5, 5), img.get_pixel(60, 20), "sky");
+    assert_ne!(img.get_pixel(5, 60), img.get_pixel(5, 5), "ground");
+    // Bad cameras are clear errors, and nothing is written.
+    for (cam, size, what) in [
+        ("0,30,0,60", "64x64", "height"),
+        ("20,30,0,180", "64x64", "field of view"),
+        ("20,30,0", "64x64", "--camera"),
+        ("20,30,0,60", "0x5", "--size"),
+    ] {
+        let bad = dir.path().join("bad.png");
+        let (code, _, err) = run(&[
+            "render",
+            "--texture",
+            "gravel",
+            "--data-dir",
+            data,
+            "--camera",
+            cam,
+            "--size",
+            size,
+            "-o",
+            bad.to_str().unwrap(),
+        ]);
+        assert_ne!(code, 0);
+        assert!(err.contains(what), "{cam} {size}: {err}");
+        assert!(!bad.exists());
+    }
+}

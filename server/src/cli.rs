@@ -111,6 +111,18 @@ pub struct RenderArgs {
     /// A window instead of a tile: X,Y,W,H in pixels at zoom --z.
     #[arg(long, value_name = "X,Y,W,H", allow_hyphen_values = true)]
     pub window: Option<String>,
+    /// A perspective view of the infinite ground plane instead of a tile, rendered entirely
+    /// through per-sample queries with footprint-based level of detail: camera height above
+    /// the plane (native texels), pitch below the horizon, yaw clockwise from north, and
+    /// vertical field of view (degrees), e.g. `--camera 48,30,0,60`.
+    #[arg(long, value_name = "HEIGHT,PITCH,YAW,FOV", conflicts_with_all = ["x", "window", "z"])]
+    pub camera: Option<String>,
+    /// The camera's position over the plane, in native texels.
+    #[arg(long, value_name = "X,Y", default_value = "0,0", allow_hyphen_values = true, requires = "camera")]
+    pub at: String,
+    /// The camera's image size.
+    #[arg(long, value_name = "WxH", default_value = "512x512", requires = "camera")]
+    pub size: String,
     /// Mode (engine); default: the texture's default mode.
     #[arg(long, value_parser = PossibleValuesParser::new(textile_core::MODE_NAMES))]
     pub mode: Option<String>,

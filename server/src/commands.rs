@@ -1,16 +1,17 @@
-//! The one-shot commands: `analyze` (with a progress bar), `render` (a tile or window to an
-//! image file, for scripts) and `info` (an analysis file's header).
+//! The one-shot commands: `analyze` (with a progress bar), `render` (a tile, a window or a
+//! perspective camera view through per-sample queries, to an image file, for scripts) and `info` (an analysis file's header).
 
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use textile_core::modes::params::{Scope, COMMON};
-use textile_core::{Analysis, Exemplar, ExemplarOptions, ParamReader, Progress, Pyramid};
+use textile_core::samples::{self, camera::GroundCamera, Footprint};
+use textile_core::{Analysis, Exemplar, ExemplarOptions, ModeParams, ParamReader, Progress, Pyramid};
 
 use crate::cli::{AnalyzeArgs, CliResult, InfoArgs, RenderArgs};
 use crate::config::{Config, Overrides, TextureConfig};
-use crate::encode::Format;
+use crate::encode::{encode, Effort, Format};
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::textures::{exemplar_bytes, load_registry, Texture};
@@ -159,6 +160,9 @@ pub fn render(a: RenderArgs) -> CliResult {
     if z > tex.max_zoom() {
         return Err(format!("--z {z} is outside 0..={}", tex.max_zoom()).into());
     }
+    if let Some(cam) = &a.camera {
+        return render_camera(&tex, &params, cam, &a.at, &a.size, &output);
+    }
     let format = output
         .extension()
         .and_then(|e| e.to_str())
@@ -187,6 +191,60 @@ pub fn render(a: RenderArgs) -> CliResult {
     let (bytes, r) = ImageJob { tex, params, target }.bytes(&Pyramid::off())?;
     write_atomic(&output, &bytes)?;
     println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
+    Ok(())
+}
+
+/// Sky above the horizon of a camera view.
+const SKY: [u8; 3] = [196, 214, 232];
+/// Largest camera image side.
+const MAX_CAMERA_SIDE: u32 = 4096;
+
+/// `textile render --camera`: a perspective view of the ground plane, every pixel a filtered
+/// per-sample query (the same sampler as `POST /samples`), through one pyramidal cache.
+fn render_camera(tex: &Texture, params: &ModeParams, cam: &str, at: &str, size: &str, output: &Path) -> CliResult {
+    let nums = |s: &str, n: usize, what: &str| -> Result<Vec<f64>, String> {
+        let v: Vec<f64> = s.split(',').map(|t| t.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| what)?;
+        if v.len() == n {
+            Ok(v)
+        } else {
+            Err(what.to_string())
+        }
+    };
+    let c = nums(cam, 4, "--camera must be HEIGHT,PITCH,YAW,FOV numbers")?;
+    let p = nums(at, 2, "--at must be X,Y numbers")?;
+    let (w, h) = size
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)))
+        .filter(|&(w, h)| (1..=MAX_CAMERA_SIDE).contains(&w) && (1..=MAX_CAMERA_SIDE).contains(&h))
+        .ok_or(format!("--size must be WxH with sides 1..={MAX_CAMERA_SIDE}"))?;
+    let camera =
+        GroundCamera { x: p[0], y: p[1], height: c[0], pitch: c[1], yaw: c[2], fov: c[3], width: w, height_px: h };
+    camera.check()?;
+    let format = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .and_then(Format::from_ext)
+        .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
+    let started = std::time::Instant::now();
+    let view = camera.footprints();
+    let ground: Vec<Footprint> = view.iter().flatten().copied().collect();
+    let cache = Pyramid::new(64 << 20);
+    let max_zoom_out = tex.native_zoom() - tex.min_zoom();
+    let s = samples::footprints(params, &tex.source(), &cache, &ground, max_zoom_out)?;
+    let mut colors = s.colors.iter();
+    let pixels: Vec<u8> =
+        view.iter().flat_map(|f| if f.is_some() { *colors.next().unwrap_or(&SKY) } else { SKY }).collect();
+    let bytes = encode(&pixels, w, h, format, Effort::Tight)?;
+    write_atomic(output, &bytes)?;
+    println!(
+        "wrote {} ({w}x{h}): {} ground samples in {:.2} s, {} pixels computed ({:.2} per sample, {} windows)",
+        output.display(),
+        ground.len(),
+        started.elapsed().as_secs_f64(),
+        s.synthesized,
+        s.synthesized as f64 / ground.len().max(1) as f64,
+        s.windows
+    );
     Ok(())
 }
 
