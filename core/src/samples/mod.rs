@@ -1,8 +1,10 @@
 //! Per-sample queries (Wei & Levoy 2003): colours of scattered texels, in any order, for
 //! renderers that ask for texture where their rasterizer or ray tracer needs it.
 //!
-//! A batch is answered by grouping its texels into aligned `GROUP × GROUP` cells per zoom,
-//! rendering each occupied cell's bounding box as a window of the mode, and reading the samples
+//! A batch is answered by grouping its texels into windows per zoom — quadtree cells from
+//! `MAX_GROUP` down to `GROUP` texels wide, merged wherever one window over their bounding box
+//! costs less than its parts (padding and a fixed overhead counted) — rendering each window with
+//! the mode, and reading the samples
 //! from it. A sample therefore equals the pixel of any tile that contains it, byte for byte (a
 //! window equals the same pixels cut from any larger one), whatever the batch around it. The
 //! windows of a batch run through one pyramidal cache, so the dependency cones of neighbouring
@@ -26,9 +28,12 @@ use crate::modes::{ModeParams, Source, View};
 
 pub use filter::Footprint;
 
-/// Side of the aligned cells a batch's texels are grouped by (pixels at their zoom): one window
-/// per occupied cell, the bounding box of its texels.
+/// Side of the smallest aligned cells a batch's texels are grouped by (pixels at their zoom):
+/// one window per occupied cell, the bounding box of its texels.
 pub const GROUP: i64 = 32;
+/// Side of the largest cells: where texels are dense, cells up to this side are one window
+/// (fewer windows, and no padding computed twice by windows running side by side).
+pub const MAX_GROUP: i64 = 256;
 
 /// One texel of the texture viewed `zoom_out` steps coarser than native (0: native texels;
 /// `k`: one texel covers `2^k × 2^k` native texels) — a pixel of a tile at zoom `N − k`.
@@ -57,11 +62,84 @@ pub struct Sampled {
 /// The samples read from one window (index in the request, colour) and the pixels it computed.
 type WindowSamples = (Vec<(u32, [u8; 3])>, u64);
 
-/// The cell of a texel, and a sort key that keeps neighbouring cells together (cells ordered
-/// in 8 × 8 super-cells), so that consecutive windows share their cones through the cache.
-fn cell(t: &Texel) -> (u32, i64, i64, i64, i64) {
-    let (cx, cy) = (t.x.div_euclid(GROUP), t.y.div_euclid(GROUP));
-    (t.zoom_out, cy.div_euclid(8), cx.div_euclid(8), cy, cx)
+/// Padding of a window at its finest level, as the cost model counts it.
+const PAD: i64 = 10;
+/// Fixed cost of a window (plans, cache lookups) in pixels' worth of work.
+const WINDOW_OVERHEAD: i64 = 1024;
+
+/// A window of texels: zoom, bounding box, members.
+type Window = (u32, Rect, Vec<u32>);
+
+/// The bounding box of some texels.
+fn bbox(texels: &[Texel], members: &[u32]) -> Rect {
+    let t0 = texels[members[0] as usize];
+    members.iter().fold(Rect::new(t0.x, t0.y, 1, 1), |r, &i| {
+        let t = texels[i as usize];
+        r.union(&Rect::new(t.x, t.y, 1, 1))
+    })
+}
+
+/// What rendering a window over `r` costs in the model: its padded area and a fixed overhead.
+fn cost(r: Rect) -> i64 {
+    (r.width() + 2 * PAD) * (r.height() + 2 * PAD) + WINDOW_OVERHEAD
+}
+
+/// The cheapest windows for `members`, all in one aligned cell of side `g` at one zoom: the
+/// cell's bounding box as one window, or the best split into its four quadrants, whichever the
+/// cost model prefers. Returns the cost and the windows.
+fn split(texels: &[Texel], members: &mut [u32], g: i64) -> (i64, Vec<Window>) {
+    let rect = bbox(texels, members);
+    let whole = cost(rect);
+    let one = |m: &[u32]| vec![(texels[m[0] as usize].zoom_out, rect, m.to_vec())];
+    if g <= GROUP {
+        return (whole, one(members));
+    }
+    let h = g / 2;
+    let quad = |i: &u32| {
+        let t = texels[*i as usize];
+        (t.y.div_euclid(h), t.x.div_euclid(h))
+    };
+    members.sort_unstable_by_key(quad);
+    let (mut total, mut parts) = (0, Vec::new());
+    let mut rest = &mut *members;
+    while !rest.is_empty() {
+        let q = quad(&rest[0]);
+        let n = rest.iter().position(|i| quad(i) != q).unwrap_or(rest.len());
+        let (run, tail) = rest.split_at_mut(n);
+        let (c, w) = split(texels, run, h);
+        total += c;
+        parts.extend(w);
+        rest = tail;
+    }
+    if whole <= total {
+        (whole, one(members))
+    } else {
+        (total, parts)
+    }
+}
+
+/// The windows of a batch: per zoom and aligned cell of side [`MAX_GROUP`], the cheapest
+/// split into windows over quadrants down to cells of side [`GROUP`] (dense texels make one
+/// big window, sparse ones small windows around them). Windows are ordered so that neighbours
+/// follow each other (cells of 8 × 8 big cells together), for the cache to share their cones.
+fn plan(texels: &[Texel]) -> Vec<Window> {
+    let cell = |i: &u32| {
+        let t = texels[*i as usize];
+        let (cy, cx) = (t.y.div_euclid(MAX_GROUP), t.x.div_euclid(MAX_GROUP));
+        (t.zoom_out, cy.div_euclid(8), cx.div_euclid(8), cy, cx)
+    };
+    let mut all: Vec<u32> = (0..texels.len() as u32).collect();
+    all.sort_unstable_by_key(cell);
+    let mut out = Vec::new();
+    let mut rest = &mut all[..];
+    while !rest.is_empty() {
+        let c = cell(&rest[0]);
+        let n = rest.iter().position(|i| cell(i) != c).unwrap_or(rest.len());
+        let (run, tail) = rest.split_at_mut(n);
+        out.extend(split(texels, run, MAX_GROUP).1);
+        rest = tail;
+    }
+    out
 }
 
 /// The colours of `texels` (any order, duplicates allowed) for a mode with its parameters,
@@ -79,36 +157,15 @@ pub fn texels_until(
     texels: &[Texel],
     cancelled: &(dyn Fn() -> bool + Sync),
 ) -> Result<Sampled> {
-    let mut order: Vec<u32> = (0..texels.len() as u32).collect();
-    order.sort_unstable_by_key(|&i| cell(&texels[i as usize]));
-    // Runs of the order with the same cell: one window each.
-    let mut runs: Vec<(usize, usize)> = Vec::new();
-    let mut start = 0;
-    for i in 1..=order.len() {
-        let key = |k: usize| {
-            let c = cell(&texels[order[k] as usize]);
-            (c.0, c.3, c.4)
-        };
-        if i == order.len() || key(i) != key(start) {
-            runs.push((start, i));
-            start = i;
-        }
-    }
-    let rendered: Vec<Result<WindowSamples>> = runs
+    let windows = plan(texels);
+    let rendered: Vec<Result<WindowSamples>> = windows
         .par_iter()
-        .with_max_len(4)
-        .map(|&(a, b)| {
+        .with_max_len(1)
+        .map(|(zoom_out, rect, members)| {
             if cancelled() {
                 return Err(CoreError::Cancelled);
             }
-            let members = &order[a..b];
-            let first = texels[members[0] as usize];
-            let mut rect = Rect::new(first.x, first.y, 1, 1);
-            for &i in members {
-                let t = texels[i as usize];
-                rect = rect.union(&Rect::new(t.x, t.y, 1, 1));
-            }
-            let r = params.render(src, cache, View { zoom_out: first.zoom_out, rect })?;
+            let r = params.render(src, cache, View { zoom_out: *zoom_out, rect: *rect })?;
             let out = members
                 .iter()
                 .map(|&i| {
@@ -128,7 +185,7 @@ pub fn texels_until(
             colors[i as usize] = c;
         }
     }
-    Ok(Sampled { colors, synthesized, windows: runs.len() as u64 })
+    Ok(Sampled { colors, synthesized, windows: windows.len() as u64 })
 }
 
 /// The colours of continuous samples, filtered trilinearly (see [`filter`]); levels of detail
