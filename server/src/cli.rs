@@ -32,6 +32,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Print the header of an analysis file.
     Info(InfoArgs),
+    /// Pre-render tiles into a PMTiles or MBTiles archive (a periodic world, or a rectangle).
+    Export(ExportArgs),
     /// Load-test a running textile server on this machine with scripted request patterns.
     Loadtest(LoadtestArgs),
 }
@@ -143,6 +145,43 @@ pub struct RenderArgs {
     /// Output image (.png, .jpg, .webp).
     #[arg(short, long, value_name = "FILE", required_unless_present = "list_params")]
     pub output: Option<PathBuf>,
+}
+
+/// `textile export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    #[command(flatten)]
+    pub config: ConfigArgs,
+    /// A configured texture id.
+    #[arg(long)]
+    pub texture: String,
+    /// Period of the exported world in native tiles (a power of two; default 2^native zoom): the
+    /// texture repeats once around a Web-Mercator world whose archive zoom a is textile zoom
+    /// a + native − log2(world).
+    #[arg(long, conflicts_with = "bbox")]
+    pub world: Option<u64>,
+    /// A rectangle instead of a world: tiles X0..X1 × Y0..Y1 (end exclusive) at the highest
+    /// zoom, in textile's own zooms and coordinates (0 ≤ X, Y ≤ 2^z).
+    #[arg(long, value_name = "X0,Y0,X1,Y1")]
+    pub bbox: Option<String>,
+    /// Archive zooms MIN..MAX (default: every zoom the area has).
+    #[arg(long, value_name = "MIN..MAX")]
+    pub zoom: Option<String>,
+    /// Tile encoding.
+    #[arg(long, default_value = "png", value_parser = ["png", "jpg", "jpeg", "webp"])]
+    pub format: String,
+    /// Mode (engine); default: the texture's default mode.
+    #[arg(long, value_parser = PossibleValuesParser::new(textile_core::MODE_NAMES))]
+    pub mode: Option<String>,
+    /// Seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// A tile query parameter of the mode (repeatable), e.g. `-p randomness=0.5`.
+    #[arg(long = "param", short = 'p', value_name = "KEY=VALUE")]
+    pub params: Vec<String>,
+    /// Output archive: NAME.pmtiles or NAME.mbtiles.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
 }
 
 /// `textile info`.

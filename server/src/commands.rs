@@ -1,5 +1,6 @@
 //! The one-shot commands: `analyze` (with a progress bar), `render` (a tile, a window or a
-//! perspective camera view through per-sample queries, to an image file, for scripts) and `info` (an analysis file's header).
+//! perspective camera view through per-sample queries, to an image file, for scripts), `export`
+//! (an archive of tiles) and `info` (an analysis file's header).
 
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -9,9 +10,10 @@ use textile_core::modes::params::{Scope, COMMON};
 use textile_core::samples::{self, camera::GroundCamera, Footprint};
 use textile_core::{Analysis, Exemplar, ExemplarOptions, ModeParams, ParamReader, Progress, Pyramid};
 
-use crate::cli::{AnalyzeArgs, CliResult, InfoArgs, RenderArgs};
+use crate::cli::{AnalyzeArgs, CliResult, ConfigArgs, ExportArgs, InfoArgs, RenderArgs};
 use crate::config::{Config, Overrides, TextureConfig};
 use crate::encode::{encode, Effort, Format};
+use crate::export;
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::textures::{exemplar_bytes, load_registry, Texture};
@@ -133,28 +135,10 @@ pub fn render(a: RenderArgs) -> CliResult {
         let an = Analysis::build(&ex, &textile_core::NoProgress);
         Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
     } else {
-        let id = a.texture.clone().unwrap_or_default();
-        let overrides = Overrides { data_dir: a.config.data_dir.clone(), ..Default::default() };
-        let cfg = Config::load(a.config.config.as_deref(), &overrides)?;
-        let mut only = cfg.clone();
-        only.textures.retain(|t| t.id == id);
-        if only.textures.is_empty() {
-            let ids: Vec<_> = cfg.textures.iter().map(|t| t.id.as_str()).collect();
-            return Err(format!("no texture '{id}'; configured: {}", ids.join(", ")).into());
-        }
-        let _ = exemplar_bytes(&only, &only.textures[0])?;
-        let reg = load_registry(&only, &|s| eprintln!("{s}"), &textile_core::NoProgress)?;
-        reg.list[0].clone()
+        configured_texture(&a.config, a.texture.as_deref().unwrap_or_default())?
     };
     // The flags and `--param` pairs are read like a query string, with texture settings allowed.
-    let mut pairs: Vec<(String, String)> = Vec::new();
-    for p in &a.params {
-        let (k, v) = p.split_once('=').ok_or_else(|| format!("--param '{p}' must be KEY=VALUE"))?;
-        pairs.push((k.trim().to_string(), v.trim().to_string()));
-    }
-    let flags =
-        [("mode", a.mode.clone()), ("seed", a.seed.map(|s| s.to_string())), ("world", a.world.map(|w| w.to_string()))];
-    pairs.extend(flags.into_iter().filter_map(|(k, v)| v.map(|v| (k.to_string(), v))));
+    let pairs = param_pairs(&a.params, &a.mode, a.seed, a.world)?;
     let params = tex.defaults.request(&tex.source(), ParamReader::texture(pairs)?)?;
     let z = a.z.unwrap_or(tex.native_zoom());
     if z > tex.max_zoom() {
@@ -191,6 +175,92 @@ pub fn render(a: RenderArgs) -> CliResult {
     let (bytes, r) = ImageJob { tex, params, target }.bytes(&Pyramid::off())?;
     write_atomic(&output, &bytes)?;
     println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
+    Ok(())
+}
+
+/// A configured texture, loaded (analysed if its analysis is not stored) from the data directory.
+fn configured_texture(c: &ConfigArgs, id: &str) -> Result<Arc<Texture>, Box<dyn std::error::Error>> {
+    let overrides = Overrides { data_dir: c.data_dir.clone(), ..Default::default() };
+    let cfg = Config::load(c.config.as_deref(), &overrides)?;
+    let mut only = cfg.clone();
+    only.textures.retain(|t| t.id == id);
+    if only.textures.is_empty() {
+        let ids: Vec<_> = cfg.textures.iter().map(|t| t.id.as_str()).collect();
+        return Err(format!("no texture '{id}'; configured: {}", ids.join(", ")).into());
+    }
+    let _ = exemplar_bytes(&only, &only.textures[0])?;
+    let reg = load_registry(&only, &|s| eprintln!("{s}"), &textile_core::NoProgress)?;
+    Ok(reg.list[0].clone())
+}
+
+/// The `--param KEY=VALUE` pairs and the flags, as query pairs.
+fn param_pairs(
+    params: &[String],
+    mode: &Option<String>,
+    seed: Option<u64>,
+    world: Option<u64>,
+) -> Result<Vec<(String, String)>, String> {
+    let mut pairs: Vec<(String, String)> = Vec::new();
+    let flags =
+        [("mode", mode.clone()), ("seed", seed.map(|s| s.to_string())), ("world", world.map(|w| w.to_string()))];
+    pairs.extend(flags.into_iter().filter_map(|(k, v)| v.map(|v| (k.to_string(), v))));
+    for p in params {
+        let (k, v) = p.split_once('=').ok_or_else(|| format!("--param '{p}' must be KEY=VALUE"))?;
+        pairs.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    Ok(pairs)
+}
+
+/// `textile export`: tiles into a PMTiles or MBTiles archive.
+pub fn export(a: ExportArgs) -> CliResult {
+    let tex = configured_texture(&a.config, &a.texture)?;
+    let pairs = param_pairs(&a.params, &a.mode, a.seed, None)?;
+    let bbox = match &a.bbox {
+        Some(b) => {
+            let v: Vec<u32> = b
+                .split(',')
+                .map(|s| s.trim().parse::<u32>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| "--bbox must be X0,Y0,X1,Y1 non-negative integers")?;
+            let [x0, y0, x1, y1] = v[..] else {
+                return Err("--bbox must be X0,Y0,X1,Y1".into());
+            };
+            Some((x0, y0, x1, y1))
+        }
+        None => None,
+    };
+    let zooms = match &a.zoom {
+        Some(z) => {
+            let (lo, hi) = z.split_once("..").unwrap_or((z, z));
+            let n = |s: &str| s.trim().parse::<u32>().map_err(|_| format!("--zoom '{z}' must be MIN..MAX or Z"));
+            Some((n(lo)?, n(hi)?))
+        }
+        None => None,
+    };
+    let format = Format::from_ext(&a.format).ok_or("--format must be png, jpg or webp")?;
+    let plan = export::Plan::new(tex, pairs, a.world, bbox, zooms, format)?;
+    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !matches!(ext, "pmtiles" | "mbtiles") {
+        return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", a.output.display()).into());
+    }
+    eprintln!(
+        "exporting {} tiles of '{}' (archive zooms {}..={}, ?{}) to {}",
+        plan.count(),
+        plan.tex.config.id,
+        plan.zooms.0,
+        plan.zooms.1,
+        plan.query,
+        a.output.display()
+    );
+    let r = export::run(&plan, &a.output)?;
+    println!(
+        "wrote {} ({} tiles, {} bytes) in {:.1} s: {:.0} tiles/s",
+        a.output.display(),
+        r.tiles,
+        r.bytes,
+        r.secs,
+        r.tiles as f64 / r.secs.max(1e-9)
+    );
     Ok(())
 }
 

@@ -17,6 +17,7 @@ pub mod commands;
 pub mod config;
 pub mod encode;
 pub mod error;
+pub mod export;
 pub mod http;
 pub mod loadtest;
 pub mod memory;
@@ -38,6 +39,7 @@ pub fn run() -> std::process::ExitCode {
         Some(cli::Command::Analyze(a)) => commands::analyze(a),
         Some(cli::Command::Render(a)) => commands::render(a),
         Some(cli::Command::Info(a)) => commands::info(a),
+        Some(cli::Command::Export(a)) => commands::export(a),
         Some(cli::Command::Loadtest(a)) => loadtest::run(a),
     };
     match result {

@@ -1,0 +1,304 @@
+//! `textile export`: a finite part of the texture pre-rendered into one archive file that any
+//! static host or CDN serves — PMTiles v3 ([`pmtiles_sink`]) or MBTiles ([`mbtiles_sink`]).
+//!
+//! The infinite plane becomes a Web-Mercator world by periodicity: with `world = 2^k` native
+//! tiles the texture repeats exactly once around the world, archive zoom `a` is textile zoom
+//! `a + native − k`, and archive tiles are `0 ≤ x, y < 2^a` — MapLibre, OpenLayers and Leaflet
+//! show a seamless world. A sub-rectangle (`--bbox`, tile coordinates at the highest zoom) keeps
+//! textile's own zooms and coordinates.
+//!
+//! Tiles are made by the same [`ImageJob`] as served tiles (an exported tile's bytes equal the
+//! server's answer for the same URL), rendered in parallel in chunks and written in ascending
+//! Hilbert tile id by one writer (the order PMTiles needs to be clustered), with a progress bar
+//! and bounded memory; the archive is written under a temporary name and renamed when complete,
+//! so an interrupted export never leaves a half-written file under the target name.
+
+pub mod mbtiles_sink;
+pub mod pmtiles_sink;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use serde_json::json;
+use textile_core::{ModeParams, ParamReader, Pyramid};
+
+use crate::encode::Format;
+use crate::pipeline::{engine_version, ImageJob, Target};
+use crate::request::TileSpec;
+use crate::textures::Texture;
+
+/// Tiles rendered per chunk per pool thread: what is held in memory before it is written.
+const CHUNK_PER_THREAD: usize = 32;
+/// Level cache shared by the export's tiles (tiles come in Hilbert order: neighbours share it).
+const LEVEL_CACHE: u64 = 256 << 20;
+/// Web-Mercator latitude limit.
+const MAX_LAT: f64 = 85.051_128_779_806_59;
+
+/// Which part of the texture to export.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Area {
+    /// A periodic world of `2^k` native tiles, archive zooms `lo..=hi` (`hi ≤ k`).
+    World {
+        /// log2 of the period in native tiles.
+        k: u32,
+    },
+    /// Tiles `[x0, x1) × [y0, y1)` at the highest zoom (and their parents below), textile zooms.
+    Bbox {
+        /// First column at the highest zoom.
+        x0: u32,
+        /// First row.
+        y0: u32,
+        /// One past the last column.
+        x1: u32,
+        /// One past the last row.
+        y1: u32,
+    },
+}
+
+/// An export, validated.
+#[derive(Clone)]
+pub struct Plan {
+    /// The texture.
+    pub tex: Arc<Texture>,
+    /// The mode and parameters (request parameters only: what a tile URL can carry).
+    pub params: ModeParams,
+    /// The query string that gives the server's tiles the same bytes (`world` included).
+    pub query: String,
+    /// The area.
+    pub area: Area,
+    /// Archive zooms, inclusive.
+    pub zooms: (u32, u32),
+    /// Tile encoding.
+    pub format: Format,
+}
+
+/// One tile to write: archive address and the textile tile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Entry {
+    /// Archive zoom, column, row.
+    pub z: u8,
+    /// Column.
+    pub x: u32,
+    /// Row.
+    pub y: u32,
+    /// The textile tile.
+    pub tile: TileSpec,
+}
+
+/// Where tiles go: an archive format.
+pub trait Sink {
+    /// Add a tile (called in ascending PMTiles tile id).
+    fn add(&mut self, e: &Entry, bytes: &[u8]) -> Result<(), String>;
+    /// Complete the archive.
+    fn finish(self: Box<Self>) -> Result<(), String>;
+}
+
+impl Plan {
+    /// Validate an export: `pairs` are the tile query parameters (mode, seed, the mode's own),
+    /// `world` the period in native tiles (world exports), `bbox` a rectangle instead, `zooms`
+    /// the archive zooms (default: all the area has).
+    pub fn new(
+        tex: Arc<Texture>,
+        mut pairs: Vec<(String, String)>,
+        world: Option<u64>,
+        bbox: Option<(u32, u32, u32, u32)>,
+        zooms: Option<(u32, u32)>,
+        format: Format,
+    ) -> Result<Plan, String> {
+        let native = tex.native_zoom();
+        let (area, all) = match bbox {
+            Some((x0, y0, x1, y1)) => {
+                let (lo, hi) = zooms.unwrap_or((native, native));
+                if hi > native || lo > hi {
+                    return Err(format!("--zoom {lo}..{hi}: a bbox export has zooms {}..={native}", tex.min_zoom()));
+                }
+                if x0 >= x1 || y0 >= y1 || x1 > 1 << hi || y1 > 1 << hi {
+                    return Err(format!(
+                        "--bbox {x0},{y0},{x1},{y1}: needs X0 < X1 ≤ 2^{hi} and Y0 < Y1 ≤ 2^{hi} (archives address tiles 0 ≤ x, y < 2^z; use a world export for the whole plane)"
+                    ));
+                }
+                (Area::Bbox { x0, y0, x1, y1 }, (lo, hi))
+            }
+            None => {
+                let w = world.unwrap_or(1 << native);
+                if !w.is_power_of_two() || w > 1 << 24 {
+                    return Err(format!("--world {w}: a power of two up to 2^24 native tiles"));
+                }
+                let k = w.trailing_zeros();
+                pairs.push(("world".into(), w.to_string()));
+                let first = k.saturating_sub(native);
+                let (lo, hi) = zooms.unwrap_or((first, k));
+                if lo < first || hi > k || lo > hi {
+                    return Err(format!(
+                        "--zoom {lo}..{hi}: a world of 2^{k} native tiles has archive zooms {first}..={k} (archive zoom a is textile zoom a + {native} - {k})"
+                    ));
+                }
+                (Area::World { k }, (lo, hi))
+            }
+        };
+        let query = form_urlencoded::Serializer::new(String::new()).extend_pairs(&pairs).finish();
+        let params = tex.defaults.request(&tex.source(), ParamReader::request(pairs).map_err(|e| e.to_string())?);
+        let params = params.map_err(|e| e.to_string())?;
+        Ok(Plan { tex, params, query, area, zooms: all, format })
+    }
+
+    /// Textile zoom of archive zoom `a`.
+    fn textile_zoom(&self, a: u32) -> u32 {
+        match self.area {
+            Area::World { k } => a + self.tex.native_zoom() - k,
+            Area::Bbox { .. } => a,
+        }
+    }
+
+    /// The tiles of one archive zoom.
+    fn tiles_at(&self, a: u32) -> (u32, u32, u32, u32) {
+        match self.area {
+            Area::World { .. } => (0, 0, 1 << a, 1 << a),
+            Area::Bbox { x0, y0, x1, y1 } => {
+                let s = self.zooms.1 - a;
+                (x0 >> s, y0 >> s, ((x1 - 1) >> s) + 1, ((y1 - 1) >> s) + 1)
+            }
+        }
+    }
+
+    /// Number of tiles.
+    pub fn count(&self) -> u64 {
+        (self.zooms.0..=self.zooms.1)
+            .map(|a| {
+                let (x0, y0, x1, y1) = self.tiles_at(a);
+                (x1 - x0) as u64 * (y1 - y0) as u64
+            })
+            .sum()
+    }
+
+    /// Every tile, in ascending PMTiles tile id (zoom, then Hilbert order within it).
+    pub fn entries(&self) -> Vec<Entry> {
+        let mut out = Vec::with_capacity(self.count() as usize);
+        for a in self.zooms.0..=self.zooms.1 {
+            let (x0, y0, x1, y1) = self.tiles_at(a);
+            let z = self.textile_zoom(a);
+            let mut level: Vec<(u64, Entry)> = (y0..y1)
+                .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let tile = TileSpec { z, x: x as i64, y: y as i64, scale: 1, format: self.format };
+                    (pmtiles_sink::tile_id(a as u8, x, y), Entry { z: a as u8, x, y, tile })
+                })
+                .collect();
+            level.sort_unstable_by_key(|(id, _)| *id);
+            out.extend(level.into_iter().map(|(_, e)| e));
+        }
+        out
+    }
+
+    /// Longitude/latitude bounds of the area.
+    pub fn bounds(&self) -> [f64; 4] {
+        let (x0, y0, x1, y1) = self.tiles_at(self.zooms.1);
+        let n = (1u64 << self.zooms.1) as f64;
+        let lon = |x: u32| x as f64 / n * 360.0 - 180.0;
+        let lat = |y: u32| (std::f64::consts::PI * (1.0 - 2.0 * y as f64 / n)).sinh().atan().to_degrees();
+        [lon(x0), lat(y1).max(-MAX_LAT), lon(x1), lat(y0).min(MAX_LAT)]
+    }
+
+    /// The archive's JSON metadata: what it shows, and how to make the same tiles again.
+    pub fn metadata(&self) -> serde_json::Value {
+        let c = &self.tex.config;
+        let (offset, world) = match self.area {
+            Area::World { k } => (self.tex.native_zoom() as i64 - k as i64, Some(1u64 << k)),
+            Area::Bbox { .. } => (0, None),
+        };
+        json!({
+            "name": c.name,
+            "description": format!("textile texture '{}' ({}), exported by {}", c.id, self.params.name(), engine_version()),
+            "attribution": c.attribution,
+            "type": "baselayer",
+            "format": self.format.ext(),
+            "version": engine_version(),
+            "minzoom": self.zooms.0,
+            "maxzoom": self.zooms.1,
+            "bounds": self.bounds(),
+            "textile": {
+                "texture": c.id,
+                "mode": self.params.name(),
+                "parameters": self.params.canonical(),
+                "query": self.query,
+                "world": world,
+                "zoom_offset": offset,
+                "engine": engine_version(),
+                "analysis": self.tex.file_hash(),
+                "tile_url": format!("/tiles/{}/{{z+{offset}}}/{{x}}/{{y}}.{}?{}", c.id, self.format.ext(), self.query),
+            }
+        })
+    }
+}
+
+/// `path` with its final name prefixed by a dot and suffixed by the process id: the name an
+/// archive is written under until it is complete.
+pub fn temp_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+}
+
+/// What an export did.
+#[derive(Debug, Clone, Copy)]
+pub struct Report {
+    /// Tiles written.
+    pub tiles: u64,
+    /// Bytes of the archive.
+    pub bytes: u64,
+    /// Seconds.
+    pub secs: f64,
+}
+
+/// Run an export to `output` (`.pmtiles` or `.mbtiles`).
+pub fn run(plan: &Plan, output: &Path) -> Result<Report, String> {
+    let tmp = temp_path(output);
+    let started = std::time::Instant::now();
+    let result = write(plan, output, &tmp);
+    match result {
+        Ok(tiles) => {
+            std::fs::rename(&tmp, output).map_err(|e| format!("{}: {e}", output.display()))?;
+            let bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
+            Ok(Report { tiles, bytes, secs: started.elapsed().as_secs_f64() })
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+fn write(plan: &Plan, output: &Path, tmp: &Path) -> Result<u64, String> {
+    let ext = output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let mut sink: Box<dyn Sink> = match ext.as_str() {
+        "pmtiles" => Box::new(pmtiles_sink::PmtilesSink::create(tmp, plan)?),
+        "mbtiles" => Box::new(mbtiles_sink::MbtilesSink::create(tmp, plan)?),
+        _ => return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", output.display())),
+    };
+    let entries = plan.entries();
+    let bar = ProgressBar::new(entries.len() as u64);
+    if let Ok(s) =
+        ProgressStyle::with_template("{spinner} exporting [{bar:30}] {pos}/{len} tiles ({per_sec}, {eta} left)")
+    {
+        bar.set_style(s.progress_chars("=> "));
+    }
+    let pyramid = Pyramid::new(LEVEL_CACHE);
+    let chunk = CHUNK_PER_THREAD * rayon::current_num_threads().max(1);
+    for part in entries.chunks(chunk) {
+        let bytes: Vec<Result<Vec<u8>, String>> = part
+            .par_iter()
+            .map(|e| {
+                let job = ImageJob { tex: plan.tex.clone(), params: plan.params.clone(), target: Target::Tile(e.tile) };
+                job.bytes(&pyramid).map(|(b, _)| b).map_err(|err| err.message)
+            })
+            .collect();
+        for (e, b) in part.iter().zip(bytes) {
+            sink.add(e, &b?)?;
+        }
+        bar.inc(part.len() as u64);
+    }
+    bar.finish_and_clear();
+    sink.finish()?;
+    Ok(entries.len() as u64)
+}

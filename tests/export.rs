@@ -1,0 +1,119 @@
+//! `textile export` against the real binary: PMTiles and MBTiles archives read back by
+//! independent readers (PyPI `pmtiles`, Python's sqlite3 — `tests/export/check_archive.py`)
+//! whose tiles equal the running server's answers for the same URLs; world and bbox areas;
+//! clear errors; and an interrupted export leaves nothing under the target name.
+
+mod support;
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use support::{binary, shared_data_dir, skip, Server};
+
+fn textile(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(binary()).args(args).output().expect("run textile");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn export(args: &[&str], out: &Path) {
+    let data = shared_data_dir();
+    let mut all =
+        vec!["export", "--texture", "gravel", "--data-dir", data.to_str().unwrap(), "-o", out.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let (code, stdout, err) = textile(&all);
+    assert_eq!(code, 0, "export {args:?}: {err}");
+    assert!(stdout.contains("tiles/s"), "{stdout}");
+}
+
+/// The independent reader: Python with the `pmtiles` package (installed by `.ci/run`).
+fn reader_available() -> bool {
+    Command::new("python3").args(["-c", "import pmtiles.reader"]).output().is_ok_and(|o| o.status.success())
+}
+
+fn check(archive: &Path, s: &Server) {
+    let script = format!("{}/../tests/export/check_archive.py", env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new("python3").args([&script, archive.to_str().unwrap(), &s.base]).output().expect("python3");
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}: {report}{}", archive.display(), String::from_utf8_lossy(&out.stderr));
+    assert!(report.contains("\"problems\": []"), "{report}");
+}
+
+#[tokio::test]
+async fn archives_hold_the_servers_tiles() {
+    if !reader_available() {
+        return skip(
+            "archives_hold_the_servers_tiles",
+            "python3 with the pmtiles package (pip install -r tests/export/requirements.txt)",
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (world, mosaic, bbox) =
+        (dir.path().join("world.pmtiles"), dir.path().join("mosaic.mbtiles"), dir.path().join("part.pmtiles"));
+    // A world of 8 native tiles: archive zooms 0..3 are textile zooms 4..7.
+    export(&["--world", "8"], &world);
+    export(&["--world", "4", "--mode", "mosaic", "--seed", "3", "--format", "webp"], &mosaic);
+    export(&["--bbox", "3,5,9,8", "--zoom", "5..7", "--format", "jpg", "-p", "randomness=0.5"], &bbox);
+    let s = Server::builder().data_dir(&shared_data_dir()).start();
+    for a in [&world, &mosaic, &bbox] {
+        check(a, &s);
+    }
+    // Nothing but the archives was left in the directory.
+    let names: Vec<String> =
+        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    assert_eq!(names.len(), 3, "{names:?}");
+}
+
+#[test]
+fn bad_exports_are_clear_errors_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.pmtiles");
+    let data = shared_data_dir();
+    let base = ["export", "--texture", "gravel", "--data-dir", data.to_str().unwrap()];
+    for (args, what) in [
+        (vec!["--world", "6", "-o", out.to_str().unwrap()], "power of two"),
+        (vec!["--world", "8", "--zoom", "0..5", "-o", out.to_str().unwrap()], "archive zooms 0..=3"),
+        (vec!["--bbox", "0,0,200,1", "-o", out.to_str().unwrap()], "--bbox"),
+        (vec!["--bbox", "1,2,3", "-o", out.to_str().unwrap()], "--bbox"),
+        (vec!["-p", "kappa=0.5", "-o", out.to_str().unwrap()], "kappa"),
+        (vec!["-o", dir.path().join("x.zip").to_str().unwrap()], ".pmtiles or .mbtiles"),
+    ] {
+        let (code, _, err) = textile(&[&base[..], &args[..]].concat());
+        assert_ne!(code, 0, "{args:?}");
+        assert!(err.contains(what), "{args:?}: {err}");
+    }
+    let (code, _, err) = textile(&["export", "--texture", "nosuch", "-o", out.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("nosuch"), "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "nothing written");
+}
+
+#[test]
+fn an_interrupted_export_leaves_no_file_under_the_target_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("big.pmtiles");
+    let data = shared_data_dir();
+    // 21 845 tiles: minutes of work, killed once it is under way.
+    let mut child = Command::new(binary())
+        .args(["export", "--texture", "gravel", "--data-dir", data.to_str().unwrap(), "--world", "128"])
+        .args(["-o", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("start export");
+    let started = Instant::now();
+    let temp =
+        || std::fs::read_dir(dir.path()).unwrap().any(|e| e.unwrap().file_name().to_string_lossy().contains(".tmp-"));
+    while !temp() && started.elapsed() < Duration::from_secs(120) {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(temp(), "the export writes under a temporary name");
+    std::thread::sleep(Duration::from_millis(500));
+    child.kill().expect("kill -9");
+    child.wait().expect("wait");
+    assert!(!out.exists(), "no file under the target name after kill -9");
+}
