@@ -25,6 +25,7 @@ const ENV_KEYS: &[&str] = &[
     "max_in_flight",
     "max_queue_wait_ms",
     "max_exemplar_side",
+    "public_url",
 ];
 
 /// Tri-state toroidal setting of a texture.
@@ -155,6 +156,15 @@ pub struct Config {
     /// otherwise replace them); a texture of the same id replaces the built-in one.
     #[serde(default)]
     pub include_default_textures: bool,
+    /// The URL clients reach the service at (e.g. behind a proxy), used for absolute URLs in
+    /// documents (TileJSON `tiles`, catalog links, glTF extras, X3D textures); empty: from the
+    /// request (its `Host`, or the forwarded headers of a trusted proxy).
+    #[serde(default)]
+    pub public_url: String,
+    /// Addresses of reverse proxies whose `X-Forwarded-Proto`/`X-Forwarded-Host` (or
+    /// `Forwarded`) headers are believed; from anyone else they are ignored.
+    #[serde(default)]
+    pub trusted_proxies: Vec<String>,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
     /// Directory relative exemplar paths are resolved against (set by the loader).
@@ -271,6 +281,19 @@ impl Config {
         }
         if axum::http::HeaderValue::from_str(&self.cache_control).is_err() {
             return bad("cache_control", "must be a valid header value".into());
+        }
+        if !self.public_url.is_empty() {
+            let ok = url::Url::parse(&self.public_url)
+                .is_ok_and(|u| matches!(u.scheme(), "http" | "https") && u.host().is_some() && u.query().is_none());
+            if !ok {
+                return bad(
+                    "public_url",
+                    format!("'{}' is not an http(s) URL like https://tiles.example.org", self.public_url),
+                );
+            }
+        }
+        if let Some(p) = self.trusted_proxies.iter().find(|p| p.parse::<std::net::IpAddr>().is_err()) {
+            return bad("trusted_proxies", format!("'{p}' is not an IP address"));
         }
         if self.textures.is_empty() {
             return bad("textures", "at least one texture is needed".into());

@@ -14,7 +14,7 @@ use textile_core::modes::{Cost, Needs};
 use textile_core::{MODE_NAMES, TILE_SIZE};
 
 use crate::error::{ApiError, Kind};
-use crate::http::extract::{base_url, path_error, texture};
+use crate::http::extract::{base_url, path_error, texture, Peer};
 use crate::pipeline::engine_version;
 use crate::request::{params, query_pairs};
 use crate::state::AppState;
@@ -59,9 +59,9 @@ pub async fn ready(State(st): State<Arc<AppState>>) -> Result<Json<Value>, ApiEr
 
 /// The textures served.
 #[utoipa::path(get, path = "/catalog", tag = "textures", responses((status = 200, description = "catalog")))]
-pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap) -> Result<Json<Value>, ApiError> {
+pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap, peer: Peer) -> Result<Json<Value>, ApiError> {
     let reg = st.ready()?;
-    let base = base_url(&st, &headers);
+    let base = base_url(&st, &headers, peer);
     let textures: Vec<Value> = reg
         .list
         .iter()
@@ -208,6 +208,7 @@ pub async fn tilejson(
     path: Result<Path<String>, PathRejection>,
     RawQuery(raw): RawQuery,
     headers: HeaderMap,
+    peer: Peer,
 ) -> Result<Json<Value>, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
@@ -228,7 +229,7 @@ pub async fn tilejson(
     for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
         qs.append_pair(k, v);
     }
-    let base = base_url(&st, &headers);
+    let base = base_url(&st, &headers, peer);
     Ok(Json(json!({
         "tilejson": "3.0.0",
         "name": t.config.name,

@@ -18,7 +18,7 @@ use crate::assets::{glb, gltf_json, x3d, Quad};
 use crate::encode::Format;
 use crate::error::ApiError;
 use crate::http::content::{if_none_match, image, not_modified};
-use crate::http::extract::{base_url, path_error, texture};
+use crate::http::extract::{base_url, path_error, texture, Peer};
 use crate::metrics::GLTF_LABEL;
 use crate::pipeline::{cache_key, cached, engine_version, etag_for, produce, ImageJob, Target};
 use crate::request::{params, parse_tile, query_pairs, TileSpec, COORD_MAX};
@@ -142,6 +142,7 @@ pub async fn gltf_tile(
     path: Result<Path<(String, String, String, String)>, PathRejection>,
     RawQuery(raw): RawQuery,
     headers: HeaderMap,
+    peer: Peer,
 ) -> Result<Response, ApiError> {
     let (r, ext) = tile_request(&st, path, raw, &["glb", "gltf", "png"])?;
     let cc = &st.config.cache_control;
@@ -160,7 +161,7 @@ pub async fn gltf_tile(
         return Ok(image(bytes, "image/png", &etag, cc, found));
     }
     if ext == "gltf" {
-        let base = base_url(&st, &headers);
+        let base = base_url(&st, &headers, peer);
         let etag = etag_for(&key(&r, "gltf", &base));
         if if_none_match(&headers, &etag) {
             return Ok(not_modified(&etag, cc));
@@ -258,9 +259,10 @@ pub async fn x3d_tile(
     path: Result<Path<(String, String, String, String)>, PathRejection>,
     RawQuery(raw): RawQuery,
     headers: HeaderMap,
+    peer: Peer,
 ) -> Result<Response, ApiError> {
     let (r, _) = tile_request(&st, path, raw, &["x3d"])?;
-    let base = base_url(&st, &headers);
+    let base = base_url(&st, &headers, peer);
     let etag = etag_for(&key(&r, "x3d", &base));
     let cc = &st.config.cache_control;
     if if_none_match(&headers, &etag) {

@@ -69,8 +69,11 @@ async fn serve(cfg: Config) -> CliResult {
             analyse_registry(&state.config, &reg, &log, &LogProgress)
         })
     };
-    let server =
-        tokio::spawn(async move { axum::serve(listener, app).with_graceful_shutdown(shutdown_signal()).await });
+    let server = tokio::spawn(async move {
+        axum::serve(listener, app.into_make_service_with_connect_info::<std::net::SocketAddr>())
+            .with_graceful_shutdown(shutdown_signal())
+            .await
+    });
     tokio::spawn(crate::memory::return_freed_memory());
     match loader.await? {
         Ok(()) => {
