@@ -42,3 +42,34 @@ fn viewer_in_headless_chromium() {
     assert!(status.success(), "browser tests failed (see the node test output above)");
     eprintln!("viewer screenshot: {}", shot.display());
 }
+
+#[test]
+fn exported_archive_in_headless_chromium() {
+    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/browser");
+    if !PathBuf::from(&chromium).exists() {
+        return support::skip("exported_archive_in_headless_chromium", &format!("no Chromium at {chromium}"));
+    }
+    if let Err(why) = support::npm_ready(&dir, "playwright-core") {
+        return support::skip("exported_archive_in_headless_chromium", &why);
+    }
+    let archives = tempfile::tempdir().unwrap();
+    let data = support::shared_data_dir();
+    let out = archives.path().join("world.pmtiles");
+    let status = Command::new(support::binary())
+        .args(["export", "--texture", "gravel", "--world", "8", "--data-dir", data.to_str().unwrap(), "-o"])
+        .arg(&out)
+        .status()
+        .expect("export");
+    assert!(status.success());
+    let server = Server::builder().env("TEXTILE_ARCHIVES_DIR", archives.path().to_str().unwrap()).start();
+    let status = Command::new("node")
+        .args(["--test", "pmtiles.test.mjs"])
+        .current_dir(&dir)
+        .env("TEXTILE_URL", &server.base)
+        .env("TEXTILE_ARCHIVE", "/archives/world.pmtiles")
+        .env("CHROMIUM", &chromium)
+        .status()
+        .expect("run node");
+    assert!(status.success(), "archive page test failed (see the node test output above)");
+}

@@ -26,6 +26,7 @@ const ENV_KEYS: &[&str] = &[
     "max_queue_wait_ms",
     "max_exemplar_side",
     "public_url",
+    "archives_dir",
 ];
 
 /// Tri-state toroidal setting of a texture.
@@ -165,6 +166,10 @@ pub struct Config {
     /// `Forwarded`) headers are believed; from anyone else they are ignored.
     #[serde(default)]
     pub trusted_proxies: Vec<String>,
+    /// A directory of exported archives served under `/archives/` (with range requests, for
+    /// PMTiles readers); empty: none.
+    #[serde(default)]
+    pub archives_dir: String,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
     /// Directory relative exemplar paths are resolved against (set by the loader).

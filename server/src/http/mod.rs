@@ -60,6 +60,16 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/gltf/{id}/patch.glb", get(models::gltf_patch))
         .route("/gltf/{id}/{z}/{x}/{y}", get(models::gltf_tile))
         .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile));
+    // Exported archives, served as static files with range requests (what PMTiles readers use).
+    let routes = match state.config.archives_dir.as_str() {
+        "" => routes,
+        dir => {
+            use axum::handler::HandlerWithoutStateExt;
+            let missing =
+                (|uri: axum::extract::OriginalUri| async move { meta::not_found(uri.0).await }).into_service();
+            routes.nest_service("/archives", tower_http::services::ServeDir::new(dir).fallback(missing))
+        }
+    };
     with_middleware(routes, state)
 }
 
@@ -68,12 +78,13 @@ pub fn router(state: Arc<AppState>) -> Router {
 fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Router {
     let cors = CorsLayer::new()
         .allow_methods([Method::GET, Method::HEAD, Method::POST])
-        .allow_headers([header::IF_NONE_MATCH, header::CONTENT_TYPE])
+        .allow_headers([header::IF_NONE_MATCH, header::CONTENT_TYPE, header::RANGE])
         .expose_headers([
             header::ETAG,
             header::HeaderName::from_static("x-cache"),
             header::HeaderName::from_static("x-textile-computed"),
             header::HeaderName::from_static("x-textile-windows"),
+            header::CONTENT_RANGE,
         ])
         .allow_origin(if state.config.cors_origins.iter().any(|o| o == "*") {
             AllowOrigin::any()

@@ -1,5 +1,5 @@
 //! The web viewer's files, compiled into the binary (`web/`): pages at `/` and `/world.html`,
-//! scripts, styles and the vendored libraries (with their licences) under `/static/`.
+//! the archive page `/static/pmtiles.html`, scripts, styles and the vendored libraries (with their licences) under `/static/`.
 
 use axum::extract::Path;
 use axum::http::{header, HeaderValue};
@@ -11,6 +11,10 @@ use crate::error::ApiError;
 const FILES: &[(&str, &str, &[u8])] = &[
     ("app.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/app.js")),
     ("world.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/world.js")),
+    ("pmtiles.html", "text/html; charset=utf-8", include_bytes!("../../../web/pmtiles.html")),
+    ("pmtiles.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/pmtiles.js")),
+    ("vendor/pmtiles.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/vendor/pmtiles.js")),
+    ("vendor/LICENSE-pmtiles", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/LICENSE-pmtiles")),
     ("style.css", "text/css; charset=utf-8", include_bytes!("../../../web/style.css")),
     ("vendor/leaflet.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/vendor/leaflet.js")),
     ("vendor/leaflet.css", "text/css; charset=utf-8", include_bytes!("../../../web/vendor/leaflet.css")),
