@@ -5,7 +5,8 @@ usage: check.py NGINX_URL REPLICA_URL REPLICA_URL REPLICA_URL --kill-pid PID
 
 (a) ~50 URLs (zooms, negative coordinates, every format, @2x, world, modes) are byte-identical
     with identical ETags from each replica and through nginx;
-(b) the same URI always reaches the same replica, and distinct URIs spread over all three;
+(b) the same URI always reaches the same replica, and distinct URIs spread over all three
+    (tiles of one 10 × 10 block share a replica: the nginx configuration's affinity key);
 (c) kill -9 of the replica with PID during a 16-client load over ~2000 cold URIs: zero failed
     requests, every body equal to the reference;
 (d) 100 concurrent requests for one fresh URI: exactly one synthesis over the live replicas;
@@ -73,7 +74,7 @@ def main():
     # (b) URI affinity.
     seen = {}
     for i in range(60):
-        u = f"/tiles/gravel/7/{i}/{-i}.png?mode=mosaic"
+        u = f"/tiles/gravel/7/{37 * i}/{-53 * i}.png?mode=mosaic"
         ups = set()
         for _ in range(3):
             s, h, _ = get(nginx + u, {"X-Cache-Bypass": "1"})
@@ -86,7 +87,11 @@ def main():
     spread = {v: list(seen.values()).count(v) for v in set(seen.values())}
     if len(spread) != 3:
         fail(f"(b) 60 URIs reached only {spread}")
-    print(f"(b) each URI always reaches one replica; 60 URIs spread {sorted(spread.values())}")
+    # Neighbours in one 10 × 10 block of tiles share a replica (the affinity key).
+    block = {get(nginx + f"/tiles/brick/7/{40 + d}/{-21 - d}.png", {"X-Cache-Bypass": "1"})[1].get("x-upstream") for d in range(7)}
+    if len(block) != 1:
+        fail(f"(b) one block of tiles reached {block}")
+    print(f"(b) each URI always reaches one replica; 60 URIs spread {sorted(spread.values())}; a block shares one")
 
     # (d) 100 concurrent requests for one fresh URI: one synthesis (before any replica dies).
     before = sum(syntheses(r) for r in replicas)
