@@ -67,6 +67,15 @@ CONF
 cluster_stop() {
   local p
   for p in "${REPLICA_PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  # Replicas drain for at most their shutdown grace; anything left after 15 s is killed.
+  for _ in $(seq 1 150); do
+    local alive=0
+    for p in "${REPLICA_PIDS[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    [ "$alive" = 0 ] && break
+    sleep 0.1
+  done
+  for p in "${REPLICA_PIDS[@]}"; do kill -9 "$p" 2>/dev/null || true; done
+  REPLICA_PIDS=()
   [ -n "${WORK:-}" ] && [ -f "$WORK/nginx.pid" ] && kill "$(cat "$WORK/nginx.pid")" 2>/dev/null || true
   wait 2>/dev/null || true
   [ -n "${WORK:-}" ] && rm -rf "$WORK"

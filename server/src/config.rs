@@ -27,6 +27,9 @@ const ENV_KEYS: &[&str] = &[
     "max_exemplar_side",
     "public_url",
     "archives_dir",
+    "max_connections",
+    "header_read_timeout_secs",
+    "shutdown_grace_secs",
 ];
 
 /// Tri-state toroidal setting of a texture.
@@ -123,6 +126,18 @@ fn default_toroidal() -> Toroidal {
     Toroidal::Auto
 }
 
+fn default_max_connections() -> usize {
+    1024
+}
+
+fn default_header_read_timeout() -> u64 {
+    10
+}
+
+fn default_shutdown_grace() -> u64 {
+    10
+}
+
 fn default_mode() -> String {
     "synth".into()
 }
@@ -166,6 +181,17 @@ pub struct Config {
     /// `Forwarded`) headers are believed; from anyone else they are ignored.
     #[serde(default)]
     pub trusted_proxies: Vec<String>,
+    /// Open connections at most; beyond, new connections wait to be accepted.
+    #[serde(default = "default_max_connections")]
+    pub max_connections: usize,
+    /// Seconds a client has to send a request's headers; also the longest idle time of a
+    /// keep-alive connection between requests.
+    #[serde(default = "default_header_read_timeout")]
+    pub header_read_timeout_secs: u64,
+    /// Seconds in-flight requests may take to finish after SIGINT/SIGTERM before the process
+    /// exits anyway.
+    #[serde(default = "default_shutdown_grace")]
+    pub shutdown_grace_secs: u64,
     /// A directory of exported archives served under `/archives/` (with range requests, for
     /// PMTiles readers); empty: none.
     #[serde(default)]
@@ -299,6 +325,15 @@ impl Config {
         }
         if let Some(p) = self.trusted_proxies.iter().find(|p| p.parse::<std::net::IpAddr>().is_err()) {
             return bad("trusted_proxies", format!("'{p}' is not an IP address"));
+        }
+        if !(1..=1_000_000).contains(&self.max_connections) {
+            return bad("max_connections", format!("{} is outside 1..=1000000", self.max_connections));
+        }
+        if !(1..=3600).contains(&self.header_read_timeout_secs) {
+            return bad("header_read_timeout_secs", format!("{} is outside 1..=3600", self.header_read_timeout_secs));
+        }
+        if self.shutdown_grace_secs > 3600 {
+            return bad("shutdown_grace_secs", format!("{} is outside 0..=3600", self.shutdown_grace_secs));
         }
         if self.textures.is_empty() {
             return bad("textures", "at least one texture is needed".into());

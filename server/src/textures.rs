@@ -157,6 +157,19 @@ pub enum LoadError {
         /// Cause.
         source: textile_core::modes::DefaultsError,
     },
+    /// The exemplar path is not a regular file, or is larger than any exemplar can be.
+    #[error("texture '{id}': exemplar {path}: {message}")]
+    NotAnImageFile {
+        /// Texture id.
+        id: String,
+        /// Exemplar path.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// Loading was stopped by a shutdown signal.
+    #[error("loading stopped by a shutdown signal")]
+    Stopped,
     /// The exemplar or its analysis is unusable.
     #[error("texture '{id}': {source}")]
     Core {
@@ -175,7 +188,45 @@ pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadEr
             .ok_or_else(|| LoadError::NoEmbedded { id: t.id.clone(), name: name.into() });
     }
     let path = cfg.base_dir.join(&t.exemplar);
+    // Regular files only (a FIFO or device would block the read or never end), of a bounded size.
+    let meta =
+        std::fs::metadata(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path: path.clone(), source })?;
+    let bad = |message: String| LoadError::NotAnImageFile { id: t.id.clone(), path: path.clone(), message };
+    if !meta.is_file() {
+        return Err(bad("is not a regular file".into()));
+    }
+    if meta.len() > MAX_EXEMPLAR_FILE {
+        return Err(bad(format!("is {} bytes; exemplar files are at most {MAX_EXEMPLAR_FILE}", meta.len())));
+    }
     std::fs::read(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path, source })
+}
+
+/// Largest exemplar file read (bytes): far beyond any accepted exemplar side, compressed.
+const MAX_EXEMPLAR_FILE: u64 = 256 << 20;
+
+/// Remove temporary analysis files (`.ID.tex.tmp-PID`) left by processes that no longer run
+/// (killed while writing); those of live processes (another replica sharing the directory) stay.
+fn remove_stale_temp_files(dir: &std::path::Path, log: &dyn Fn(String)) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name.strip_prefix('.').and_then(|n| n.rsplit_once(".tex.tmp-")).map(|(_, pid)| pid) else {
+            continue;
+        };
+        let alive = pid.parse::<u32>().is_ok_and(|p| std::path::Path::new(&format!("/proc/{p}")).exists());
+        if !alive && std::fs::remove_file(e.path()).is_ok() {
+            log(format!("removed {}, left by an interrupted analysis", e.path().display()));
+        }
+    }
+}
+
+/// Whether analyses can be stored in `dir` (created if missing): a probe file is written and
+/// removed.
+fn writable(dir: &std::path::Path) -> Result<(), std::io::Error> {
+    std::fs::create_dir_all(dir)?;
+    let probe = dir.join(format!(".probe-{}", std::process::id()));
+    std::fs::write(&probe, b"textile")?;
+    std::fs::remove_file(&probe)
 }
 
 /// Decode every configured texture's exemplar: a registry whose textures have no analysis yet.
@@ -211,18 +262,39 @@ pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, 
 
 /// Load or compute the analysis of every texture of a prepared registry, in configuration order
 /// (each texture serves its analysis-needing modes as soon as its own is attached). `progress`
-/// receives analysis progress.
+/// receives analysis progress; `stop` is asked between textures and ends the loading with
+/// [`LoadError::Stopped`] once it answers true.
+///
+/// The data directory is checked first: stale temporary files of interrupted writes are removed,
+/// and if analyses cannot be stored there (read-only, full, not a directory) the server warns
+/// and keeps them in memory only (recomputed at each start) rather than exit after computing them.
 pub fn analyse_registry(
     cfg: &Config,
     reg: &Registry,
     log: &dyn Fn(String),
     progress: &dyn Progress,
+    stop: &dyn Fn() -> bool,
 ) -> Result<(), LoadError> {
     let data_dir = cfg.data_dir();
+    let storable = match writable(&data_dir) {
+        Ok(()) => {
+            remove_stale_temp_files(&data_dir, log);
+            true
+        }
+        Err(e) => {
+            log(format!(
+                "warning: analyses cannot be stored in {} ({e}); computing them and keeping them in memory only",
+                data_dir.display()
+            ));
+            false
+        }
+    };
     for tex in &reg.list {
+        if stop() {
+            return Err(LoadError::Stopped);
+        }
         let t = &tex.config;
         let ex = &tex.exemplar;
-        let core = |source| LoadError::Core { id: t.id.clone(), source };
         let path = data_dir.join(format!("{}.tex", t.id));
         let expected = Analysis::id_for(ex);
         let analysis = match Analysis::load(&path) {
@@ -242,14 +314,20 @@ pub fn analyse_registry(
                 }
                 let started = std::time::Instant::now();
                 let a = Analysis::build(ex, progress);
-                a.save(&path).map_err(core)?;
+                let stored = if storable {
+                    match a.save(&path) {
+                        Ok(()) => format!("stored {}", path.display()),
+                        Err(e) => format!("warning: not stored ({e}); kept in memory only"),
+                    }
+                } else {
+                    "kept in memory only".to_string()
+                };
                 log(format!(
-                    "texture '{}': analysed {}x{} in {:.2}s, stored {}",
+                    "texture '{}': analysed {}x{} in {:.2}s, {stored}",
                     t.id,
                     a.side(),
                     a.side(),
-                    started.elapsed().as_secs_f64(),
-                    path.display()
+                    started.elapsed().as_secs_f64()
                 ));
                 a
             }
@@ -262,6 +340,6 @@ pub fn analyse_registry(
 /// Both phases: every texture with its analysis.
 pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress) -> Result<Registry, LoadError> {
     let reg = prepare_registry(cfg, log)?;
-    analyse_registry(cfg, &reg, log, progress)?;
+    analyse_registry(cfg, &reg, log, progress, &|| false)?;
     Ok(reg)
 }

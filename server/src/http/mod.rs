@@ -7,6 +7,7 @@ pub mod content;
 pub mod error;
 pub mod extract;
 pub mod images;
+pub mod listen;
 pub mod meta;
 pub mod models;
 pub mod openapi;

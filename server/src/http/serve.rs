@@ -1,17 +1,21 @@
 //! `textile serve`: load the configuration, start listening at once (answering `/health`, and
 //! 503 elsewhere while textures load), decode the exemplars (modes that need only the exemplar
 //! serve from then on), load or compute analyses, announce the viewer URL, and drain in-flight
-//! requests on SIGINT/SIGTERM.
+//! requests on SIGINT/SIGTERM for at most `shutdown_grace_secs` (a signal during start-up stops
+//! the loading and never announces ready). Connections are accepted by [`listen`].
 
 use std::sync::Arc;
+use std::time::Duration;
 
 use tokio::net::TcpListener;
+use tokio::sync::watch;
 use tracing::{info, warn};
 
+use super::listen::{self, Limits};
 use crate::cli::{CliResult, ServeArgs};
 use crate::config::{Config, Overrides};
 use crate::state::AppState;
-use crate::textures::{analyse_registry, prepare_registry};
+use crate::textures::{analyse_registry, prepare_registry, LoadError};
 
 struct LogProgress;
 
@@ -49,47 +53,67 @@ pub fn run(args: ServeArgs) -> CliResult {
         .thread_name(|i| format!("textile-synth-{i}"))
         .build_global()?;
     let rt = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
-    rt.block_on(serve(cfg))
+    let result = rt.block_on(serve(cfg));
+    // Do not wait for an analysis abandoned by a shutdown during start-up.
+    rt.shutdown_timeout(Duration::from_millis(100));
+    result
 }
 
 async fn serve(cfg: Config) -> CliResult {
     let listener = TcpListener::bind(&cfg.bind).await.map_err(|e| format!("cannot listen on {}: {e}", cfg.bind))?;
     let addr = listener.local_addr()?;
     crate::memory::tune_allocator();
+    let limits = Limits {
+        max_connections: cfg.max_connections,
+        header_read_timeout: Duration::from_secs(cfg.header_read_timeout_secs),
+        shutdown_grace: Duration::from_secs(cfg.shutdown_grace_secs),
+    };
     let state = Arc::new(AppState::new(cfg));
     let app = super::router(state.clone());
     info!("listening on http://{addr}/ (loading textures)");
+    // One shutdown signal for everything: the accept loop, and the loading below.
+    let (stop_tx, stop) = watch::channel(false);
+    tokio::spawn(async move {
+        shutdown_signal().await;
+        let _ = stop_tx.send(true);
+    });
     // Exemplars first (modes that need only the exemplar serve at once), then the analyses.
     let loader = {
         let state = state.clone();
+        let stop = stop.clone();
         tokio::task::spawn_blocking(move || {
             let log = |s: String| info!("{s}");
             let reg = Arc::new(prepare_registry(&state.config, &log)?);
             let _ = state.registry.set(reg.clone());
-            analyse_registry(&state.config, &reg, &log, &LogProgress)
+            analyse_registry(&state.config, &reg, &log, &LogProgress, &|| *stop.borrow())
         })
     };
-    let server = tokio::spawn(async move {
-        axum::serve(listener, app.into_make_service_with_connect_info::<std::net::SocketAddr>())
-            .with_graceful_shutdown(shutdown_signal())
-            .await
-    });
+    let server = tokio::spawn(listen::serve(listener, app, limits, stop.clone()));
     tokio::spawn(crate::memory::return_freed_memory());
-    match loader.await? {
-        Ok(()) => {
-            let n = state.registry.get().map(|r| r.list.len()).unwrap_or(0);
-            let plural = if n == 1 { "" } else { "s" };
-            println!("textile ready: viewer at http://{addr}/ ({n} texture{plural})");
-            use std::io::Write;
-            let _ = std::io::stdout().flush();
-        }
-        Err(e) => {
-            warn!("{e}");
-            return Err(Box::new(e));
-        }
+    let mut stopping = stop.clone();
+    tokio::select! {
+        loaded = loader => match loaded? {
+            Ok(()) => {
+                let n = state.registry.get().map(|r| r.list.len()).unwrap_or(0);
+                let plural = if n == 1 { "" } else { "s" };
+                println!("textile ready: viewer at http://{addr}/ ({n} texture{plural})");
+                use std::io::Write;
+                let _ = std::io::stdout().flush();
+            }
+            Err(LoadError::Stopped) => info!("stopped while loading textures"),
+            Err(e) => {
+                warn!("{e}");
+                return Err(Box::new(e));
+            }
+        },
+        // A signal while loading: stop at once (the analysis thread is abandoned at exit).
+        _ = stopping.wait_for(|s| *s) => info!("stopped while loading textures"),
     }
-    server.await??;
-    info!("shut down cleanly");
+    if server.await? {
+        info!("shut down cleanly");
+    } else {
+        warn!("shut down with requests still open after the drain deadline");
+    }
     Ok(())
 }
 

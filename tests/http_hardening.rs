@@ -1,0 +1,192 @@
+//! Hardening of the real binary against hostile or unlucky conditions (issue: hardening):
+//! silent, slow and idle connections are closed and never exhaust the descriptors; SIGTERM
+//! drains with a deadline even with a half-sent request open, and during start-up stops the
+//! loading without announcing ready; exemplar reads are bounded (a FIFO is refused); a data
+//! directory that cannot store analyses is survived; stale temporary files are removed.
+
+mod support;
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use support::{binary, shared_data_dir, Server};
+
+/// Wait for `child` to exit within `limit`; its exit code.
+fn exit_within(child: &mut std::process::Child, limit: Duration) -> Option<i32> {
+    let t = Instant::now();
+    while t.elapsed() < limit {
+        if let Ok(Some(s)) = child.try_wait() {
+            return Some(s.code().unwrap_or(-1));
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _ = child.kill();
+    None
+}
+
+fn addr(s: &Server) -> String {
+    s.base.trim_start_matches("http://").to_string()
+}
+
+/// Whether the server closed `c` (read returns EOF or an error) within `limit`.
+fn closed_within(c: &mut TcpStream, limit: Duration) -> bool {
+    c.set_read_timeout(Some(limit)).unwrap();
+    let mut b = [0u8; 64];
+    !matches!(c.read(&mut b), Err(ref e) if e.kind() == std::io::ErrorKind::WouldBlock || e.kind() == std::io::ErrorKind::TimedOut)
+}
+
+#[test]
+fn silent_slow_and_idle_connections_are_closed() {
+    let s = Server::builder().env("TEXTILE_HEADER_READ_TIMEOUT_SECS", "1").start();
+    // Silent: connected, nothing sent.
+    let mut silent: Vec<TcpStream> = (0..20).map(|_| TcpStream::connect(addr(&s)).unwrap()).collect();
+    // Slowloris: a header byte every 200 ms.
+    let mut slow = TcpStream::connect(addr(&s)).unwrap();
+    let started = Instant::now();
+    for b in b"GET /health HTTP/1.1\r\nHost: x\r\nX-Slow: aaaaaaaaaaaaaaaaaaaa".iter() {
+        if slow.write_all(&[*b]).is_err() || started.elapsed() > Duration::from_secs(4) {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    assert!(closed_within(&mut slow, Duration::from_secs(3)), "slowloris connection still open");
+    for c in silent.iter_mut() {
+        assert!(closed_within(c, Duration::from_secs(3)), "silent connection still open");
+    }
+    // Idle keep-alive: one request, then nothing.
+    let mut idle = TcpStream::connect(addr(&s)).unwrap();
+    idle.write_all(b"GET /health HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
+    let mut buf = [0u8; 4096];
+    let n = idle.read(&mut buf).unwrap();
+    assert!(String::from_utf8_lossy(&buf[..n]).starts_with("HTTP/1.1 200"));
+    assert!(closed_within(&mut idle, Duration::from_secs(3)), "idle keep-alive connection still open");
+}
+
+#[test]
+fn more_idle_connections_than_descriptors_do_not_stop_service() {
+    // 300 idle connections against a process limited to 256 descriptors.
+    let dir = shared_data_dir();
+    let port = std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -n 256 && exec {} serve --bind 127.0.0.1:{port} --data-dir {}", binary(), dir.display()))
+        .env("TEXTILE_HEADER_READ_TIMEOUT_SECS", "2")
+        .env("TEXTILE_MAX_CONNECTIONS", "200")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let base = format!("127.0.0.1:{port}");
+    let health = |limit: Duration| -> bool {
+        let t = Instant::now();
+        while t.elapsed() < limit {
+            if let Ok(mut c) = TcpStream::connect(&base) {
+                c.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+                let _ = c.write_all(b"GET /health HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+                let mut s = String::new();
+                if c.read_to_string(&mut s).is_ok() && s.starts_with("HTTP/1.1 200") {
+                    return true;
+                }
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        false
+    };
+    assert!(health(Duration::from_secs(60)), "server never answered");
+    let idle: Vec<TcpStream> = (0..300).filter_map(|_| TcpStream::connect(&base).ok()).collect();
+    assert!(idle.len() >= 250, "only {} connections", idle.len());
+    // Service goes on: at once for requests that find a free slot, else once idle ones time out.
+    assert!(health(Duration::from_secs(20)), "no service with 300 idle connections open");
+    drop(idle);
+    let _ = Command::new("kill").arg(child.id().to_string()).status();
+    assert_eq!(exit_within(&mut child, Duration::from_secs(15)), Some(0));
+}
+
+#[test]
+fn sigterm_with_a_half_sent_request_exits_after_the_drain_deadline() {
+    let s = Server::builder()
+        .env("TEXTILE_SHUTDOWN_GRACE_SECS", "2")
+        .env("TEXTILE_HEADER_READ_TIMEOUT_SECS", "120")
+        .start();
+    let mut half = TcpStream::connect(addr(&s)).unwrap();
+    half.write_all(b"GET /tiles/gravel/7/0/0.png HTTP/1.1\r\nHost: x\r\nX-Half: ").unwrap();
+    std::thread::sleep(Duration::from_millis(200));
+    let started = Instant::now();
+    let code = s.terminate();
+    assert_eq!(code, Some(0), "exit code");
+    assert!(started.elapsed() < Duration::from_secs(8), "took {:?}", started.elapsed());
+}
+
+#[test]
+fn sigterm_during_start_up_stops_loading_and_never_announces_ready() {
+    // A 512² exemplar analysed from scratch: seconds of work to interrupt.
+    let dir = tempfile::tempdir().unwrap();
+    let img = image::RgbImage::from_fn(512, 512, |x, y| {
+        let v = ((x * 7 + y * 13) ^ (x * y)) as u8;
+        image::Rgb([v, v.wrapping_mul(3), 255 - v])
+    });
+    img.save(dir.path().join("big.png")).unwrap();
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(&cfg, "[[textures]]\nid = \"big\"\nexemplar = \"big.png\"\n").unwrap();
+    let mut child = Command::new(binary())
+        .args(["serve", "--bind", "127.0.0.1:0", "--config", cfg.to_str().unwrap(), "--data-dir"])
+        .arg(dir.path().join("data"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let _ = Command::new("kill").arg(child.id().to_string()).status();
+    assert_eq!(exit_within(&mut child, Duration::from_secs(5)), Some(0), "exits promptly and cleanly");
+    let mut out = String::new();
+    child.stdout.take().unwrap().read_to_string(&mut out).unwrap();
+    assert!(!out.contains("textile ready"), "announced ready: {out}");
+    assert!(!dir.path().join("data/big.tex").exists(), "no analysis was finished");
+}
+
+#[test]
+fn a_fifo_exemplar_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.png");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let cfg = dir.path().join("t.toml");
+    std::fs::write(&cfg, "[[textures]]\nid = \"pipe\"\nexemplar = \"pipe.png\"\n").unwrap();
+    let mut child = Command::new(binary())
+        .args(["serve", "--bind", "127.0.0.1:0", "--config", cfg.to_str().unwrap(), "--data-dir"])
+        .arg(dir.path().join("data"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let code = exit_within(&mut child, Duration::from_secs(10));
+    assert!(code.is_some_and(|c| c != 0), "exits with an error, not a hang: {code:?}");
+    let mut err = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+    assert!(err.contains("pipe.png") && err.contains("not a regular file"), "{err}");
+}
+
+#[tokio::test]
+async fn a_data_directory_that_cannot_store_analyses_is_survived() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("plain-file");
+    std::fs::write(&file, "not a directory").unwrap();
+    // A data directory below a regular file can never be created.
+    let s = Server::builder().data_dir(&file.join("data")).start();
+    assert_eq!(s.get_bytes("/tiles/gravel/7/0/0.png").await.0, 200);
+    let log = s.log_text();
+    assert!(log.contains("cannot be stored") && log.contains("memory only"), "{log}");
+}
+
+#[tokio::test]
+async fn stale_temporary_files_are_removed_at_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let dead = dir.path().join(".gravel.tex.tmp-4000000");
+    let live = dir.path().join(format!(".brick.tex.tmp-{}", std::process::id()));
+    std::fs::write(&dead, "half").unwrap();
+    std::fs::write(&live, "being written").unwrap();
+    let _s = Server::builder().data_dir(dir.path()).start();
+    assert!(!dead.exists(), "left by a dead process: removed");
+    assert!(live.exists(), "of a live process: kept");
+}
