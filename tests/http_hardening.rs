@@ -190,3 +190,34 @@ async fn stale_temporary_files_are_removed_at_start() {
     assert!(!dead.exists(), "left by a dead process: removed");
     assert!(live.exists(), "of a live process: kept");
 }
+
+#[tokio::test]
+async fn hostile_input_is_not_echoed_in_full_and_v_is_carried() {
+    let s = Server::builder().start();
+    let long = "k".repeat(60_000);
+    for (path, status) in [
+        (format!("/tiles/gravel/7/0/0.png?{long}=1"), 400),
+        (format!("/tiles/gravel/7/0/0.png?mode={long}"), 400),
+        (format!("/tiles/{long}/7/0/0.png"), 404),
+        (format!("/tiles/gravel/7/{long}/0.png"), 400),
+        (format!("/nothing/{long}"), 404),
+    ] {
+        let (st, body) = s.get_bytes(&path).await;
+        assert_eq!(st, status, "{}", &path[..40]);
+        assert!(body.len() < 1200, "{} bytes of error for {}", body.len(), &path[..40]);
+        let v: serde_json::Value = serde_json::from_slice(&body).expect("JSON error");
+        let m = v["message"].as_str().unwrap();
+        assert!(m.contains(" bytes)") && !m.contains(&"k".repeat(101)), "{v}");
+    }
+    // TileJSON carries a caller's `v` after its own version; its tiles accept it.
+    let tj = s.json("/tiles/gravel/tilejson.json?v=abc&seed=4").await;
+    let tiles = tj["tiles"][0].as_str().unwrap();
+    let v = tiles.split("v=").nth(1).unwrap().split('&').next().unwrap();
+    assert!(v.len() == 16 && v.ends_with("-abc"), "{tiles}");
+    let tile = tiles.replace("{z}", "7").replace("{x}", "1").replace("{y}", "2");
+    let path = tile.trim_start_matches(&s.base);
+    assert_eq!(s.get_bytes(path).await.0, 200, "{path}");
+    let plain = s.json("/tiles/gravel/tilejson.json?seed=4").await;
+    assert_ne!(plain["tiles"][0], tj["tiles"][0]);
+    assert_eq!(s.get_bytes(&format!("/tiles/gravel/tilejson.json?v={}", "x".repeat(65))).await.0, 400);
+}

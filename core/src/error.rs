@@ -124,3 +124,19 @@ pub enum AnalysisFileProblem {
 
 /// Result alias used throughout the crate.
 pub type Result<T, E = CoreError> = std::result::Result<T, E>;
+
+/// Longest piece of a request echoed back in an error message, in characters.
+pub const ECHO_MAX: usize = 100;
+
+/// `s` as an error message echoes it: control characters escaped, at most [`ECHO_MAX`]
+/// characters, longer input cut with its full length noted — a hostile 60 KB key does not come
+/// back as a 60 KB answer.
+pub fn clip(s: &str) -> String {
+    let escaped: String = s.escape_debug().collect();
+    if escaped.chars().count() <= ECHO_MAX {
+        escaped
+    } else {
+        let head: String = escaped.chars().take(ECHO_MAX).collect();
+        format!("{head}… ({} bytes)", s.len())
+    }
+}

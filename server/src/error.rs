@@ -2,6 +2,7 @@
 //! message naming the problem. No HTTP in it: `http::error` maps each kind to one status and
 //! the JSON body, in one place. Core errors are classified here and nowhere else.
 
+use textile_core::error::clip;
 use textile_core::CoreError;
 
 /// What kind of failure, independent of the protocol that reports it.
@@ -49,14 +50,14 @@ impl ApiError {
     }
     /// No route for a path.
     pub fn not_found_route(path: &str) -> Self {
-        Self::new(Kind::NotFound, "not_found", format!("no route for '{path}'; see /openapi.json"))
+        Self::new(Kind::NotFound, "not_found", format!("no route for '{}'; see /openapi.json", clip(path)))
     }
     /// No texture with this id.
     pub fn unknown_texture(id: &str, known: &[String]) -> Self {
         Self::new(
             Kind::NotFound,
             "unknown_texture",
-            format!("no texture '{}'; available: {}", id.escape_debug(), known.join(", ")),
+            format!("no texture '{}'; available: {}", clip(id), known.join(", ")),
         )
     }
     /// Textures are still being prepared.

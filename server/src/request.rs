@@ -5,6 +5,7 @@
 //! geometry), then the texture's [`textile_core::Defaults`] read `mode`, `seed`, `world` and the
 //! mode's own keys, and whatever is left is refused, naming the mode it belongs to.
 
+use textile_core::error::clip;
 use textile_core::modes::Needs;
 use textile_core::{ModeParams, ParamReader};
 
@@ -20,8 +21,11 @@ pub const COORD_MAX: i64 = (1 << 31) - 1;
 pub const MAX_WINDOW_SIDE: i64 = 4096;
 /// Largest window origin magnitude, in pixels at the requested zoom.
 pub const MAX_WINDOW_COORD: i64 = 1 << 40;
-/// Longest `v` (cache-busting version) accepted.
-pub const MAX_V: usize = 64;
+/// Longest `v` (cache-busting version) a tile accepts: a TileJSON's own version (12) joined to a
+/// caller's (at most [`MAX_CALLER_V`]).
+pub const MAX_V: usize = 80;
+/// Longest `v` a caller may give TileJSON (carried into its tiles template).
+pub const MAX_CALLER_V: usize = 64;
 
 /// The key–value pairs of a raw query string, percent-decoded, in order.
 pub fn query_pairs(raw: Option<&str>) -> Vec<(String, String)> {
@@ -65,7 +69,10 @@ pub struct TileSpec {
 
 fn parse_int(name: &str, s: &str, lo: i64, hi: i64) -> Result<i64, ApiError> {
     let v: i64 = s.parse().map_err(|_| {
-        ApiError::bad_request("invalid_coordinate", format!("'{name}' = '{s}' is not an integer in [{lo}, {hi}]"))
+        ApiError::bad_request(
+            "invalid_coordinate",
+            format!("'{name}' = '{}' is not an integer in [{lo}, {hi}]", clip(s)),
+        )
     })?;
     if v < lo || v > hi {
         return Err(ApiError::bad_request("invalid_coordinate", format!("'{name}' = {v} is outside [{lo}, {hi}]")));
@@ -78,11 +85,14 @@ pub fn split_format(s: &str) -> Result<(&str, Format), ApiError> {
     let (stem, ext) = s.rsplit_once('.').ok_or_else(|| {
         ApiError::bad_request(
             "invalid_format",
-            format!("'{s}' has no format extension; use .png, .jpg, .jpeg or .webp"),
+            format!("'{}' has no format extension; use .png, .jpg, .jpeg or .webp", clip(s)),
         )
     })?;
     let fmt = Format::from_ext(ext).ok_or_else(|| {
-        ApiError::bad_request("invalid_format", format!("format '{ext}' is not supported; use png, jpg, jpeg or webp"))
+        ApiError::bad_request(
+            "invalid_format",
+            format!("format '{}' is not supported; use png, jpg, jpeg or webp", clip(ext)),
+        )
     })?;
     Ok((stem, fmt))
 }

@@ -51,7 +51,7 @@ impl Records {
             "footprints" => Ok(Records::Footprints),
             _ => Err(ApiError::bad_request(
                 "invalid_parameter",
-                format!("parameter 'records' = '{}': use texels or footprints", s.escape_debug()),
+                format!("parameter 'records' = '{}': use texels or footprints", textile_core::error::clip(s)),
             )),
         }
     }

@@ -262,7 +262,11 @@ impl Defaults {
     ) -> std::result::Result<Defaults, DefaultsError> {
         let mode_name = MODE_NAMES.iter().copied().find(|m| *m == mode).ok_or_else(|| DefaultsError {
             mode: None,
-            source: params::MODE.error(format!("'{mode}' is not one of {}", MODE_NAMES.join(", "))),
+            source: params::MODE.error(format!(
+                "'{}' is not one of {}",
+                crate::error::clip(mode),
+                MODE_NAMES.join(", ")
+            )),
         })?;
         if let Some(unknown) = tables.keys().find(|k| !MODE_NAMES.contains(&k.as_str())) {
             return Err(DefaultsError {
@@ -303,7 +307,11 @@ impl Defaults {
     pub fn request(&self, src: &Source, mut r: ParamReader) -> Result<ModeParams> {
         let mode = r.get(&params::MODE).unwrap_or_else(|| self.mode.to_string());
         let base = self.get(&mode).ok_or_else(|| {
-            params::MODE.error(format!("'{mode}' is not available; allowed: {}", MODE_NAMES.join(", ")))
+            params::MODE.error(format!(
+                "'{}' is not available; allowed: {}",
+                crate::error::clip(&mode),
+                MODE_NAMES.join(", ")
+            ))
         })?;
         let common = Common::read(&mut r, src.side())?;
         let p = base.parse(&common, &mut r, src)?;

@@ -12,7 +12,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use serde_json::{json, Value};
 
-use crate::error::{CoreError, Result};
+use crate::error::{clip, CoreError, Result};
 
 /// Tile side in pixels: `world` is counted in tiles of this size at the native zoom.
 pub const TILE_SIZE: i64 = 256;
@@ -105,7 +105,7 @@ impl ParamSpec {
     pub fn check(&self, s: &str) -> Result<()> {
         match self.kind {
             Kind::Choice(values) if values.contains(&s) => Ok(()),
-            Kind::Choice(values) => Err(self.error(format!("'{s}' is not one of {}", values.join(", ")))),
+            Kind::Choice(values) => Err(self.error(format!("'{}' is not one of {}", clip(s), values.join(", ")))),
             Kind::Integer { .. } | Kind::PowerOfTwo { .. } => self.integer(s).map(drop),
             Kind::Unit => self.unit(s).map(drop),
             Kind::Levels => s.split(',').try_for_each(|v| self.unit(v).map(drop)),
@@ -128,7 +128,7 @@ impl ParamSpec {
         s.trim().parse::<u64>().ok().filter(|v| (min..=max).contains(v) && (!pow2 || v.is_power_of_two())).ok_or_else(
             || {
                 let what = if pow2 { "a power of two" } else { "an integer" };
-                self.error(format!("'{s}' is not {what} in {min}..={max}"))
+                self.error(format!("'{}' is not {what} in {min}..={max}", clip(s)))
             },
         )
     }
@@ -143,7 +143,7 @@ impl ParamSpec {
         let Kind::Interval { min, max } = self.kind else {
             return Err(self.error("is not an interval parameter"));
         };
-        let bad = || self.error(format!("'{s}' must be LOW,HIGH with {min} <= LOW <= HIGH <= {max}"));
+        let bad = || self.error(format!("'{}' must be LOW,HIGH with {min} <= LOW <= HIGH <= {max}", clip(s)));
         let (a, b) = s.split_once(',').ok_or_else(bad)?;
         let f = |v: &str| v.trim().parse::<f64>().ok().filter(|x| x.is_finite()).map(|x| (x * 1000.0).round());
         let (a, b) = (f(a).ok_or_else(bad)?, f(b).ok_or_else(bad)?);
@@ -158,10 +158,10 @@ impl ParamSpec {
 pub(crate) fn parse_unit(name: &'static str, s: &str) -> Result<u32> {
     let v: f64 = s.trim().parse().map_err(|_| CoreError::Param {
         name,
-        message: format!("'{s}' is not a number; expected a value in [0, 1]"),
+        message: format!("'{}' is not a number; expected a value in [0, 1]", clip(s)),
     })?;
     if !v.is_finite() || !(0.0..=1.0).contains(&v) {
-        return Err(CoreError::Param { name, message: format!("{s} is outside [0, 1]") });
+        return Err(CoreError::Param { name, message: format!("{} is outside [0, 1]", clip(s)) });
     }
     Ok((v * ONE_Q16 as f64).round() as u32)
 }
@@ -280,7 +280,7 @@ impl ParamReader {
         for (k, v) in pairs {
             let k = k.into();
             if values.contains_key(&k) {
-                return Err(CoreError::ParamKey { key: k, message: "is given more than once".into() });
+                return Err(CoreError::ParamKey { key: clip(&k), message: "is given more than once".into() });
             }
             values.insert(k, v.into());
         }
@@ -331,7 +331,7 @@ impl ParamReader {
             });
         }
         let allowed: Vec<String> = self.asked.into_iter().collect();
-        Err(CoreError::UnknownParam { key, allowed: allowed.join(", ") })
+        Err(CoreError::UnknownParam { key: clip(&key), allowed: allowed.join(", ") })
     }
 }
 

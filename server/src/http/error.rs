@@ -8,6 +8,9 @@ use axum::Json;
 
 use crate::error::{ApiError, Kind};
 
+/// Longest error message sent, in bytes.
+const MAX_MESSAGE: usize = 1024;
+
 /// The HTTP status of an error kind.
 pub fn status(kind: Kind) -> StatusCode {
     match kind {
@@ -24,7 +27,17 @@ pub fn status(kind: Kind) -> StatusCode {
 
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
-        let body = serde_json::json!({ "error": self.code, "message": self.message });
+        // A safety net: no message longer than this leaves, whatever it echoes.
+        let mut message = self.message;
+        if message.len() > MAX_MESSAGE {
+            let mut cut = MAX_MESSAGE;
+            while !message.is_char_boundary(cut) {
+                cut -= 1;
+            }
+            message.truncate(cut);
+            message.push('…');
+        }
+        let body = serde_json::json!({ "error": self.code, "message": message });
         let mut r = (status(self.kind), Json(body)).into_response();
         if let Some(s) = self.retry_after {
             r.headers_mut().insert(header::RETRY_AFTER, HeaderValue::from(s));

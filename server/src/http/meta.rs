@@ -16,7 +16,7 @@ use textile_core::{MODE_NAMES, TILE_SIZE};
 use crate::error::{ApiError, Kind};
 use crate::http::extract::{base_url, path_error, texture, Peer};
 use crate::pipeline::engine_version;
-use crate::request::{params, query_pairs};
+use crate::request::{params, query_pairs, MAX_CALLER_V};
 use crate::state::AppState;
 use crate::textures::Texture;
 
@@ -214,6 +214,15 @@ pub async fn tilejson(
     let Path(id) = path.map_err(path_error)?;
     let t = texture(reg, &id)?;
     let q = query_pairs(raw.as_deref());
+    // A caller's `v` (e.g. busting its own cache of this document) is carried into the tiles'
+    // version after the server's, which still changes with the analysis and engine.
+    let caller_v = q.iter().find(|(k, _)| k == "v").map(|(_, v)| v.clone());
+    if caller_v.as_ref().is_some_and(|v| v.len() > MAX_CALLER_V) {
+        return Err(ApiError::bad_request(
+            "invalid_parameter",
+            format!("parameter 'v': at most {MAX_CALLER_V} characters"),
+        ));
+    }
     params(&t, textile_core::ParamReader::request(q.clone())?)?;
     // Everything that decides a tile's bytes besides its own request: engine, analysis, and the
     // texture's configured defaults of every mode with the modes' versions (a changed default
@@ -223,7 +232,10 @@ pub async fn tilejson(
     let version =
         &blake3::hash(format!("{}|{file_hash}|{}", engine_version(), t.defaults.canonical()).as_bytes()).to_hex()[..12];
     let mut qs = form_urlencoded::Serializer::new(String::new());
-    qs.append_pair("v", version);
+    match &caller_v {
+        Some(cv) => qs.append_pair("v", &format!("{version}-{cv}")),
+        None => qs.append_pair("v", version),
+    };
     let mut q = q;
     q.sort();
     for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {

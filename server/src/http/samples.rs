@@ -58,7 +58,10 @@ pub async fn samples(
             return Err(ApiError::new(
                 Kind::UnsupportedMediaType,
                 "unsupported_media_type",
-                format!("Content-Type '{}': use application/json or application/octet-stream", other.escape_debug()),
+                format!(
+                    "Content-Type '{}': use application/json or application/octet-stream",
+                    textile_core::error::clip(other)
+                ),
             ))
         }
     };
