@@ -16,6 +16,10 @@ pub enum Kind {
     MethodNotAllowed,
     /// The request body is larger than allowed.
     TooLarge,
+    /// The request target (path and query) is longer than allowed.
+    UriTooLong,
+    /// The request headers are more or larger than allowed.
+    HeadersTooLarge,
     /// The request body is of a media type the route does not read.
     UnsupportedMediaType,
     /// The content (an image) cannot be used.

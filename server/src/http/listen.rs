@@ -39,7 +39,13 @@ pub async fn serve(listener: TcpListener, app: Router, limits: Limits, mut stop:
     // HTTP/1.1 only (browsers speak HTTP/2 only over TLS, which a proxy terminates): protocol
     // detection would wait for a silent client's first bytes with no timeout.
     let mut builder = Builder::new();
-    builder.timer(TokioTimer::new()).header_read_timeout(limits.header_read_timeout);
+    // hyper reads up to 4× our header limits, so that our JSON 431 (http::limits) answers the
+    // oversized requests most clients send; beyond that hyper answers a bare 431 itself.
+    builder
+        .timer(TokioTimer::new())
+        .header_read_timeout(limits.header_read_timeout)
+        .max_headers(4 * super::MAX_HEADERS)
+        .max_buf_size(4 * super::MAX_HEADER_BYTES + (64 << 10));
     let mut backoff = Duration::from_millis(10);
     loop {
         let slot = tokio::select! {

@@ -41,6 +41,39 @@ async fn track(State(st): State<Arc<AppState>>, req: Request, next: Next) -> Res
     resp
 }
 
+/// Most request headers accepted (hyper itself refuses more than [`listen`] lets it read).
+pub const MAX_HEADERS: usize = 100;
+/// Most bytes of request headers accepted.
+pub const MAX_HEADER_BYTES: usize = 64 << 10;
+/// Longest request target (path and query) accepted.
+pub const MAX_URI_BYTES: usize = 16 << 10;
+
+/// Refuse oversized requests with the contract's JSON errors (414, 431) before any route sees
+/// them. What hyper refuses itself — beyond what it reads at all, or a malformed request line —
+/// it answers with a bare status (README: Configuration).
+async fn limits(req: Request, next: Next) -> Response {
+    let uri = req.uri().to_string().len();
+    if uri > MAX_URI_BYTES {
+        return ApiError::new(
+            crate::error::Kind::UriTooLong,
+            "uri_too_long",
+            format!("the request target is {uri} bytes; at most {MAX_URI_BYTES}"),
+        )
+        .into_response();
+    }
+    let h = req.headers();
+    let bytes: usize = h.iter().map(|(k, v)| k.as_str().len() + v.len() + 4).sum();
+    if h.len() > MAX_HEADERS || bytes > MAX_HEADER_BYTES {
+        return ApiError::new(
+            crate::error::Kind::HeadersTooLarge,
+            "headers_too_large",
+            format!("{} headers of {bytes} bytes; at most {MAX_HEADERS} headers and {MAX_HEADER_BYTES} bytes", h.len()),
+        )
+        .into_response();
+    }
+    next.run(req).await
+}
+
 /// Build the router for a state.
 pub fn router(state: Arc<AppState>) -> Router {
     let routes = Router::new()
@@ -96,6 +129,7 @@ fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Route
         .fallback(meta::not_found)
         .method_not_allowed_fallback(meta::method_not_allowed)
         .layer(middleware::from_fn_with_state(state.clone(), track))
+        .layer(middleware::from_fn(limits))
         .with_state(state)
         .layer(CompressionLayer::new())
         .layer(cors)
