@@ -260,3 +260,34 @@ async fn oversized_requests_get_json_errors() {
     assert!(st == 431 || st == 0, "{st}");
     assert_eq!(s.get_bytes("/health").await.0, 200);
 }
+
+#[tokio::test]
+async fn big_windows_are_rendered_in_pieces_and_leave_a_worker_for_tiles() {
+    let s = Server::builder().args(&["--workers", "2"]).env("TEXTILE_MAX_QUEUE_WAIT_MS", "1000").start();
+    // A window over 1024² (rendered in pieces) equals the tiles it covers.
+    let win = s.image("/windows/gravel.png?x=-256&y=0&w=1280&h=1024&seed=6").await;
+    let mut tiles = image::RgbImage::new(1280, 1024);
+    for tx in -1..4i64 {
+        for ty in 0..4i64 {
+            let t = s.image(&format!("/tiles/gravel/7/{tx}/{ty}.png?seed=6")).await;
+            support::paste(&mut tiles, &t, (256 * (tx + 1)) as u32, (256 * ty) as u32);
+        }
+    }
+    assert!(win == tiles, "pieces stitched differ from the tiles");
+    // Three big windows at once: tiles asked for meanwhile are served, not shed.
+    let mut big = Vec::new();
+    for seed in 20..23 {
+        let c = s.client.clone();
+        let url = s.url(&format!("/windows/gravel.png?x=0&y=0&w=3072&h=3072&seed={seed}"));
+        big.push(tokio::spawn(async move { c.get(url).send().await.map(|r| r.status().as_u16()).unwrap_or(0) }));
+    }
+    tokio::time::sleep(Duration::from_millis(500)).await;
+    for (i, tx) in (40..44).enumerate() {
+        let (st, _) = s.get_bytes(&format!("/tiles/gravel/7/{tx}/{i}.png?seed=9")).await;
+        assert_eq!(st, 200, "a tile during big windows");
+    }
+    for b in big {
+        let st = b.await.unwrap();
+        assert!(st == 200 || st == 503, "big window: {st}");
+    }
+}

@@ -105,10 +105,23 @@ impl ImageJob {
         }
     }
 
-    /// Render the image through a pyramidal cache.
+    /// Whether this is a big window (over [`PIECE`]² pixels): rendered in pieces, and admitted
+    /// through the big-window lane so that big windows never take every worker from tiles.
+    pub fn is_big(&self) -> bool {
+        self.view().0.rect.area() > PIECE * PIECE
+    }
+
+    /// Render the image through a pyramidal cache. Views over [`PIECE`]² pixels are rendered
+    /// as `PIECE × PIECE` pieces one after another and stitched (the same pixels: a window equals
+    /// the same area cut from any other window), so the memory a request holds while rendering
+    /// is bounded by a piece's, not the window's.
     pub fn render(&self, cache: &Pyramid) -> Result<Rendered, ApiError> {
         let (view, upscale) = self.view();
-        let mut r = self.params.render(&self.tex.source(), cache, view)?;
+        let mut r = if view.rect.area() > PIECE * PIECE {
+            render_pieces(&self.params, &self.tex, cache, view)?
+        } else {
+            self.params.render(&self.tex.source(), cache, view)?
+        };
         if upscale {
             r.image = upscale2(&r.image);
         }
@@ -146,6 +159,15 @@ where
 /// cache; the pixels it synthesized and delivered are counted when it actually runs.
 pub async fn produce(st: &Arc<AppState>, etag: &str, job: ImageJob) -> (Result<Bytes, ApiError>, bool) {
     let mode = job.params.name();
+    // Big windows wait for the big-window lane first (not holding a worker meanwhile).
+    let _lane = if job.is_big() && st.cache.peek(etag).is_none() {
+        match st.big_window_lane().await {
+            Ok(permit) => Some(permit),
+            Err(e) => return (Err(e), false),
+        }
+    } else {
+        None
+    };
     let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
     let pyramid = st.pyramid.clone();
     cached(st, etag, mode, move || {
@@ -155,6 +177,29 @@ pub async fn produce(st: &Arc<AppState>, etag: &str, job: ImageJob) -> (Result<B
         Ok(bytes)
     })
     .await
+}
+
+/// Side of the pieces big views are rendered in.
+pub const PIECE: i64 = 1024;
+
+/// Render `view` as pieces of at most `PIECE × PIECE` pixels, row by row, into one image.
+fn render_pieces(params: &ModeParams, tex: &Texture, cache: &Pyramid, view: View) -> Result<Rendered, ApiError> {
+    let (w, h) = (view.rect.width() as usize, view.rect.height() as usize);
+    let mut pixels = vec![0u8; 3 * w * h];
+    let mut synthesized = 0;
+    for py in (0..h).step_by(PIECE as usize) {
+        for px in (0..w).step_by(PIECE as usize) {
+            let (pw, ph) = ((w - px).min(PIECE as usize), (h - py).min(PIECE as usize));
+            let rect = Rect::new(view.rect.x0 + px as i64, view.rect.y0 + py as i64, pw as i64, ph as i64);
+            let r = params.render(&tex.source(), cache, View { zoom_out: view.zoom_out, rect })?;
+            synthesized += r.synthesized;
+            for j in 0..ph {
+                let dst = 3 * ((py + j) * w + px);
+                pixels[dst..dst + 3 * pw].copy_from_slice(&r.image.pixels[3 * j * pw..3 * (j + 1) * pw]);
+            }
+        }
+    }
+    Ok(Rendered { image: RgbWindow { width: w as u32, height: h as u32, pixels }, synthesized })
 }
 
 fn upscale2(img: &RgbWindow) -> RgbWindow {

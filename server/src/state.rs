@@ -37,6 +37,9 @@ pub struct AppState {
     pub running: Arc<RunQueue>,
     /// Synthesized levels shared between requests (Wei & Levoy's pyramidal cache).
     pub pyramid: Arc<Pyramid>,
+    /// Big windows in flight at once: one fewer than the pool's threads (at least one), so that
+    /// however many big windows are asked for, a worker is left for tiles.
+    pub big_windows: Arc<Semaphore>,
     /// Prometheus metrics.
     pub metrics: Metrics,
 }
@@ -60,6 +63,7 @@ impl AppState {
                 LIFO_ABOVE_PER_THREAD * rayon::current_num_threads().max(1),
             ),
             pyramid: Arc::new(Pyramid::new(config.level_cache_mib << 20)),
+            big_windows: Arc::new(Semaphore::new(rayon::current_num_threads().saturating_sub(1).max(1))),
             config,
             registry: OnceLock::new(),
             metrics,
@@ -73,6 +77,18 @@ impl AppState {
             .chain(&[crate::metrics::GLTF_LABEL])
             .map(|m| self.metrics.syntheses.with_label_values(&[m]).get())
             .sum()
+    }
+
+    /// A place in the big-window lane, waited for at most the queue-wait bound (else 503).
+    pub async fn big_window_lane(&self) -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
+        let wait = Duration::from_millis(self.config.max_queue_wait_ms);
+        match tokio::time::timeout(wait, self.big_windows.clone().acquire_owned()).await {
+            Ok(Ok(p)) => Ok(p),
+            _ => {
+                self.metrics.shed.inc();
+                Err(ApiError::overloaded())
+            }
+        }
     }
 
     /// The registry, or 503 while loading.
