@@ -14,7 +14,7 @@ use utoipa::{Modify, OpenApi};
 #[derive(OpenApi)]
 #[openapi(
     info(title = "textile", description = "Infinite, deterministic, example-based texture tiles"),
-    modifiers(&ModeParameters),
+    modifiers(&ModeParameters, &ErrorResponses),
     paths(
         crate::http::meta::health,
         crate::http::meta::ready,
@@ -95,6 +95,57 @@ impl Modify for ModeParameters {
             }
             for op in [item.get.as_mut(), item.post.as_mut()].into_iter().flatten() {
                 op.parameters.get_or_insert_with(Vec::new).extend(params.iter().cloned());
+            }
+        }
+    }
+}
+
+/// Documents the JSON error answers on every operation: the `ErrorBody` schema
+/// (`{"error", "message"}`), and the statuses any route may answer besides its own — 400 (bad
+/// path or query), 404 (unknown texture or route), 414 and 431 (oversized requests), 503 (loading,
+/// overloaded) — so that contract tests can hold every answer to the document.
+struct ErrorResponses;
+
+impl Modify for ErrorResponses {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::{ContentBuilder, Ref, ResponseBuilder};
+        let schema = ObjectBuilder::new()
+            .property(
+                "error",
+                ObjectBuilder::new().schema_type(Type::String).description(Some("machine-readable code")),
+            )
+            .property(
+                "message",
+                ObjectBuilder::new().schema_type(Type::String).description(Some("what was wrong and what is allowed")),
+            )
+            .required("error")
+            .required("message")
+            .build();
+        doc.components.get_or_insert_with(Default::default).schemas.insert("ErrorBody".into(), schema.into());
+        let generic = [
+            ("400", "bad path or parameters"),
+            ("404", "unknown texture or route"),
+            ("414", "request target too long"),
+            ("431", "too many or too large headers"),
+            ("503", "loading or overloaded; see Retry-After"),
+        ];
+        for (_, item) in doc.paths.paths.iter_mut() {
+            for op in [item.get.as_mut(), item.post.as_mut()].into_iter().flatten() {
+                for (code, what) in generic {
+                    op.responses
+                        .responses
+                        .entry(code.into())
+                        .or_insert_with(|| ResponseBuilder::new().description(what).build().into());
+                }
+                for (code, r) in op.responses.responses.iter_mut() {
+                    if !code.starts_with('4') && !code.starts_with('5') {
+                        continue;
+                    }
+                    if let utoipa::openapi::RefOr::T(resp) = r {
+                        let content = ContentBuilder::new().schema(Some(Ref::from_schema_name("ErrorBody"))).build();
+                        resp.content.insert("application/json".into(), content);
+                    }
+                }
             }
         }
     }

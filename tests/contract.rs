@@ -1,0 +1,35 @@
+//! Property-based contract testing of the whole HTTP API against its own `/openapi.json` with
+//! Schemathesis (PyPI, `tests/contract/requirements.txt`, installed by `.ci/run`): a bounded,
+//! seeded run over every operation (coverage, fuzzing and stateful phases) must find no 5xx, no
+//! undocumented status, and every answer conforming to the documented schema, content type and
+//! headers. Requests the schema allows but a texture refuses (a zoom beyond its native one, say)
+//! are legitimately 4xx, so the check that every schema-valid request is accepted is left out.
+
+mod support;
+
+use std::process::Command;
+
+use support::Server;
+
+#[test]
+fn the_api_keeps_its_openapi_contract() {
+    let st = Command::new("st").arg("--version").output();
+    if !st.is_ok_and(|o| o.status.success()) {
+        return support::skip(
+            "the_api_keeps_its_openapi_contract",
+            "Schemathesis is not installed (pip install -r tests/contract/requirements.txt)",
+        );
+    }
+    let s = Server::builder().start();
+    let config = format!("{}/../tests/contract/schemathesis.toml", env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new("st")
+        .args(["--config-file", &config, "run", &s.url("/openapi.json")])
+        .args(["--max-examples", "30", "--seed", "1", "--checks", "all"])
+        .args(["--exclude-checks", "positive_data_acceptance", "--request-timeout", "60"])
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("run schemathesis");
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "Schemathesis found contract violations:\n{text}");
+    assert!(text.contains("passed") && !text.contains("failures"), "{text}");
+}
