@@ -25,6 +25,7 @@ pub mod metrics;
 pub mod pipeline;
 pub mod queue;
 pub mod request;
+pub mod robustness;
 pub mod sampling;
 pub mod state;
 pub mod textures;

@@ -1,0 +1,70 @@
+//! Entry points for fuzzing (`fuzz/`, cargo-fuzz) and for the test that replays the committed
+//! corpus (`tests/fuzz_corpus.rs`): each takes arbitrary bytes, feeds them to one parser of
+//! untrusted input exactly as the service does, and must return — never panic, hang or allocate
+//! without bound — whatever the bytes.
+
+use std::sync::{Arc, OnceLock};
+
+use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress};
+
+use crate::config::TextureConfig;
+use crate::encode::Format;
+use crate::request::{params, parse_tile, parse_window, query_reader};
+use crate::sampling::{parse_binary, parse_json, Records};
+use crate::textures::Texture;
+
+/// A small analysed texture (a 32² crop of the embedded gravel), built once.
+fn texture() -> &'static Arc<Texture> {
+    static T: OnceLock<Arc<Texture>> = OnceLock::new();
+    T.get_or_init(|| {
+        let bytes = crate::textures::embedded("gravel.png").unwrap_or_default();
+        let img = image::load_from_memory(bytes).map(|i| i.to_rgba8()).unwrap_or_default();
+        let px: Vec<[u8; 4]> = (0..32 * 32)
+            .map(|i| img.get_pixel_checked(i % 32, i / 32).map(|p| p.0).unwrap_or([128, 128, 128, 255]))
+            .collect();
+        let ex = Exemplar::from_rgba(32, 32, &px, &ExemplarOptions::default());
+        let an = Analysis::build(&ex, &NoProgress);
+        match Texture::new(TextureConfig::new("gravel", "embedded:gravel.png"), 0, ex, an) {
+            Ok(t) => Arc::new(t),
+            Err(e) => panic!("the fuzzing texture: {e}"),
+        }
+    })
+}
+
+/// A tile or window request: `Z/X/Y.FMT?QUERY` — the path segments parsed as a tile address, the
+/// query as a window's geometry, then as the texture's mode parameters.
+pub fn request(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let (path, query) = text.split_once('?').unwrap_or((&text, ""));
+    let tex = texture();
+    let segs: Vec<&str> = path.split('/').collect();
+    if let [z, x, y, ..] = segs[..] {
+        let _ = parse_tile(tex, z, x, y);
+    }
+    let Ok(mut r) = query_reader(Some(query)) else { return };
+    let _ = parse_window(tex, &mut r, Format::Png);
+    let _ = params(tex, r);
+}
+
+/// An exemplar image, decoded and prepared as a configured or uploaded one is (at most 256 px
+/// per side here, to keep each run fast; the limits are the same code at any size).
+pub fn exemplar(data: &[u8]) {
+    let opts = ExemplarOptions { max_input_side: 256, ..ExemplarOptions::default() };
+    let _ = Exemplar::from_bytes(data, &opts);
+}
+
+/// An analysis file's bytes, loaded as the server loads one from its data directory.
+pub fn analysis_file(data: &[u8]) {
+    let _ = Analysis::from_bytes(data);
+}
+
+/// A `POST /samples` body: the first byte chooses JSON, binary texels or binary footprints.
+pub fn samples_body(data: &[u8]) {
+    let Some((&kind, body)) = data.split_first() else { return };
+    let tex = texture();
+    let _ = match kind % 3 {
+        0 => parse_json(tex, body),
+        1 => parse_binary(tex, body, Records::Texels),
+        _ => parse_binary(tex, body, Records::Footprints),
+    };
+}
