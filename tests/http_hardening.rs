@@ -291,3 +291,28 @@ async fn big_windows_are_rendered_in_pieces_and_leave_a_worker_for_tiles() {
         assert!(st == 200 || st == 503, "big window: {st}");
     }
 }
+
+#[tokio::test]
+async fn work_for_a_client_that_went_away_is_cancelled() {
+    let s = Server::builder().args(&["--workers", "2"]).start();
+    let metric = |text: &str| {
+        text.lines()
+            .find(|l| l.contains("syntheses_cancelled_total") && !l.starts_with('#'))
+            .and_then(|l| l.rsplit(' ').next()?.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    let before = metric(&s.get("/metrics").await.text().await.unwrap());
+    // A big window whose client gives up after half a second.
+    let impatient = reqwest::Client::builder().timeout(Duration::from_millis(500)).build().unwrap();
+    let r = impatient.get(s.url("/windows/gravel.png?x=0&y=0&w=4096&h=4096&seed=77")).send().await;
+    assert!(r.is_err(), "the client gave up");
+    let t = Instant::now();
+    let mut after = before;
+    while t.elapsed() < Duration::from_secs(60) && after <= before {
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        after = metric(&s.get("/metrics").await.text().await.unwrap());
+    }
+    assert!(after > before, "the abandoned window was not cancelled");
+    // And the server serves on.
+    assert_eq!(s.get_bytes("/tiles/gravel/7/0/0.png").await.0, 200);
+}

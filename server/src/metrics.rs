@@ -36,6 +36,8 @@ pub struct Metrics {
     pub in_flight: IntGauge,
     /// Requests shed with 503 because of the in-flight limit.
     pub shed: IntCounter,
+    /// Syntheses stopped because their requester went away (or timed out).
+    pub cancelled: IntCounter,
     /// Pixels synthesized at all levels (padding included), by mode.
     pub pixels_synthesized: IntCounterVec,
     /// Pixels delivered by those syntheses, by mode: the computation ratio is
@@ -86,6 +88,10 @@ impl Metrics {
             )),
             in_flight: must(IntGauge::new("syntheses_in_flight", "syntheses running or queued")),
             shed: must(IntCounter::new("shed_total", "requests answered 503 because of the in-flight limit")),
+            cancelled: must(IntCounter::new(
+                "syntheses_cancelled_total",
+                "syntheses stopped because their requester went away or timed out",
+            )),
             pixels_synthesized: must(IntCounterVec::new(
                 Opts::new("pixels_synthesized_total", "pixels synthesized at all levels, padding included, by mode"),
                 &["mode"],
@@ -119,6 +125,7 @@ impl Metrics {
             Box::new(m.synthesis_seconds.clone()),
             Box::new(m.in_flight.clone()),
             Box::new(m.shed.clone()),
+            Box::new(m.cancelled.clone()),
             Box::new(m.pixels_synthesized.clone()),
             Box::new(m.pixels_delivered.clone()),
             Box::new(m.level_cache_hits.clone()),

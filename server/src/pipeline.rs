@@ -14,7 +14,7 @@ use textile_core::{ModeParams, Pyramid, Rect, Rendered, RgbWindow, View, TILE_SI
 use crate::encode::{encode, Effort, Format, ENCODER_VERSION};
 use crate::error::ApiError;
 use crate::request::{TileSpec, WindowSpec};
-use crate::state::AppState;
+use crate::state::{AppState, Cancel};
 use crate::textures::Texture;
 
 /// Version of everything besides the analysis and the mode that determines bytes (each mode's
@@ -116,9 +116,14 @@ impl ImageJob {
     /// the same area cut from any other window), so the memory a request holds while rendering
     /// is bounded by a piece's, not the window's.
     pub fn render(&self, cache: &Pyramid) -> Result<Rendered, ApiError> {
+        self.render_until(cache, &Cancel::default())
+    }
+
+    /// [`ImageJob::render`], abandoned between pieces once `cancel` is set.
+    fn render_until(&self, cache: &Pyramid, cancel: &Cancel) -> Result<Rendered, ApiError> {
         let (view, upscale) = self.view();
         let mut r = if view.rect.area() > PIECE * PIECE {
-            render_pieces(&self.params, &self.tex, cache, view)?
+            render_pieces(&self.params, &self.tex, cache, view, cancel)?
         } else {
             self.params.render(&self.tex.source(), cache, view)?
         };
@@ -140,7 +145,12 @@ impl ImageJob {
 
     /// Render and encode: the bytes every front end serves or writes, with the render's figures.
     pub fn bytes(&self, cache: &Pyramid) -> Result<(Vec<u8>, Rendered), ApiError> {
-        let r = self.render(cache)?;
+        self.bytes_until(cache, &Cancel::default())
+    }
+
+    /// [`ImageJob::bytes`], abandoned between the pieces of a big view once `cancel` is set.
+    pub fn bytes_until(&self, cache: &Pyramid, cancel: &Cancel) -> Result<(Vec<u8>, Rendered), ApiError> {
+        let r = self.render_until(cache, cancel)?;
         Ok((self.encode(&r.image)?, r))
     }
 }
@@ -149,7 +159,7 @@ impl ImageJob {
 /// counted under `label`). Returns whether it was a cache hit.
 pub async fn cached<F>(st: &Arc<AppState>, key: &str, label: &'static str, make: F) -> (Result<Bytes, ApiError>, bool)
 where
-    F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
+    F: FnOnce(&Cancel) -> Result<Vec<u8>, ApiError> + Send + 'static,
 {
     st.cache.get_or_compute(key, || st.synthesize(label, make)).await
 }
@@ -170,8 +180,8 @@ pub async fn produce(st: &Arc<AppState>, etag: &str, job: ImageJob) -> (Result<B
     };
     let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
     let pyramid = st.pyramid.clone();
-    cached(st, etag, mode, move || {
-        let (bytes, r) = job.bytes(&pyramid)?;
+    cached(st, etag, mode, move |cancel| {
+        let (bytes, r) = job.bytes_until(&pyramid, cancel)?;
         synthesized.with_label_values(&[mode]).inc_by(r.synthesized);
         delivered.with_label_values(&[mode]).inc_by(r.image.width as u64 * r.image.height as u64);
         Ok(bytes)
@@ -183,12 +193,21 @@ pub async fn produce(st: &Arc<AppState>, etag: &str, job: ImageJob) -> (Result<B
 pub const PIECE: i64 = 1024;
 
 /// Render `view` as pieces of at most `PIECE × PIECE` pixels, row by row, into one image.
-fn render_pieces(params: &ModeParams, tex: &Texture, cache: &Pyramid, view: View) -> Result<Rendered, ApiError> {
+fn render_pieces(
+    params: &ModeParams,
+    tex: &Texture,
+    cache: &Pyramid,
+    view: View,
+    cancel: &Cancel,
+) -> Result<Rendered, ApiError> {
     let (w, h) = (view.rect.width() as usize, view.rect.height() as usize);
     let mut pixels = vec![0u8; 3 * w * h];
     let mut synthesized = 0;
     for py in (0..h).step_by(PIECE as usize) {
         for px in (0..w).step_by(PIECE as usize) {
+            if cancel.is_set() {
+                return Err(textile_core::CoreError::Cancelled.into());
+            }
             let (pw, ph) = ((w - px).min(PIECE as usize), (h - py).min(PIECE as usize));
             let rect = Rect::new(view.rect.x0 + px as i64, view.rect.y0 + py as i64, pw as i64, ph as i64);
             let r = params.render(&tex.source(), cache, View { zoom_out: view.zoom_out, rect })?;

@@ -7,7 +7,7 @@
 //! of the tile grid at zoom `z`; `footprints` are `f64 u, f64 v, f32 lod` — a position in native
 //! texels and a level of detail, filtered trilinearly. The answer is 3 bytes (RGB) per sample.
 
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use serde::Deserialize;
@@ -224,15 +224,6 @@ pub struct Answer {
     pub windows: u64,
 }
 
-/// Sets its flag when dropped: the request that owns it went away (or finished).
-struct Abandoned(Arc<AtomicBool>);
-
-impl Drop for Abandoned {
-    fn drop(&mut self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
-}
-
 /// Sample on the synthesis pool (admission, queue and timeout as for tiles), through the
 /// server's pyramidal cache, or a cache of the batch's own when the server's is off. Work stops
 /// between windows once the request is dropped.
@@ -243,15 +234,13 @@ pub async fn run(
     points: Points,
 ) -> Result<Answer, ApiError> {
     let mode = params.name();
-    let gone = Arc::new(AtomicBool::new(false));
-    let _owner = Abandoned(gone.clone());
     let figures = Arc::new([AtomicU64::new(0), AtomicU64::new(0)]);
     let (fig, pyramid) = (figures.clone(), st.pyramid.clone());
     let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
     let max_zoom_out = tex.native_zoom() - tex.min_zoom();
     let n = points.len() as u64;
     let rgb = st
-        .synthesize(mode, move || {
+        .synthesize(mode, move |cancel| {
             let local;
             let cache: &Pyramid = if pyramid.is_on() {
                 &pyramid
@@ -260,7 +249,7 @@ pub async fn run(
                 &local
             };
             let src = tex.source();
-            let cancelled = || gone.load(Ordering::Relaxed);
+            let cancelled = || cancel.is_set();
             let s = match &points {
                 Points::Texels(t) => samples::texels_until(&params, &src, cache, t, &cancelled)?,
                 Points::Footprints(f) => samples::footprints_until(&params, &src, cache, f, max_zoom_out, &cancelled)?,

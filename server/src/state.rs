@@ -98,11 +98,24 @@ impl AppState {
 
     /// Run a synthesis job (counted under `mode`) on the rayon pool (never on a tokio worker),
     /// within the in-flight limit, the queue-wait bound and the request timeout (503s beyond
-    /// them). A panic in the job becomes a 500.
+    /// them). A panic in the job becomes a 500. The job is given a [`Cancel`] that turns set
+    /// when this call is dropped before the job ends (the client went away, or the request
+    /// timed out); jobs that work in steps stop at the next one.
     pub async fn synthesize<F>(&self, mode: &str, job: F) -> Result<Bytes, ApiError>
     where
-        F: FnOnce() -> Result<Vec<u8>, ApiError> + Send + 'static,
+        F: FnOnce(&Cancel) -> Result<Vec<u8>, ApiError> + Send + 'static,
     {
+        let cancel = Cancel::default();
+        let abandon = AbandonOnDrop(Some(cancel.clone()));
+        let job_cancel = cancel.clone();
+        let cancelled = self.metrics.cancelled.clone();
+        let job = move || {
+            let r = job(&job_cancel);
+            if job_cancel.is_set() {
+                cancelled.inc();
+            }
+            r
+        };
         let admitted = self.admission.clone().try_acquire_owned().map_err(|_| {
             self.metrics.shed.inc();
             ApiError::overloaded()
@@ -129,7 +142,44 @@ impl AppState {
             }
         };
         let wait = Duration::from_secs(self.config.request_timeout_secs);
-        tokio::time::timeout(wait, work).await.unwrap_or_else(|_| Err(ApiError::timeout()))
+        let r = tokio::time::timeout(wait, work).await.unwrap_or_else(|_| Err(ApiError::timeout()));
+        if r.as_ref().is_err_and(|e| e.code == "timeout") {
+            cancel.set();
+        }
+        abandon.finished();
+        r
+    }
+}
+
+/// Set when the requester of a synthesis is gone: work that comes in steps stops at the next.
+#[derive(Debug, Clone, Default)]
+pub struct Cancel(Arc<std::sync::atomic::AtomicBool>);
+
+impl Cancel {
+    /// Whether the work should stop.
+    pub fn is_set(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    fn set(&self) {
+        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+/// Sets its [`Cancel`] when dropped before [`AbandonOnDrop::finished`].
+struct AbandonOnDrop(Option<Cancel>);
+
+impl AbandonOnDrop {
+    fn finished(mut self) {
+        self.0 = None;
+    }
+}
+
+impl Drop for AbandonOnDrop {
+    fn drop(&mut self) {
+        if let Some(c) = self.0.take() {
+            c.set();
+        }
     }
 }
 

@@ -184,7 +184,8 @@ pub async fn gltf_tile(
     let job = r.image();
     let png = tile_png(&st, &job.etag(), job).await?;
     let q = quad(&r.tex, &r.spec);
-    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move || Ok(glb(&[q], &[(png, "image/png")], &generator()))).await;
+    let (bytes, hit) =
+        cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&[q], &[(png, "image/png")], &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
@@ -244,7 +245,7 @@ pub async fn gltf_patch(
             quads.push(quad(&tex, &spec));
         }
     }
-    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move || Ok(glb(&quads, &images, &generator()))).await;
+    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&quads, &images, &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
