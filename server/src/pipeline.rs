@@ -169,24 +169,23 @@ where
 /// cache; the pixels it synthesized and delivered are counted when it actually runs.
 pub async fn produce(st: &Arc<AppState>, etag: &str, job: ImageJob) -> (Result<Bytes, ApiError>, bool) {
     let mode = job.params.name();
-    // Big windows wait for the big-window lane first (not holding a worker meanwhile).
-    let _lane = if job.is_big() && st.cache.peek(etag).is_none() {
-        match st.big_window_lane().await {
-            Ok(permit) => Some(permit),
-            Err(e) => return (Err(e), false),
-        }
-    } else {
-        None
-    };
+    let big = job.is_big();
     let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
     let pyramid = st.pyramid.clone();
-    cached(st, etag, mode, move |cancel| {
+    let make = move |cancel: &Cancel| {
         let (bytes, r) = job.bytes_until(&pyramid, cancel)?;
         synthesized.with_label_values(&[mode]).inc_by(r.synthesized);
         delivered.with_label_values(&[mode]).inc_by(r.image.width as u64 * r.image.height as u64);
         Ok(bytes)
-    })
-    .await
+    };
+    // Inside the single flight: concurrent requests for one big window take one place in the
+    // big-window lane, and wait for it without holding a worker.
+    st.cache
+        .get_or_compute(etag, || async {
+            let _lane = if big { Some(st.big_window_lane().await?) } else { None };
+            st.synthesize(mode, make).await
+        })
+        .await
 }
 
 /// Side of the pieces big views are rendered in.

@@ -105,9 +105,8 @@ impl AppState {
     where
         F: FnOnce(&Cancel) -> Result<Vec<u8>, ApiError> + Send + 'static,
     {
-        let cancel = Cancel::default();
-        let abandon = AbandonOnDrop(Some(cancel.clone()));
-        let job_cancel = cancel.clone();
+        let job_cancel = Cancel::default();
+        let abandon = AbandonOnDrop(Some(job_cancel.clone()));
         let cancelled = self.metrics.cancelled.clone();
         let job = move || {
             let r = job(&job_cancel);
@@ -142,12 +141,14 @@ impl AppState {
             }
         };
         let wait = Duration::from_secs(self.config.request_timeout_secs);
-        let r = tokio::time::timeout(wait, work).await.unwrap_or_else(|_| Err(ApiError::timeout()));
-        if r.as_ref().is_err_and(|e| e.code == "timeout") {
-            cancel.set();
+        match tokio::time::timeout(wait, work).await {
+            Ok(r) => {
+                abandon.finished();
+                r
+            }
+            // Timed out: `abandon` goes, and the job stops at its next step.
+            Err(_) => Err(ApiError::timeout()),
         }
-        abandon.finished();
-        r
     }
 }
 

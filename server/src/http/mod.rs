@@ -52,7 +52,7 @@ pub const MAX_URI_BYTES: usize = 16 << 10;
 /// them. What hyper refuses itself — beyond what it reads at all, or a malformed request line —
 /// it answers with a bare status (README: Configuration).
 async fn limits(req: Request, next: Next) -> Response {
-    let uri = req.uri().to_string().len();
+    let uri = req.uri().path_and_query().map_or(0, |pq| pq.as_str().len());
     if uri > MAX_URI_BYTES {
         return ApiError::new(
             crate::error::Kind::UriTooLong,
