@@ -20,7 +20,11 @@ fn the_api_keeps_its_openapi_contract() {
             "Schemathesis is not installed (pip install -r tests/contract/requirements.txt)",
         );
     }
-    let s = Server::builder().start();
+    // With an admin token configured (and not given to Schemathesis), so the admin routes exist
+    // and their refusals are held to the contract too.
+    let data = tempfile::tempdir().expect("temp dir");
+    let s =
+        Server::builder().data_dir(data.path()).env("TEXTILE_ADMIN_TOKEN", "contract-test-token-0123456789").start();
     // Schemathesis keeps a cache in its working directory: give it a temporary one.
     let scratch = tempfile::tempdir().expect("temp dir");
     let config = format!("{}/../tests/contract/schemathesis.toml", env!("CARGO_MANIFEST_DIR"));

@@ -87,8 +87,8 @@ pub enum CoreError {
         /// What was wrong and what is allowed.
         message: String,
     },
-    /// The work was abandoned because its requester went away.
-    #[error("cancelled: the requester went away")]
+    /// The work was abandoned: its requester went away, or the service is stopping.
+    #[error("cancelled: the requester went away or the service is stopping")]
     Cancelled,
 }
 

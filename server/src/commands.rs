@@ -178,10 +178,11 @@ pub fn render(a: RenderArgs) -> CliResult {
     Ok(())
 }
 
-/// A configured texture, loaded (analysed if its analysis is not stored) from the data directory.
+/// A configured or uploaded texture, loaded (analysed if its analysis is not stored) from the
+/// data directory.
 fn configured_texture(c: &ConfigArgs, id: &str) -> Result<Arc<Texture>, Box<dyn std::error::Error>> {
     let overrides = Overrides { data_dir: c.data_dir.clone(), ..Default::default() };
-    let cfg = Config::load(c.config.as_deref(), &overrides)?;
+    let cfg = crate::uploads::with_stored(&Config::load(c.config.as_deref(), &overrides)?, &|s| eprintln!("{s}"));
     let mut only = cfg.clone();
     only.textures.retain(|t| t.id == id);
     if only.textures.is_empty() {

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use figment::providers::{Env, Format, Serialized, Toml};
 use figment::Figment;
 use serde::{Deserialize, Serialize};
+use textile_core::error::clip;
 use textile_core::MODE_NAMES;
 
 /// The default configuration, compiled in.
@@ -30,6 +31,10 @@ const ENV_KEYS: &[&str] = &[
     "max_connections",
     "header_read_timeout_secs",
     "shutdown_grace_secs",
+    "admin_token",
+    "max_upload_mib",
+    "max_concurrent_analyses",
+    "max_uploaded_textures",
 ];
 
 /// Tri-state toroidal setting of a texture.
@@ -85,6 +90,9 @@ pub struct TextureConfig {
     /// Per-mode tables, and any other key (refused by validation, naming it).
     #[serde(flatten)]
     pub modes: BTreeMap<String, toml::Value>,
+    /// Added through the admin API (kept in the data directory), not configured.
+    #[serde(skip)]
+    pub uploaded: bool,
 }
 
 impl TextureConfig {
@@ -99,7 +107,48 @@ impl TextureConfig {
             default_seed: 0,
             attribution: String::new(),
             modes: BTreeMap::new(),
+            uploaded: false,
         }
+    }
+
+    /// Check the id, the default mode and every per-mode setting against the modes' specs;
+    /// on failure, the key (under `at`, e.g. `textures[2]`) and what is wrong with it.
+    pub fn validate(&self, at: &str) -> Result<(), (String, String)> {
+        let bad = |key: String, msg: String| Err((key, msg));
+        if !valid_id(&self.id) {
+            return bad(format!("{at}.id"), format!("'{}' must be 1-64 of a-z 0-9 _ -", clip(&self.id)));
+        }
+        if !MODE_NAMES.contains(&self.default_mode.as_str()) {
+            return bad(
+                format!("{at}.default_mode"),
+                format!("'{}' is not one of {}", clip(&self.default_mode), MODE_NAMES.join(", ")),
+            );
+        }
+        for (key, value) in &self.modes {
+            let at = format!("{at}.{}", clip(key));
+            if let Some(moved) = moved_key(key) {
+                return bad(at, format!("is now written per mode: {moved}"));
+            }
+            let Some(info) = textile_core::modes::all().into_iter().find(|m| m.name == key) else {
+                return bad(at, format!("unknown key; per-mode tables are {}", MODE_NAMES.join(", ")));
+            };
+            let Some(table) = value.as_table() else {
+                return bad(at, format!("must be a table of mode={key}'s parameters ([textures.{key}])"));
+            };
+            for (k, v) in table {
+                let Some(spec) = info.specs.iter().find(|s| s.name == k) else {
+                    let known: Vec<&str> = info.specs.iter().map(|s| s.name).collect();
+                    return bad(
+                        format!("{at}.{}", clip(k)),
+                        format!("mode={key} has no parameter '{}'; it has: {}", clip(k), known.join(", ")),
+                    );
+                };
+                if let Err(e) = spec.check(&text(v)) {
+                    return bad(format!("{at}.{k}"), e.to_string());
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The per-mode tables as `key = value` text pairs (lists joined with commas).
@@ -136,6 +185,18 @@ fn default_header_read_timeout() -> u64 {
 
 fn default_shutdown_grace() -> u64 {
     10
+}
+
+fn default_max_upload_mib() -> u64 {
+    32
+}
+
+fn default_max_concurrent_analyses() -> usize {
+    1
+}
+
+fn default_max_uploaded_textures() -> usize {
+    100
 }
 
 fn default_mode() -> String {
@@ -196,6 +257,20 @@ pub struct Config {
     /// PMTiles readers); empty: none.
     #[serde(default)]
     pub archives_dir: String,
+    /// Bearer token of the admin API (`POST /admin/textures`, `DELETE /admin/textures/{id}`);
+    /// empty: the admin API is off (its routes answer 404). Best given by environment
+    /// (`TEXTILE_ADMIN_TOKEN`) rather than in a file.
+    #[serde(default)]
+    pub admin_token: String,
+    /// Largest upload body, in MiB.
+    #[serde(default = "default_max_upload_mib")]
+    pub max_upload_mib: u64,
+    /// Analyses of uploaded textures run at once at most; more wait their turn.
+    #[serde(default = "default_max_concurrent_analyses")]
+    pub max_concurrent_analyses: usize,
+    /// Uploaded textures kept at most.
+    #[serde(default = "default_max_uploaded_textures")]
+    pub max_uploaded_textures: usize,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
     /// Directory relative exemplar paths are resolved against (set by the loader).
@@ -335,49 +410,41 @@ impl Config {
         if self.shutdown_grace_secs > 3600 {
             return bad("shutdown_grace_secs", format!("{} is outside 0..=3600", self.shutdown_grace_secs));
         }
+        if !self.admin_token.is_empty() && self.admin_token.len() < 16 {
+            return bad("admin_token", "must be at least 16 characters (or empty: admin API off)".into());
+        }
+        if axum::http::HeaderValue::from_str(&format!("Bearer {}", self.admin_token)).is_err() {
+            return bad("admin_token", "must be printable ASCII".into());
+        }
+        if !(1..=4096).contains(&self.max_upload_mib) {
+            return bad("max_upload_mib", format!("{} is outside 1..=4096", self.max_upload_mib));
+        }
+        if !(1..=64).contains(&self.max_concurrent_analyses) {
+            return bad("max_concurrent_analyses", format!("{} is outside 1..=64", self.max_concurrent_analyses));
+        }
+        if self.max_uploaded_textures > 100_000 {
+            return bad("max_uploaded_textures", format!("{} is outside 0..=100000", self.max_uploaded_textures));
+        }
         if self.textures.is_empty() {
             return bad("textures", "at least one texture is needed".into());
         }
         let mut seen = std::collections::HashSet::new();
         for (i, t) in self.textures.iter().enumerate() {
-            if !valid_id(&t.id) {
-                return bad(&format!("textures[{i}].id"), format!("'{}' must be 1-64 of a-z 0-9 _ -", t.id));
-            }
+            t.validate(&format!("textures[{i}]")).map_err(|(key, msg)| ConfigError(format!("key '{key}': {msg}")))?;
             if !seen.insert(&t.id) {
                 return bad(&format!("textures[{i}].id"), format!("'{}' is used twice", t.id));
             }
-            if !MODE_NAMES.contains(&t.default_mode.as_str()) {
-                return bad(
-                    &format!("textures[{i}].default_mode"),
-                    format!("'{}' is not one of {}", t.default_mode, MODE_NAMES.join(", ")),
-                );
-            }
-            for (key, value) in &t.modes {
-                let at = format!("textures[{i}].{key}");
-                if let Some(moved) = moved_key(key) {
-                    return bad(&at, format!("is now written per mode: {moved}"));
-                }
-                let Some(info) = textile_core::modes::all().into_iter().find(|m| m.name == key) else {
-                    return bad(&at, format!("unknown key; per-mode tables are {}", MODE_NAMES.join(", ")));
-                };
-                let Some(table) = value.as_table() else {
-                    return bad(&at, format!("must be a table of mode={key}'s parameters ([textures.{key}])"));
-                };
-                for (k, v) in table {
-                    let Some(spec) = info.specs.iter().find(|s| s.name == k) else {
-                        let known: Vec<&str> = info.specs.iter().map(|s| s.name).collect();
-                        return bad(
-                            &format!("{at}.{k}"),
-                            format!("mode={key} has no parameter '{k}'; it has: {}", known.join(", ")),
-                        );
-                    };
-                    if let Err(e) = spec.check(&text(v)) {
-                        return bad(&format!("{at}.{k}"), e.to_string());
-                    }
-                }
-            }
         }
         Ok(())
+    }
+
+    /// The configuration as `--print-config` shows it: the admin token hidden.
+    pub fn redacted(&self) -> Config {
+        let mut c = self.clone();
+        if !c.admin_token.is_empty() {
+            c.admin_token = "(set)".into();
+        }
+        c
     }
 
     /// The analysis directory in effect.

@@ -12,6 +12,10 @@ pub enum Kind {
     BadRequest,
     /// No such texture or route.
     NotFound,
+    /// The request needs credentials it lacks (the admin token).
+    Unauthorized,
+    /// The request conflicts with the catalogue (an id in use, a configured texture).
+    Conflict,
     /// The method is not allowed on an existing route.
     MethodNotAllowed,
     /// The request body is larger than allowed.

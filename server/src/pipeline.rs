@@ -261,6 +261,10 @@ mod tests {
             exemplar_hash: a.exemplar_hash.clone(),
             exemplar_png: Vec::new(),
             defaults: a.defaults.clone(),
+            uploaded: false,
+            progress: Default::default(),
+            failure: Default::default(),
+            removed: Default::default(),
         });
         assert_ne!(key(&a, "synth"), key(&b, "synth"));
         assert_eq!(key(&a, "mosaic"), key(&b, "mosaic"));

@@ -3,7 +3,7 @@
 //! the synthesis thread pool.
 
 use std::panic::AssertUnwindSafe;
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
 use axum::body::Bytes;
@@ -24,8 +24,19 @@ const LIFO_ABOVE_PER_THREAD: usize = 4;
 pub struct AppState {
     /// Effective configuration.
     pub config: Config,
-    /// Set once every texture is loaded.
-    pub registry: OnceLock<Arc<Registry>>,
+    /// The catalogue: set once the exemplars are decoded, then replaced whole (never edited in
+    /// place) when an upload adds or a deletion removes a texture, so every request works with
+    /// one consistent catalogue.
+    registry: RwLock<Option<Arc<Registry>>>,
+    /// Held while the catalogue is being changed (uploads and deletions, one at a time).
+    pub catalogue_writer: tokio::sync::Mutex<()>,
+    /// Permits to run analyses of uploaded textures (`max_concurrent_analyses`).
+    pub analyses: Arc<Semaphore>,
+    /// Set when the service is stopping: background analyses stop at their next step.
+    pub stopping: Cancel,
+    /// Set once the textures present at start-up are analysed (readiness; uploads analysed
+    /// later do not make the service unready).
+    pub loaded: std::sync::atomic::AtomicBool,
     /// Encoded images.
     pub cache: TileCache,
     /// Permits for syntheses in flight (running or waiting); beyond them requests are shed.
@@ -64,8 +75,12 @@ impl AppState {
             ),
             pyramid: Arc::new(Pyramid::new(config.level_cache_mib << 20)),
             big_windows: Arc::new(Semaphore::new(rayon::current_num_threads().saturating_sub(1).max(1))),
+            analyses: Arc::new(Semaphore::new(config.max_concurrent_analyses)),
             config,
-            registry: OnceLock::new(),
+            registry: RwLock::new(None),
+            catalogue_writer: tokio::sync::Mutex::new(()),
+            stopping: Cancel::default(),
+            loaded: Default::default(),
             metrics,
         }
     }
@@ -91,9 +106,24 @@ impl AppState {
         }
     }
 
-    /// The registry, or 503 while loading.
-    pub fn ready(&self) -> Result<&Arc<Registry>, ApiError> {
-        self.registry.get().ok_or_else(ApiError::not_ready)
+    /// The catalogue, or 503 while loading.
+    pub fn ready(&self) -> Result<Arc<Registry>, ApiError> {
+        self.registry().ok_or_else(ApiError::not_ready)
+    }
+
+    /// Whether the textures present at start-up are analysed.
+    pub fn loaded(&self) -> bool {
+        self.loaded.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// The catalogue, once the exemplars are decoded.
+    pub fn registry(&self) -> Option<Arc<Registry>> {
+        self.registry.read().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
+    /// Replace the catalogue (requests already holding the old one finish with it).
+    pub fn set_registry(&self, reg: Arc<Registry>) {
+        *self.registry.write().unwrap_or_else(|e| e.into_inner()) = Some(reg);
     }
 
     /// Run a synthesis job (counted under `mode`) on the rayon pool (never on a tokio worker),
@@ -162,7 +192,8 @@ impl Cancel {
         self.0.load(std::sync::atomic::Ordering::Relaxed)
     }
 
-    fn set(&self) {
+    /// Ask the work to stop.
+    pub fn set(&self) {
         self.0.store(true, std::sync::atomic::Ordering::Relaxed);
     }
 }

@@ -6,11 +6,13 @@
 
 use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, OnceLock};
 
 use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, Progress, Source};
 
 use crate::config::{Config, TextureConfig};
+use crate::state::Cancel;
 
 /// Exemplars compiled into the binary (`config/exemplars`, CC0; see LICENSE.md there).
 const EMBEDDED: &[(&str, &[u8])] = &[
@@ -40,6 +42,36 @@ pub struct Texture {
     pub exemplar_png: Vec<u8>,
     /// Parameters a request starts from: default mode, and each mode's configured defaults.
     pub defaults: Defaults,
+    /// Added through the admin API (stored in the data directory's uploads), not configured.
+    pub uploaded: bool,
+    /// Analysis progress, in percent.
+    pub progress: AtomicU32,
+    /// Why the analysis failed, if it did.
+    pub failure: OnceLock<String>,
+    /// Set when the texture is removed from the catalogue: its analysis stops.
+    pub removed: Cancel,
+}
+
+/// Where a texture stands: its analysis being computed, done, or failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// The analysis is being loaded or computed (modes that need only the exemplar serve).
+    Analysing,
+    /// Every mode serves.
+    Ready,
+    /// The analysis could not be computed.
+    Failed,
+}
+
+impl Status {
+    /// As the API writes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Analysing => "analysing",
+            Status::Ready => "ready",
+            Status::Failed => "failed",
+        }
+    }
 }
 
 impl Texture {
@@ -63,7 +95,18 @@ impl Texture {
             h.update(p);
         }
         let exemplar_hash = h.finalize().to_hex()[..16].to_string();
-        Ok(Texture { config, exemplar, analysis: OnceLock::new(), exemplar_hash, exemplar_png, defaults })
+        Ok(Texture {
+            uploaded: config.uploaded,
+            config,
+            exemplar,
+            analysis: OnceLock::new(),
+            exemplar_hash,
+            exemplar_png,
+            defaults,
+            progress: AtomicU32::new(0),
+            failure: OnceLock::new(),
+            removed: Cancel::default(),
+        })
     }
 
     /// A texture with its analysis.
@@ -76,7 +119,19 @@ impl Texture {
     /// Attach the analysis (once; later calls are ignored).
     pub fn set_analysis(&self, analysis: Analysis) {
         let hash = analysis.file_hash();
+        self.progress.store(100, Ordering::Relaxed);
         let _ = self.analysis.set((Arc::new(analysis), hash));
+    }
+
+    /// Where the texture stands.
+    pub fn status(&self) -> Status {
+        if self.analysis.get().is_some() {
+            Status::Ready
+        } else if self.failure.get().is_some() {
+            Status::Failed
+        } else {
+            Status::Analysing
+        }
     }
 
     /// The analysis, once available.
@@ -107,22 +162,42 @@ impl Texture {
     }
 }
 
-/// All served textures, in configuration order.
+/// All served textures: configured ones in configuration order, then uploaded ones in upload
+/// order. Never changed in place: a change makes a new registry ([`Registry::with`],
+/// [`Registry::without`]) that replaces the old one whole.
 pub struct Registry {
-    /// Textures in configuration order.
+    /// Textures in catalogue order.
     pub list: Vec<Arc<Texture>>,
     by_id: HashMap<String, Arc<Texture>>,
 }
 
 impl Registry {
+    /// A registry of these textures (ids unique).
+    pub fn new(list: Vec<Arc<Texture>>) -> Self {
+        let by_id = list.iter().map(|t| (t.config.id.clone(), t.clone())).collect();
+        Registry { list, by_id }
+    }
+
+    /// This registry with `tex` added at the end.
+    pub fn with(&self, tex: Arc<Texture>) -> Self {
+        let mut list: Vec<_> = self.list.iter().filter(|t| t.config.id != tex.config.id).cloned().collect();
+        list.push(tex);
+        Registry::new(list)
+    }
+
+    /// This registry without the texture `id`.
+    pub fn without(&self, id: &str) -> Self {
+        Registry::new(self.list.iter().filter(|t| t.config.id != id).cloned().collect())
+    }
+
+    /// Uploaded textures in it.
+    pub fn uploads(&self) -> usize {
+        self.list.iter().filter(|t| t.uploaded).count()
+    }
+
     /// The texture with this id.
     pub fn get(&self, id: &str) -> Option<&Arc<Texture>> {
         self.by_id.get(id)
-    }
-
-    /// Has every texture its analysis?
-    pub fn analysed(&self) -> bool {
-        self.list.iter().all(|t| t.analysis().is_some())
     }
 }
 
@@ -229,35 +304,51 @@ fn writable(dir: &std::path::Path) -> Result<(), std::io::Error> {
     std::fs::remove_file(&probe)
 }
 
-/// Decode every configured texture's exemplar: a registry whose textures have no analysis yet.
+/// Decode one texture's exemplar from its bytes: a texture without its analysis yet (`index`:
+/// its place in the configuration, for errors). `log` hears of any crop or resize.
+pub fn prepare_texture(
+    cfg: &Config,
+    t: &TextureConfig,
+    index: usize,
+    bytes: &[u8],
+    log: &dyn Fn(String),
+) -> Result<Texture, LoadError> {
+    let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
+    let ex = Exemplar::from_bytes(bytes, &opts).map_err(|source| LoadError::Core { id: t.id.clone(), source })?;
+    let prep = &ex.preparation;
+    if prep.input_width != prep.input_height || prep.crop_side != ex.side {
+        log(format!(
+            "texture '{}': exemplar {}x{} {}resized to {}x{} (exemplars are used as power-of-two squares)",
+            t.id,
+            prep.input_width,
+            prep.input_height,
+            if prep.input_width != prep.input_height {
+                format!("cropped to its central {0}x{0} and ", prep.crop_side)
+            } else {
+                String::new()
+            },
+            ex.side,
+            ex.side
+        ));
+    }
+    Texture::prepare(t.clone(), index, ex)
+}
+
+/// Decode every texture's exemplar: a registry whose textures have no analysis yet. A
+/// configured texture that cannot be prepared is an error; an uploaded one (which was checked
+/// when it was uploaded) is skipped with a warning, so a changed limit cannot stop the service.
 /// `log` receives one line per event.
 pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, LoadError> {
     let mut list = Vec::new();
     for (index, t) in cfg.textures.iter().enumerate() {
-        let core = |source| LoadError::Core { id: t.id.clone(), source };
-        let bytes = exemplar_bytes(cfg, t)?;
-        let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
-        let ex = Exemplar::from_bytes(&bytes, &opts).map_err(core)?;
-        let prep = &ex.preparation;
-        if prep.input_width != prep.input_height || prep.crop_side != ex.side {
-            log(format!(
-                "texture '{}': exemplar {}x{} {}resized to {}x{} (exemplars are used as power-of-two squares)",
-                t.id,
-                prep.input_width,
-                prep.input_height,
-                if prep.input_width != prep.input_height {
-                    format!("cropped to its central {0}x{0} and ", prep.crop_side)
-                } else {
-                    String::new()
-                },
-                ex.side,
-                ex.side
-            ));
+        let prepared = exemplar_bytes(cfg, t).and_then(|bytes| prepare_texture(cfg, t, index, &bytes, log));
+        match prepared {
+            Ok(tex) => list.push(Arc::new(tex)),
+            Err(e) if t.uploaded => log(format!("warning: uploaded {e}; not served")),
+            Err(e) => return Err(e),
         }
-        list.push(Arc::new(Texture::prepare(t.clone(), index, ex)?));
     }
-    let by_id = list.iter().map(|t| (t.config.id.clone(), t.clone())).collect();
-    Ok(Registry { list, by_id })
+    Ok(Registry::new(list))
 }
 
 /// Load or compute the analysis of every texture of a prepared registry, in configuration order
@@ -276,7 +367,23 @@ pub fn analyse_registry(
     stop: &dyn Fn() -> bool,
 ) -> Result<(), LoadError> {
     let data_dir = cfg.data_dir();
-    let storable = match writable(&data_dir) {
+    let storable = data_dir_storable(cfg, log);
+    for tex in &reg.list {
+        if stop() {
+            return Err(LoadError::Stopped);
+        }
+        if let Err(source) = analyse_texture(&data_dir, storable, tex, log, progress) {
+            return Err(LoadError::Core { id: tex.config.id.clone(), source });
+        }
+    }
+    Ok(())
+}
+
+/// Whether analyses can be stored in the data directory (checked first, with stale temporary
+/// files of interrupted writes removed); if not, a warning is logged.
+pub fn data_dir_storable(cfg: &Config, log: &dyn Fn(String)) -> bool {
+    let data_dir = cfg.data_dir();
+    match writable(&data_dir) {
         Ok(()) => {
             remove_stale_temp_files(&data_dir, log);
             true
@@ -288,52 +395,59 @@ pub fn analyse_registry(
             ));
             false
         }
-    };
-    for tex in &reg.list {
-        if stop() {
-            return Err(LoadError::Stopped);
-        }
-        let t = &tex.config;
-        let ex = &tex.exemplar;
-        let path = data_dir.join(format!("{}.tex", t.id));
-        let expected = Analysis::id_for(ex);
-        let analysis = match Analysis::load(&path) {
-            Ok(a) if a.header.id == expected => {
-                log(format!("texture '{}': loaded analysis {} from {}", t.id, a.header.id, path.display()));
-                a
-            }
-            other => {
-                match other {
-                    Ok(_) => {
-                        log(format!("texture '{}': stored analysis is stale (exemplar changed); recomputing", t.id))
-                    }
-                    Err(textile_core::CoreError::Io { .. }) => {
-                        log(format!("texture '{}': no stored analysis; computing", t.id))
-                    }
-                    Err(e) => log(format!("texture '{}': {e}; recomputing", t.id)),
-                }
-                let started = std::time::Instant::now();
-                let a = Analysis::build(ex, progress);
-                let stored = if storable {
-                    match a.save(&path) {
-                        Ok(()) => format!("stored {}", path.display()),
-                        Err(e) => format!("warning: not stored ({e}); kept in memory only"),
-                    }
-                } else {
-                    "kept in memory only".to_string()
-                };
-                log(format!(
-                    "texture '{}': analysed {}x{} in {:.2}s, {stored}",
-                    t.id,
-                    a.side(),
-                    a.side(),
-                    started.elapsed().as_secs_f64()
-                ));
-                a
-            }
-        };
-        tex.set_analysis(analysis);
     }
+}
+
+/// Load one texture's analysis from `data_dir` when it is current, else compute it (stopped
+/// when `progress` says so) and store it there if `storable`; then attach it to the texture.
+pub fn analyse_texture(
+    data_dir: &std::path::Path,
+    storable: bool,
+    tex: &Texture,
+    log: &dyn Fn(String),
+    progress: &dyn Progress,
+) -> Result<(), textile_core::CoreError> {
+    let t = &tex.config;
+    let ex = &tex.exemplar;
+    let path = data_dir.join(format!("{}.tex", t.id));
+    let expected = Analysis::id_for(ex);
+    let analysis = match Analysis::load(&path) {
+        Ok(a) if a.header.id == expected => {
+            log(format!("texture '{}': loaded analysis {} from {}", t.id, a.header.id, path.display()));
+            a
+        }
+        other => {
+            match other {
+                Ok(_) => log(format!("texture '{}': stored analysis is stale (exemplar changed); recomputing", t.id)),
+                Err(textile_core::CoreError::Io { .. }) => {
+                    log(format!("texture '{}': no stored analysis; computing", t.id))
+                }
+                Err(e) => log(format!("texture '{}': {e}; recomputing", t.id)),
+            }
+            let started = std::time::Instant::now();
+            let a = Analysis::try_build(ex, progress)?;
+            // A texture removed while it was analysed leaves nothing behind.
+            let stored = if tex.removed.is_set() {
+                "not stored (the texture was removed)".to_string()
+            } else if storable {
+                match a.save(&path) {
+                    Ok(()) => format!("stored {}", path.display()),
+                    Err(e) => format!("warning: not stored ({e}); kept in memory only"),
+                }
+            } else {
+                "kept in memory only".to_string()
+            };
+            log(format!(
+                "texture '{}': analysed {}x{} in {:.2}s, {stored}",
+                t.id,
+                a.side(),
+                a.side(),
+                started.elapsed().as_secs_f64()
+            ));
+            a
+        }
+    };
+    tex.set_analysis(analysis);
     Ok(())
 }
 

@@ -15,6 +15,7 @@ use crate::analysis::features::{
     principal_directions, project_runtime, project_search, quantise_projection, LevelColours, RUNTIME_DIMS, SEARCH_DIMS,
 };
 use crate::analysis::stack::{build_stack, to_u8};
+use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
 
 /// Version of the analysis (its content and file layout; part of the analysis id, so a change
@@ -32,6 +33,11 @@ pub const FIRST_CORRECTED_LEVEL: u32 = 4;
 pub trait Progress: Sync {
     /// `done` of `total` steps are finished; `what` names the current step.
     fn step(&self, done: u32, total: u32, what: &str);
+
+    /// Whether the work should stop (asked between steps by [`Analysis::try_build`]).
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// A [`Progress`] that ignores everything.
@@ -95,6 +101,21 @@ impl Analysis {
     /// Analyse a prepared exemplar. Deterministic: the same exemplar always gives the same
     /// analysis, whatever the thread count.
     pub fn build(ex: &Exemplar, progress: &dyn Progress) -> Analysis {
+        struct Uncancellable<'a>(&'a dyn Progress);
+        impl Progress for Uncancellable<'_> {
+            fn step(&self, done: u32, total: u32, what: &str) {
+                self.0.step(done, total, what)
+            }
+        }
+        match Self::try_build(ex, &Uncancellable(progress)) {
+            Ok(a) => a,
+            Err(_) => unreachable!("an uncancellable build is never cancelled"),
+        }
+    }
+
+    /// [`Analysis::build`], stopped between steps with [`CoreError::Cancelled`] once
+    /// `progress` says it is [`Progress::cancelled`].
+    pub fn try_build(ex: &Exemplar, progress: &dyn Progress) -> Result<Analysis> {
         let m = ex.side as usize;
         let levels = ex.side.trailing_zeros();
         let total = levels - FIRST_CORRECTED_LEVEL + 2;
@@ -103,6 +124,9 @@ impl Analysis {
         let stack8 = derive_stack8(&stack);
         let mut corrected = Vec::new();
         for l in FIRST_CORRECTED_LEVEL..=levels {
+            if progress.cancelled() {
+                return Err(CoreError::Cancelled);
+            }
             progress.step(l - FIRST_CORRECTED_LEVEL + 1, total, "neighbourhoods and candidates");
             corrected.push(analyse_level(&stack8[l as usize], m, ex.toroidal, 1 << (levels - l)));
         }
@@ -115,7 +139,7 @@ impl Analysis {
             toroidal: ex.toroidal,
             preparation: ex.preparation.clone(),
         };
-        Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8 }
+        Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8 })
     }
 
     /// The analysis id an exemplar would get: compare with a stored analysis's

@@ -16,6 +16,8 @@ pub fn status(kind: Kind) -> StatusCode {
     match kind {
         Kind::BadRequest => StatusCode::BAD_REQUEST,
         Kind::NotFound => StatusCode::NOT_FOUND,
+        Kind::Unauthorized => StatusCode::UNAUTHORIZED,
+        Kind::Conflict => StatusCode::CONFLICT,
         Kind::MethodNotAllowed => StatusCode::METHOD_NOT_ALLOWED,
         Kind::TooLarge => StatusCode::PAYLOAD_TOO_LARGE,
         Kind::UriTooLong => StatusCode::URI_TOO_LONG,
@@ -41,6 +43,10 @@ impl IntoResponse for ApiError {
         }
         let body = serde_json::json!({ "error": self.code, "message": message });
         let mut r = (status(self.kind), Json(body)).into_response();
+        if self.kind == Kind::Unauthorized {
+            r.headers_mut()
+                .insert(header::WWW_AUTHENTICATE, HeaderValue::from_static("Bearer realm=\"textile admin\""));
+        }
         if let Some(s) = self.retry_after {
             r.headers_mut().insert(header::RETRY_AFTER, HeaderValue::from(s));
         }

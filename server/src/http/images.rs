@@ -48,7 +48,7 @@ pub async fn tile(
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path((id, z, x, y)) = path.map_err(path_error)?;
-    let tex = texture(reg, &id)?;
+    let tex = texture(&reg, &id)?;
     let spec = parse_tile(&tex, &z, &x, &y)?;
     let params = params(&tex, query_reader(q.as_deref())?)?;
     answer(&st, &headers, ImageJob { tex, params, target: Target::Tile(spec) }).await
@@ -72,7 +72,7 @@ pub async fn window(
     let reg = st.ready()?;
     let Path(file) = path.map_err(path_error)?;
     let (id, fmt) = split_format(&file)?;
-    let tex = texture(reg, id)?;
+    let tex = texture(&reg, id)?;
     let mut r = query_reader(q.as_deref())?;
     let spec = parse_window(&tex, &mut r, fmt)?;
     let params = params(&tex, r)?;

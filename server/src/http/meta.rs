@@ -29,8 +29,8 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
         "status": "ok",
         "version": env!("CARGO_PKG_VERSION"),
         "engine": engine_version(),
-        "ready": st.registry.get().is_some_and(|r| r.analysed()),
-        "textures": st.registry.get().map(|r| r.list.len()).unwrap_or(0),
+        "ready": st.loaded(),
+        "textures": st.registry().map(|r| r.list.len()).unwrap_or(0),
         "tiles_synthesized": st.syntheses(),
         "shed": st.metrics.shed.get(),
         "cache": {
@@ -51,7 +51,7 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
 #[utoipa::path(get, path = "/ready", tag = "service",
     responses((status = 200, description = "ready"), (status = 503, description = "still loading or analysing")))]
 pub async fn ready(State(st): State<Arc<AppState>>) -> Result<Json<Value>, ApiError> {
-    if !st.ready()?.analysed() {
+    if !st.loaded() {
         return Err(ApiError::not_ready());
     }
     Ok(Json(json!({"status": "ready"})))
@@ -68,12 +68,13 @@ pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap, peer: 
         .map(|t| {
             json!({
                 "id": t.config.id, "name": t.config.name, "modes": MODE_NAMES, "default_mode": t.defaults.mode,
+                "status": t.status().as_str(), "uploaded": t.uploaded,
                 "tilejson": format!("{base}/tiles/{}/tilejson.json", t.config.id),
                 "exemplar": format!("{base}/textures/{}/exemplar.png", t.config.id),
             })
         })
         .collect();
-    Ok(Json(json!({ "textures": textures })))
+    Ok(Json(json!({ "textures": textures, "uploads": !st.config.admin_token.is_empty() })))
 }
 
 /// Metadata of one texture.
@@ -86,17 +87,23 @@ pub async fn texture_meta(
 ) -> Result<Json<Value>, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let t = texture(reg, &id)?;
+    let t = texture(&reg, &id)?;
     let (ex, prep) = (&t.exemplar, &t.exemplar.preparation);
     let analysis = match (t.analysis(), t.file_hash()) {
         (Some(a), Some(hash)) => json!({
             "status": "ready", "id": a.header.id, "file_hash": hash, "algorithm_version": a.header.algorithm_version,
         }),
-        _ => json!({ "status": "analysing" }),
+        _ => match t.failure.get() {
+            Some(why) => json!({ "status": "failed", "error": why }),
+            None => json!({ "status": "analysing" }),
+        },
     };
     Ok(Json(json!({
         "id": t.config.id,
         "name": t.config.name,
+        "status": t.status().as_str(),
+        "progress": t.progress.load(std::sync::atomic::Ordering::Relaxed),
+        "uploaded": t.uploaded,
         "attribution": t.config.attribution,
         "exemplar": {
             "width": ex.side, "height": ex.side, "toroidal": ex.toroidal,
@@ -192,7 +199,7 @@ pub async fn exemplar(
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let t = texture(reg, &id)?;
+    let t = texture(&reg, &id)?;
     let mut r = t.exemplar_png.clone().into_response();
     r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
     r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("public, max-age=3600"));
@@ -212,7 +219,7 @@ pub async fn tilejson(
 ) -> Result<Json<Value>, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let t = texture(reg, &id)?;
+    let t = texture(&reg, &id)?;
     let q = query_pairs(raw.as_deref());
     // A caller's `v` (e.g. busting its own cache of this document) is carried into the tiles'
     // version after the server's, which still changes with the analysis and engine.

@@ -3,6 +3,7 @@
 //! route modules (images, descriptive endpoints, 3D assets, static files, OpenAPI), which import
 //! nothing from each other. Nothing outside this folder names it: the crate root dispatches `textile serve` to [`serve`].
 
+pub mod admin;
 pub mod content;
 pub mod error;
 pub mod extract;
@@ -17,11 +18,12 @@ pub mod static_files;
 
 use std::sync::Arc;
 
+use axum::extract::DefaultBodyLimit;
 use axum::extract::{MatchedPath, Request, State};
 use axum::http::{header, HeaderValue, Method};
 use axum::middleware::{self, Next};
 use axum::response::{IntoResponse, Response};
-use axum::routing::{get, post};
+use axum::routing::{delete, get, post};
 use axum::Router;
 use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::compression::CompressionLayer;
@@ -86,6 +88,11 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/openapi.json", get(openapi::openapi))
         .route("/metrics", get(meta::metrics))
         .route("/textures/{id}", get(meta::texture_meta))
+        .route(
+            "/admin/textures",
+            post(admin::upload).layer(DefaultBodyLimit::max((state.config.max_upload_mib << 20) as usize)),
+        )
+        .route("/admin/textures/{id}", delete(admin::delete))
         .route("/textures/{id}/exemplar.png", get(meta::exemplar))
         .route("/tiles/{id}/tilejson.json", get(meta::tilejson))
         .route("/tiles/{id}/{z}/{x}/{y}", get(images::tile))
@@ -111,14 +118,15 @@ pub fn router(state: Arc<AppState>) -> Router {
 /// metrics, JSON compression, CORS, and panics turned into a 500 JSON error.
 fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Router {
     let cors = CorsLayer::new()
-        .allow_methods([Method::GET, Method::HEAD, Method::POST])
-        .allow_headers([header::IF_NONE_MATCH, header::CONTENT_TYPE, header::RANGE])
+        .allow_methods([Method::GET, Method::HEAD, Method::POST, Method::DELETE])
+        .allow_headers([header::IF_NONE_MATCH, header::CONTENT_TYPE, header::RANGE, header::AUTHORIZATION])
         .expose_headers([
             header::ETAG,
             header::HeaderName::from_static("x-cache"),
             header::HeaderName::from_static("x-textile-computed"),
             header::HeaderName::from_static("x-textile-windows"),
             header::CONTENT_RANGE,
+            header::LOCATION,
         ])
         .allow_origin(if state.config.cors_origins.iter().any(|o| o == "*") {
             AllowOrigin::any()

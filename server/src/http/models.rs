@@ -103,7 +103,7 @@ fn tile_request(
 ) -> Result<(TileRequest, String), ApiError> {
     let reg = st.ready()?;
     let Path((id, z, x, y)) = path.map_err(path_error)?;
-    let tex = texture(reg, &id)?;
+    let tex = texture(&reg, &id)?;
     let (y, ext) = split_ext(&y, exts)?;
     // `{y}.{token}.png`: the parameters of an image beside a .gltf, base64url in the path.
     let (y, raw) = match (ext, y.split_once('.')) {
@@ -204,7 +204,7 @@ pub async fn gltf_patch(
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let tex = texture(reg, &id)?;
+    let tex = texture(&reg, &id)?;
     let pairs = query_pairs(raw.as_deref());
     let mut reader = ParamReader::request(pairs.clone())?;
     let mut need = |k: &str| {

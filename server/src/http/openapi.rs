@@ -14,7 +14,7 @@ use utoipa::{Modify, OpenApi};
 #[derive(OpenApi)]
 #[openapi(
     info(title = "textile", description = "Infinite, deterministic, example-based texture tiles"),
-    modifiers(&ModeParameters, &ErrorResponses),
+    modifiers(&ModeParameters, &ErrorResponses, &AdminToken),
     paths(
         crate::http::meta::health,
         crate::http::meta::ready,
@@ -25,6 +25,8 @@ use utoipa::{Modify, OpenApi};
         crate::http::images::tile,
         crate::http::images::window,
         crate::http::samples::samples,
+        crate::http::admin::upload,
+        crate::http::admin::delete,
         openapi,
         crate::http::meta::metrics,
         crate::http::static_files::index,
@@ -93,7 +95,7 @@ impl Modify for ModeParameters {
             if !WITH_MODE_PARAMETERS.contains(&path.as_str()) {
                 continue;
             }
-            for op in [item.get.as_mut(), item.post.as_mut()].into_iter().flatten() {
+            for op in [item.get.as_mut(), item.post.as_mut(), item.delete.as_mut()].into_iter().flatten() {
                 op.parameters.get_or_insert_with(Vec::new).extend(params.iter().cloned());
             }
         }
@@ -130,7 +132,7 @@ impl Modify for ErrorResponses {
             ("503", "loading or overloaded; see Retry-After"),
         ];
         for (_, item) in doc.paths.paths.iter_mut() {
-            for op in [item.get.as_mut(), item.post.as_mut()].into_iter().flatten() {
+            for op in [item.get.as_mut(), item.post.as_mut(), item.delete.as_mut()].into_iter().flatten() {
                 for (code, what) in generic {
                     op.responses
                         .responses
@@ -148,6 +150,23 @@ impl Modify for ErrorResponses {
                 }
             }
         }
+    }
+}
+
+/// Declares the admin API's bearer token (`security(("admin_token" = []))` on its routes).
+struct AdminToken;
+
+impl Modify for AdminToken {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        use utoipa::openapi::security::{Http, HttpAuthScheme, SecurityScheme};
+        let scheme = Http::builder()
+            .scheme(HttpAuthScheme::Bearer)
+            .description(Some("the configured admin_token (TEXTILE_ADMIN_TOKEN); without one the admin API is off"))
+            .build();
+        doc.components
+            .get_or_insert_with(Default::default)
+            .security_schemes
+            .insert("admin_token".into(), SecurityScheme::Http(scheme));
     }
 }
 

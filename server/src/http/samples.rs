@@ -47,7 +47,7 @@ pub async fn samples(
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let tex = texture(reg, &id)?;
+    let tex = texture(&reg, &id)?;
     let mut r = query_reader(q.as_deref())?;
     let records = r.take("records").map(|s| Records::parse(&s)).transpose()?;
     let params = params(&tex, r)?;

@@ -37,7 +37,7 @@ pub fn run(args: ServeArgs) -> CliResult {
     };
     let cfg = Config::load(args.config.config.as_deref(), &overrides)?;
     if args.print_config {
-        print!("{}", toml::to_string_pretty(&cfg)?);
+        print!("{}", toml::to_string_pretty(&cfg.redacted())?);
         return Ok(());
     }
     let filter = tracing_subscriber::EnvFilter::try_from_env("TEXTILE_LOG")
@@ -73,19 +73,26 @@ async fn serve(cfg: Config) -> CliResult {
     info!("listening on http://{addr}/ (loading textures)");
     // One shutdown signal for everything: the accept loop, and the loading below.
     let (stop_tx, stop) = watch::channel(false);
-    tokio::spawn(async move {
-        shutdown_signal().await;
-        let _ = stop_tx.send(true);
-    });
+    {
+        let state = state.clone();
+        tokio::spawn(async move {
+            shutdown_signal().await;
+            state.stopping.set();
+            let _ = stop_tx.send(true);
+        });
+    }
     // Exemplars first (modes that need only the exemplar serve at once), then the analyses.
     let loader = {
         let state = state.clone();
         let stop = stop.clone();
         tokio::task::spawn_blocking(move || {
             let log = |s: String| info!("{s}");
-            let reg = Arc::new(prepare_registry(&state.config, &log)?);
-            let _ = state.registry.set(reg.clone());
-            analyse_registry(&state.config, &reg, &log, &LogProgress, &|| *stop.borrow())
+            let cfg = crate::uploads::with_stored(&state.config, &log);
+            let reg = Arc::new(prepare_registry(&cfg, &log)?);
+            state.set_registry(reg.clone());
+            analyse_registry(&cfg, &reg, &log, &LogProgress, &|| *stop.borrow())?;
+            state.loaded.store(true, std::sync::atomic::Ordering::Relaxed);
+            Ok(())
         })
     };
     let server = tokio::spawn(listen::serve(listener, app, limits, stop.clone()));
@@ -94,7 +101,7 @@ async fn serve(cfg: Config) -> CliResult {
     tokio::select! {
         loaded = loader => match loaded? {
             Ok(()) => {
-                let n = state.registry.get().map(|r| r.list.len()).unwrap_or(0);
+                let n = state.registry().map(|r| r.list.len()).unwrap_or(0);
                 let plural = if n == 1 { "" } else { "s" };
                 println!("textile ready: viewer at http://{addr}/ ({n} texture{plural})");
                 use std::io::Write;

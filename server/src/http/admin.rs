@@ -1,0 +1,285 @@
+//! The admin API: `POST /admin/textures` adds a texture from an uploaded exemplar (a PNG, JPEG
+//! or WebP body with its fields in the query, or `multipart/form-data` with an `image` part and
+//! field parts), answered `202 Accepted` with the texture's status at `Location` while it is
+//! analysed in the background; `DELETE /admin/textures/{id}` removes an uploaded texture. Both
+//! need `Authorization: Bearer TOKEN` (the configured `admin_token`); without a configured token
+//! the routes do not exist (404). The catalogue is changed under one lock and replaced whole.
+//! Storage and field rules are [`crate::uploads`]'s.
+
+use std::sync::Arc;
+
+use axum::body::to_bytes;
+use axum::extract::rejection::PathRejection;
+use axum::extract::{FromRequest, Multipart, OriginalUri, Path, RawQuery, Request, State};
+use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use textile_core::error::clip;
+use textile_core::CoreError;
+
+use crate::error::{ApiError, Kind};
+use crate::http::extract::path_error;
+use crate::state::AppState;
+use crate::textures::{prepare_texture, LoadError};
+use crate::uploads;
+
+/// The admin routes exist (a token is configured) and the request carries the token.
+fn admit(st: &AppState, headers: &HeaderMap, uri: &axum::http::Uri) -> Result<(), ApiError> {
+    if st.config.admin_token.is_empty() {
+        return Err(ApiError::not_found_route(uri.path()));
+    }
+    let given = headers.get(header::AUTHORIZATION).map(|v| v.as_bytes());
+    if !uploads::authorized(&st.config.admin_token, given) {
+        let why = if given.is_some() { "the bearer token is wrong" } else { "an Authorization header is required" };
+        return Err(ApiError::new(
+            Kind::Unauthorized,
+            "unauthorized",
+            format!("{why}: send Authorization: Bearer <admin token>"),
+        ));
+    }
+    Ok(())
+}
+
+fn too_large(limit: u64) -> ApiError {
+    ApiError::new(Kind::TooLarge, "body_too_large", format!("the upload is over {} MiB", limit >> 20))
+}
+
+/// The upload's fields and image bytes, from a raw image body (fields in the query) or a
+/// multipart form (fields as parts, the image as the part named `image`).
+async fn read_upload(
+    req: Request,
+    query: Option<&str>,
+    limit: u64,
+) -> Result<(Vec<(String, String)>, axum::body::Bytes), ApiError> {
+    let mut fields: Vec<(String, String)> =
+        form_urlencoded::parse(query.unwrap_or("").as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
+    let media = req
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .unwrap_or("")
+        .split(';')
+        .next()
+        .unwrap_or("")
+        .trim()
+        .to_ascii_lowercase();
+    let read_error = |e: String| {
+        if e.contains("length limit") || e.contains("limit exceeded") || e.contains("too large") {
+            too_large(limit)
+        } else {
+            ApiError::bad_request("invalid_body", format!("the body could not be read: {}", clip(&e)))
+        }
+    };
+    match media.as_str() {
+        "image/png" | "image/jpeg" | "image/webp" | "application/octet-stream" => {
+            let bytes = to_bytes(req.into_body(), limit as usize).await.map_err(|e| read_error(e.to_string()))?;
+            Ok((fields, bytes))
+        }
+        "multipart/form-data" => {
+            let mut form = Multipart::from_request(req, &()).await.map_err(|e| {
+                ApiError::bad_request("invalid_body", format!("not a multipart form: {}", clip(&e.body_text())))
+            })?;
+            let mut image = None;
+            while let Some(part) = form.next_field().await.map_err(|e| read_error(e.body_text()))? {
+                let name = part.name().unwrap_or("").to_string();
+                let bytes = part.bytes().await.map_err(|e| read_error(e.body_text()))?;
+                if name == "image" {
+                    if image.replace(bytes).is_some() {
+                        return Err(ApiError::bad_request("invalid_upload", "the part 'image' is given twice"));
+                    }
+                } else {
+                    let value = String::from_utf8(bytes.to_vec()).map_err(|_| {
+                        ApiError::bad_request("invalid_upload", format!("field '{}' is not UTF-8 text", clip(&name)))
+                    })?;
+                    fields.push((name, value));
+                }
+                if fields.len() > uploads::MAX_FIELDS {
+                    return Err(ApiError::bad_request(
+                        "invalid_upload",
+                        format!("more than {} fields", uploads::MAX_FIELDS),
+                    ));
+                }
+            }
+            let image =
+                image.ok_or_else(|| ApiError::bad_request("invalid_upload", "the form has no part named 'image'"))?;
+            Ok((fields, image))
+        }
+        other => Err(ApiError::new(
+            Kind::UnsupportedMediaType,
+            "unsupported_media_type",
+            format!(
+                "Content-Type '{}': send image/png, image/jpeg or image/webp (fields in the query), or \
+                 multipart/form-data with an 'image' part",
+                clip(other)
+            ),
+        )),
+    }
+}
+
+/// A failure to prepare an uploaded exemplar, as an answer.
+fn refused(e: LoadError) -> ApiError {
+    match e {
+        LoadError::Core { source: CoreError::ExemplarSize { .. }, .. } => {
+            ApiError::new(Kind::TooLarge, "image_too_large", e.to_string())
+        }
+        LoadError::Core { source: CoreError::ExemplarUndecodable(_), .. } => {
+            ApiError::bad_request("invalid_image", e.to_string())
+        }
+        other => ApiError::bad_request("invalid_upload", other.to_string()),
+    }
+}
+
+/// The status document of a texture, as `GET /textures/{id}` also gives it.
+fn status_body(tex: &crate::textures::Texture) -> serde_json::Value {
+    serde_json::json!({
+        "id": tex.config.id,
+        "status": tex.status().as_str(),
+        "progress": tex.progress.load(std::sync::atomic::Ordering::Relaxed),
+        "location": format!("/textures/{}", tex.config.id),
+    })
+}
+
+/// Add a texture from an uploaded exemplar.
+#[utoipa::path(post, path = "/admin/textures", tag = "admin",
+    params(("id" = Option<String>, Query, description = "texture id (1-64 of a-z 0-9 _ -); required, here or as a form field"),
+           ("name" = Option<String>, Query, description = "display name"),
+           ("toroidal" = Option<String>, Query, description = "auto, true or false"),
+           ("default_mode" = Option<String>, Query, description = "mode of requests that name none"),
+           ("default_seed" = Option<u64>, Query, description = "seed of requests that name none"),
+           ("attribution" = Option<String>, Query, description = "attribution shown in TileJSON")),
+    request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). At most max_upload_mib MiB; each side at most max_exemplar_side.",
+        content(("image/png"), ("image/jpeg"), ("image/webp"), ("multipart/form-data"))),
+    responses((status = 202, description = "accepted: decoded and stored; analysing (Location: the texture's status)"),
+              (status = 400, description = "a field is invalid, or the image is corrupt or of another format"),
+              (status = 401, description = "no or wrong bearer token"),
+              (status = 404, description = "the admin API is off (no admin token configured)"),
+              (status = 409, description = "the id is in use, or the upload limit is reached"),
+              (status = 413, description = "the body or the image's dimensions are over the limits"),
+              (status = 415, description = "neither an image nor a multipart form"),
+              (status = 503, description = "still loading")),
+    security(("admin_token" = [])))]
+pub async fn upload(
+    State(st): State<Arc<AppState>>,
+    OriginalUri(uri): OriginalUri,
+    RawQuery(query): RawQuery,
+    req: Request,
+) -> Result<Response, ApiError> {
+    admit(&st, req.headers(), &uri)?;
+    let reg = st.ready()?;
+    let limit = st.config.max_upload_mib << 20;
+    let declared = req.headers().get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()?.parse::<u64>().ok());
+    if declared.is_some_and(|n| n > limit) {
+        return Err(too_large(limit));
+    }
+    let (fields, image) = read_upload(req, query.as_deref(), limit).await?;
+    let config = uploads::texture_config(&fields)?;
+    let id = config.id.clone();
+    let exists = |id: &str| {
+        ApiError::new(
+            Kind::Conflict,
+            "texture_exists",
+            format!("a texture '{id}' exists; DELETE it first to replace it"),
+        )
+    };
+    if reg.get(&id).is_some() {
+        return Err(exists(&id));
+    }
+    let Some(ext) = uploads::image_extension(&image) else {
+        return Err(ApiError::bad_request("invalid_image", "the image is not a PNG, JPEG or WebP file"));
+    };
+    // Decode and prepare off the async workers (an 8-megapixel JPEG takes a while).
+    let prepared = {
+        let (st, config, image) = (st.clone(), config.clone(), image.clone());
+        tokio::task::spawn_blocking(move || {
+            let log = |s: String| tracing::info!("{s}");
+            prepare_texture(&st.config, &config, 0, &image, &log)
+        })
+        .await
+        .map_err(|_| ApiError::internal("preparing the exemplar failed unexpectedly"))?
+        .map_err(refused)?
+    };
+    let tex = Arc::new(prepared);
+    {
+        let _writer = st.catalogue_writer.lock().await;
+        let reg = st.ready()?;
+        if reg.get(&id).is_some() {
+            return Err(exists(&id));
+        }
+        if reg.uploads() >= st.config.max_uploaded_textures {
+            return Err(ApiError::new(
+                Kind::Conflict,
+                "too_many_uploads",
+                format!("{} textures are uploaded already, the limit (max_uploaded_textures)", reg.uploads()),
+            ));
+        }
+        let dir = uploads::dir(&st.config);
+        let stored = {
+            let (config, dir, data_dir) = (config.clone(), dir.clone(), st.config.data_dir());
+            tokio::task::spawn_blocking(move || {
+                let r = uploads::store(&dir, &config, &image, ext);
+                if r.is_err() {
+                    let _ = uploads::remove(&dir, &data_dir, &config.id);
+                }
+                r
+            })
+            .await
+        };
+        match stored {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => {
+                return Err(ApiError::internal(format!("the upload could not be stored in {}: {e}", dir.display())))
+            }
+            Err(_) => return Err(ApiError::internal("storing the upload failed unexpectedly")),
+        }
+        st.set_registry(Arc::new(reg.with(tex.clone())));
+    }
+    tracing::info!("texture '{id}': uploaded ({}x{}); analysing", tex.exemplar.side, tex.exemplar.side);
+    uploads::analyse_in_background(st.clone(), tex.clone());
+    let mut resp = (StatusCode::ACCEPTED, Json(status_body(&tex))).into_response();
+    if let Ok(v) = HeaderValue::from_str(&format!("/textures/{id}")) {
+        resp.headers_mut().insert(header::LOCATION, v);
+    }
+    resp.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    Ok(resp)
+}
+
+/// Remove an uploaded texture (and its stored files).
+#[utoipa::path(delete, path = "/admin/textures/{id}", tag = "admin",
+    params(("id" = String, Path, description = "texture id")),
+    responses((status = 204, description = "removed"),
+              (status = 401, description = "no or wrong bearer token"),
+              (status = 404, description = "no such texture, or the admin API is off"),
+              (status = 409, description = "a configured texture (remove it from the configuration instead)"),
+              (status = 503, description = "still loading")),
+    security(("admin_token" = [])))]
+pub async fn delete(
+    State(st): State<Arc<AppState>>,
+    OriginalUri(uri): OriginalUri,
+    headers: HeaderMap,
+    path: Result<Path<String>, PathRejection>,
+) -> Result<Response, ApiError> {
+    admit(&st, &headers, &uri)?;
+    let Path(id) = path.map_err(path_error)?;
+    let _writer = st.catalogue_writer.lock().await;
+    let reg = st.ready()?;
+    let tex = crate::http::extract::texture(&reg, &id)?;
+    if !tex.uploaded {
+        return Err(ApiError::new(
+            Kind::Conflict,
+            "configured_texture",
+            format!("texture '{id}' is configured, not uploaded: remove it from the configuration"),
+        ));
+    }
+    tex.removed.set();
+    st.set_registry(Arc::new(reg.without(&id)));
+    let (dir, data_dir) = (uploads::dir(&st.config), st.config.data_dir());
+    let removed = tokio::task::spawn_blocking(move || uploads::remove(&dir, &data_dir, &id)).await;
+    if !matches!(removed, Ok(Ok(()))) {
+        tracing::warn!(
+            "texture '{}': removed from the catalogue, but its files could not all be deleted",
+            tex.config.id
+        );
+    }
+    tracing::info!("texture '{}': deleted", tex.config.id);
+    Ok(StatusCode::NO_CONTENT.into_response())
+}

@@ -1,0 +1,341 @@
+//! Uploaded textures, without HTTP: the admin token check, an upload's fields read into a
+//! texture configuration, and the store in the data directory's `uploads/` folder — the
+//! exemplar file as sent (`ID.png|jpg|webp`) and its configuration (`ID.toml`), each written to
+//! a temporary file and renamed into place, the configuration last: a configuration present
+//! means a complete upload, and whatever an interrupted upload left is removed at start-up —
+//! and the background analysis of an upload.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use textile_core::error::clip;
+
+use std::sync::Arc;
+
+use crate::config::{Config, TextureConfig, Toroidal};
+use crate::error::ApiError;
+use crate::state::{AppState, Cancel};
+use crate::textures::Texture;
+
+/// The folder of uploaded textures inside the data directory.
+pub const UPLOADS_DIR: &str = "uploads";
+
+/// The uploads folder of a configuration's data directory.
+pub fn dir(cfg: &Config) -> PathBuf {
+    cfg.data_dir().join(UPLOADS_DIR)
+}
+
+/// Whether `authorization` (the header's value) carries the configured admin token. Both sides
+/// are hashed and the hashes compared in constant time, so the comparison's duration says
+/// nothing about the token.
+pub fn authorized(token: &str, authorization: Option<&[u8]>) -> bool {
+    let Some(given) = authorization.and_then(|a| a.strip_prefix(b"Bearer ")) else {
+        return false;
+    };
+    !token.is_empty() && blake3::hash(given) == blake3::hash(token.as_bytes())
+}
+
+/// The image formats accepted, by their file extension.
+pub fn image_extension(bytes: &[u8]) -> Option<&'static str> {
+    match image::guess_format(bytes).ok()? {
+        image::ImageFormat::Png => Some("png"),
+        image::ImageFormat::Jpeg => Some("jpg"),
+        image::ImageFormat::WebP => Some("webp"),
+        _ => None,
+    }
+}
+
+/// Files without a configuration younger than this are left alone (see [`stored`]).
+const ORPHAN_AGE: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// Most fields an upload may carry.
+pub const MAX_FIELDS: usize = 64;
+
+/// A texture configuration from an upload's fields (query pairs or multipart fields): `id`
+/// (required), `name`, `toroidal` (`auto|true|false`), `default_mode`, `default_seed`,
+/// `attribution`, and `MODE.KEY` for a per-mode setting (`synth.kappa=0.5`). Checked as a
+/// configured texture is, so an upload is refused for what a configuration file would be.
+pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiError> {
+    let bad = |m: String| ApiError::bad_request("invalid_upload", m);
+    if fields.len() > MAX_FIELDS {
+        return Err(bad(format!("{} fields; at most {MAX_FIELDS}", fields.len())));
+    }
+    let mut id = None;
+    let mut t = TextureConfig::new("", "");
+    t.name.clear();
+    let mut modes: BTreeMap<String, toml::map::Map<String, toml::Value>> = BTreeMap::new();
+    let mut seen = std::collections::HashSet::new();
+    for (k, v) in fields {
+        if !seen.insert(k.as_str()) {
+            return Err(bad(format!("field '{}' is given twice", clip(k))));
+        }
+        let long = |max: usize| bad(format!("field '{}' is over {max} characters", clip(k)));
+        match k.as_str() {
+            "id" => id = Some(v.clone()),
+            "name" if v.chars().count() > 200 => return Err(long(200)),
+            "name" => t.name = v.clone(),
+            "attribution" if v.chars().count() > 1000 => return Err(long(1000)),
+            "attribution" => t.attribution = v.clone(),
+            "default_mode" => t.default_mode = v.clone(),
+            "default_seed" => {
+                t.default_seed =
+                    v.parse().map_err(|_| bad(format!("default_seed '{}' is not an integer in 0..2^64", clip(v))))?
+            }
+            "toroidal" => {
+                t.toroidal = match v.as_str() {
+                    "auto" => Toroidal::Auto,
+                    "true" => Toroidal::True,
+                    "false" => Toroidal::False,
+                    _ => return Err(bad(format!("toroidal '{}' is not one of auto, true, false", clip(v)))),
+                }
+            }
+            other => {
+                let Some((mode, key)) = other.split_once('.') else {
+                    return Err(bad(format!(
+                        "unknown field '{}'; fields are id, name, toroidal, default_mode, default_seed, \
+                         attribution and MODE.KEY settings",
+                        clip(other)
+                    )));
+                };
+                if v.len() > 256 {
+                    return Err(long(256));
+                }
+                modes.entry(mode.to_string()).or_default().insert(key.to_string(), toml::Value::String(v.clone()));
+            }
+        }
+    }
+    t.id = id.ok_or_else(|| bad("the field 'id' is required".into()))?;
+    if t.name.is_empty() {
+        t.name = t.id.clone();
+    }
+    t.modes = modes.into_iter().map(|(m, table)| (m, toml::Value::Table(table))).collect();
+    t.uploaded = true;
+    t.validate("upload").map_err(|(key, msg)| bad(format!("{key}: {msg}")))?;
+    Ok(t)
+}
+
+/// Store an upload: the exemplar bytes as `ID.EXT`, then its configuration as `ID.toml` (each
+/// written to a temporary file, synced and renamed into place).
+pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let file = format!("{}.{ext}", t.id);
+    write_atomic(&dir.join(&file), image)?;
+    let mut stored = t.clone();
+    stored.exemplar = file;
+    let text = toml::to_string(&stored).map_err(std::io::Error::other)?;
+    write_atomic(&dir.join(format!("{}.toml", t.id)), text.as_bytes())
+}
+
+/// Write `bytes` to `path` through a temporary file beside it, synced, then renamed.
+fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let written = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
+
+/// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
+/// orphan that start-up removes, never a half texture), then its exemplar, then its analysis
+/// in `data_dir`.
+pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
+    match std::fs::remove_file(dir.join(format!("{id}.toml"))) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
+        _ => {}
+    }
+    for ext in ["png", "jpg", "webp"] {
+        let _ = std::fs::remove_file(dir.join(format!("{id}.{ext}")));
+    }
+    let _ = std::fs::remove_file(data_dir.join(format!("{id}.tex")));
+    Ok(())
+}
+
+/// The stored uploads, in upload order (oldest first), their exemplar paths made absolute.
+/// Files no configuration owns (left by an interrupted upload or deletion) are removed; an
+/// unreadable configuration is skipped with a warning.
+pub fn stored(dir: &Path, log: &dyn Fn(String)) -> Vec<TextureConfig> {
+    let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
+    let mut configs = Vec::new();
+    let mut others = Vec::new();
+    for e in entries.flatten() {
+        let path = e.path();
+        match path.extension().and_then(|x| x.to_str()) {
+            Some("toml") => {
+                let modified = e.metadata().and_then(|m| m.modified()).ok();
+                configs.push((modified, path));
+            }
+            _ => others.push(path),
+        }
+    }
+    configs.sort();
+    let mut out: Vec<TextureConfig> = Vec::new();
+    for (_, path) in configs {
+        let parsed = std::fs::read_to_string(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|s| toml::from_str::<TextureConfig>(&s).map_err(|e| e.to_string()));
+        match parsed {
+            Ok(mut t) if path.file_stem().is_some_and(|s| s == t.id.as_str()) && t.validate("upload").is_ok() => {
+                t.exemplar = dir.join(&t.exemplar).to_string_lossy().into_owned();
+                t.uploaded = true;
+                out.push(t);
+            }
+            Ok(_) => log(format!("warning: {} is not a valid upload record; skipped", path.display())),
+            Err(e) => log(format!("warning: {}: {e}; skipped", path.display())),
+        }
+    }
+    for path in others {
+        let owned = out.iter().any(|t| Path::new(&t.exemplar) == path);
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let writer = name.rsplit_once(".tmp-").and_then(|(_, pid)| pid.parse::<u32>().ok());
+        if writer.is_some_and(|p| Path::new(&format!("/proc/{p}")).exists()) {
+            continue; // being written by a live process (another replica sharing the directory)
+        }
+        // An exemplar renamed into place a moment ago may be an upload whose configuration is
+        // being written by another process: only old orphans are removed.
+        let age = std::fs::metadata(&path).and_then(|m| m.modified()).ok().and_then(|t| t.elapsed().ok());
+        if writer.is_none() && age.is_none_or(|a| a < ORPHAN_AGE) {
+            continue;
+        }
+        if !owned && std::fs::remove_file(&path).is_ok() {
+            log(format!("removed {}, left by an interrupted upload or deletion", path.display()));
+        }
+    }
+    out
+}
+
+/// A configuration with the stored uploads added after its own textures (an upload whose id a
+/// configured texture has is left out, with a warning).
+pub fn with_stored(cfg: &Config, log: &dyn Fn(String)) -> Config {
+    let mut all = cfg.clone();
+    for t in stored(&dir(cfg), log) {
+        if cfg.textures.iter().any(|c| c.id == t.id) {
+            log(format!("warning: uploaded texture '{}' is not served: a configured texture has its id", t.id));
+        } else {
+            all.textures.push(t);
+        }
+    }
+    all
+}
+
+/// Progress of a background analysis: kept on the texture (in percent), stopped when the
+/// texture is removed or the service stops.
+struct Background<'a> {
+    tex: &'a Texture,
+    stopping: &'a Cancel,
+}
+
+impl textile_core::Progress for Background<'_> {
+    fn step(&self, done: u32, total: u32, _: &str) {
+        // Analysis time grows with the level's area: weigh step `done` by it (the finest step,
+        // the last before "done", is about three quarters of the work).
+        let weight = |d: u32| 4f64.powi(d as i32);
+        let all: f64 = (0..=total).map(weight).sum();
+        let finished: f64 = (0..done.min(total + 1)).map(weight).sum();
+        let pct = if done >= total { 100 } else { ((finished / all) * 100.0).floor().min(99.0) as u32 };
+        self.tex.progress.store(pct, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    fn cancelled(&self) -> bool {
+        self.tex.removed.is_set() || self.stopping.is_set()
+    }
+}
+
+/// Analyse an uploaded texture in the background, at most `max_concurrent_analyses` at once,
+/// its progress kept on the texture; it stops if the texture is removed or the service stops.
+/// A failure is kept on the texture (its status becomes `failed`).
+pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
+    tokio::spawn(async move {
+        let Ok(_permit) = st.analyses.clone().acquire_owned().await else { return };
+        if tex.removed.is_set() || st.stopping.is_set() {
+            return;
+        }
+        let job = {
+            let (st, tex) = (st.clone(), tex.clone());
+            move || {
+                let data_dir = st.config.data_dir();
+                let log = |s: String| tracing::info!("{s}");
+                let storable = crate::textures::data_dir_storable(&st.config, &log);
+                let progress = Background { tex: &tex, stopping: &st.stopping };
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    crate::textures::analyse_texture(&data_dir, storable, &tex, &log, &progress)
+                }))
+            }
+        };
+        let failure = match tokio::task::spawn_blocking(job).await {
+            Ok(Ok(Ok(()))) | Ok(Ok(Err(textile_core::CoreError::Cancelled))) => None,
+            Ok(Ok(Err(e))) => Some(e.to_string()),
+            Ok(Err(_)) | Err(_) => Some("the analysis failed unexpectedly".to_string()),
+        };
+        if let Some(f) = failure {
+            tracing::warn!("texture '{}': analysis failed: {f}", tex.config.id);
+            let _ = tex.failure.set(f);
+        }
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pairs(p: &[(&str, &str)]) -> Vec<(String, String)> {
+        p.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    #[test]
+    fn fields_become_a_checked_texture_configuration() {
+        let t = texture_config(&pairs(&[("id", "cobble"), ("toroidal", "false"), ("synth.kappa", "0.5")])).unwrap();
+        assert_eq!((t.id.as_str(), t.name.as_str(), t.toroidal), ("cobble", "cobble", Toroidal::False));
+        assert_eq!(t.mode_tables()["synth"], vec![("kappa".to_string(), "0.5".to_string())]);
+        for bad in [
+            vec![("name", "x")],
+            vec![("id", "../x")],
+            vec![("id", "a"), ("toroidal", "maybe")],
+            vec![("id", "a"), ("synth.kappa", "7")],
+            vec![("id", "a"), ("nosuch.key", "1")],
+            vec![("id", "a"), ("colour", "red")],
+            vec![("id", "a"), ("id", "b")],
+        ] {
+            let e = texture_config(&pairs(&bad)).unwrap_err();
+            assert_eq!(e.code, "invalid_upload", "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn the_token_must_match_exactly() {
+        let t = "0123456789abcdef";
+        assert!(authorized(t, Some(b"Bearer 0123456789abcdef")));
+        for wrong in [&b"Bearer 0123456789abcdeg"[..], b"bearer 0123456789abcdef", b"0123456789abcdef", b"Bearer "] {
+            assert!(!authorized(t, Some(wrong)));
+        }
+        assert!(!authorized(t, None));
+        assert!(!authorized("", Some(b"Bearer ")));
+    }
+
+    #[test]
+    fn store_list_and_remove_leave_no_orphans() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path().join(UPLOADS_DIR);
+        let t = texture_config(&pairs(&[("id", "one"), ("name", "One")])).unwrap();
+        store(&dir, &t, b"\x89PNG fake", "png").unwrap();
+        let orphan = std::fs::File::create(dir.join("orphan.jpg")).unwrap();
+        orphan.set_modified(std::time::SystemTime::now() - 2 * ORPHAN_AGE).unwrap();
+        std::fs::write(dir.join("fresh.jpg"), b"x").unwrap();
+        let listed = stored(&dir, &|_| {});
+        assert_eq!(listed.len(), 1);
+        assert_eq!(listed[0].name, "One");
+        assert_eq!(std::fs::read(&listed[0].exemplar).unwrap(), b"\x89PNG fake");
+        assert!(!dir.join("orphan.jpg").exists());
+        assert!(dir.join("fresh.jpg").exists(), "a file just written may be an upload in progress");
+        remove(&dir, d.path(), "one").unwrap();
+        assert!(stored(&dir, &|_| {}).is_empty());
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+    }
+}

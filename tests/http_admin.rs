@@ -1,0 +1,272 @@
+//! The admin API against the real binary: uploads need the bearer token (and leave nothing
+//! behind without it, or when corrupt, oversized or a decompression bomb), a good upload is
+//! analysed in the background and then serves the same bytes as `textile render --exemplar` of
+//! the same file, per-texture settings travel with it, concurrent uploads of one id have one
+//! winner, deletion removes configured-or-not correctly, and uploads survive a restart.
+
+mod support;
+
+use std::path::Path;
+use std::time::Duration;
+
+use support::Server;
+
+const TOKEN: &str = "test-admin-token-0123456789";
+
+fn exemplar_path(name: &str) -> String {
+    format!("{}/../config/exemplars/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn brick() -> Vec<u8> {
+    std::fs::read(exemplar_path("brick.png")).expect("brick.png")
+}
+
+fn admin_server(data: &Path, extra_env: &[(&str, &str)]) -> Server {
+    let mut b = Server::builder().data_dir(data).env("TEXTILE_ADMIN_TOKEN", TOKEN);
+    for (k, v) in extra_env {
+        b = b.env(k, v);
+    }
+    b.start()
+}
+
+/// POST an upload: status, headers and JSON body.
+async fn upload(
+    s: &Server,
+    query: &str,
+    content_type: &str,
+    body: Vec<u8>,
+    token: Option<&str>,
+) -> (u16, reqwest::header::HeaderMap, serde_json::Value) {
+    let mut r = s.client.post(s.url(&format!("/admin/textures{query}"))).header("content-type", content_type);
+    if let Some(t) = token {
+        r = r.bearer_auth(t);
+    }
+    let r = r.body(body).send().await.expect("upload");
+    let (status, headers) = (r.status().as_u16(), r.headers().clone());
+    let body = r.json().await.unwrap_or(serde_json::Value::Null);
+    (status, headers, body)
+}
+
+async fn delete(s: &Server, id: &str, token: Option<&str>) -> (u16, serde_json::Value) {
+    let mut r = s.client.delete(s.url(&format!("/admin/textures/{id}")));
+    if let Some(t) = token {
+        r = r.bearer_auth(t);
+    }
+    let r = r.send().await.expect("delete");
+    let status = r.status().as_u16();
+    (status, r.json().await.unwrap_or(serde_json::Value::Null))
+}
+
+/// Poll a texture's status document until it is ready (or fail after a minute).
+async fn until_ready(s: &Server, location: &str) -> serde_json::Value {
+    let mut seen = Vec::new();
+    for _ in 0..600 {
+        let m = s.json(location).await;
+        let p = m["progress"].as_u64().expect("progress");
+        assert!(p <= 100, "{m}");
+        seen.push(p);
+        match m["status"].as_str() {
+            Some("ready") => {
+                assert_eq!(p, 100, "{m}");
+                assert!(seen.windows(2).all(|w| w[0] <= w[1]), "progress never goes back: {seen:?}");
+                return m;
+            }
+            Some("analysing") => tokio::time::sleep(Duration::from_millis(100)).await,
+            other => panic!("unexpected status {other:?}: {m}"),
+        }
+    }
+    panic!("{location} was not ready within a minute");
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|d| d.flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+async fn catalog_ids(s: &Server) -> Vec<String> {
+    let c = s.json("/catalog").await;
+    c["textures"].as_array().unwrap().iter().map(|t| t["id"].as_str().unwrap().to_string()).collect()
+}
+
+/// A PNG whose header claims `w`×`h` with almost no data: a decompression bomb.
+fn png_claiming(w: u32, h: u32) -> Vec<u8> {
+    let mut buf = std::io::Cursor::new(Vec::new());
+    image::RgbImage::new(1, 1).write_to(&mut buf, image::ImageFormat::Png).unwrap();
+    let mut png = buf.into_inner();
+    // IHDR data sits at bytes 16..29, its CRC (over type and data) at 29..33.
+    png[16..20].copy_from_slice(&w.to_be_bytes());
+    png[20..24].copy_from_slice(&h.to_be_bytes());
+    let crc = crc32(&png[12..29]);
+    png[29..33].copy_from_slice(&crc.to_be_bytes());
+    png
+}
+
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
+        }
+    }
+    !c
+}
+
+#[tokio::test]
+async fn admin_routes_do_not_exist_without_a_token() {
+    let s = Server::builder().start();
+    let (status, _, body) = upload(&s, "?id=x", "image/png", brick(), Some("anything-at-all-long")).await;
+    assert_eq!((status, body["error"].as_str()), (404, Some("not_found")), "{body}");
+    let (status, body) = delete(&s, "gravel", Some("anything-at-all-long")).await;
+    assert_eq!(status, 404, "{body}");
+    assert_eq!(s.json("/catalog").await["uploads"], false);
+}
+
+#[tokio::test]
+async fn refused_uploads_leave_nothing_behind() {
+    let data = tempfile::tempdir().unwrap();
+    let uploads = data.path().join("uploads");
+    let s = admin_server(data.path(), &[("TEXTILE_MAX_UPLOAD_MIB", "1")]);
+    assert_eq!(s.json("/catalog").await["uploads"], true);
+    let before = catalog_ids(&s).await;
+    let (status, headers, body) = upload(&s, "?id=nope", "image/png", brick(), None).await;
+    assert_eq!((status, body["error"].as_str()), (401, Some("unauthorized")), "{body}");
+    assert!(headers.get("www-authenticate").is_some_and(|v| v.to_str().unwrap().starts_with("Bearer")));
+    let (status, _, body) = upload(&s, "?id=nope", "image/png", brick(), Some("test-admin-token-0123456788")).await;
+    assert_eq!(status, 401, "{body}");
+    let (status, body) = delete(&s, "gravel", None).await;
+    assert_eq!(status, 401, "{body}");
+    let mut truncated = brick();
+    truncated.truncate(truncated.len() / 3);
+    let mut jpeg = std::io::Cursor::new(Vec::new());
+    image::RgbImage::new(64, 64).write_to(&mut jpeg, image::ImageFormat::Jpeg).unwrap();
+    let mut truncated_jpeg = jpeg.into_inner();
+    truncated_jpeg.truncate(200);
+    let cases: Vec<(&str, &str, Vec<u8>, u16, &str)> = vec![
+        ("?id=nope", "image/png", b"not an image at all".to_vec(), 400, "invalid_image"),
+        ("?id=nope", "image/png", truncated, 400, "invalid_image"),
+        ("?id=nope", "image/jpeg", truncated_jpeg, 400, "invalid_image"),
+        ("?id=nope", "image/png", png_claiming(200_000, 200_000), 413, "image_too_large"),
+        ("?id=Bad%20Id", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&toroidal=sometimes", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&synth.kappa=9", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&colour=red", "image/png", brick(), 400, "invalid_upload"),
+        ("?name=no-id", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope", "text/plain", brick(), 415, "unsupported_media_type"),
+        ("?id=gravel", "image/png", brick(), 409, "texture_exists"),
+    ];
+    for (query, ct, body, want, code) in cases {
+        let (status, _, got) = upload(&s, query, ct, body, Some(TOKEN)).await;
+        assert_eq!((status, got["error"].as_str()), (want, Some(code)), "{query} {ct}: {got}");
+        assert!(got["message"].as_str().is_some_and(|m| !m.is_empty() && m.len() < 1100), "{got}");
+    }
+    // Over the body limit: refused from the declared length, before the body is sent.
+    let (status, answer) = declared_upload(&s, (1 << 20) + 1).await;
+    assert_eq!(status, 413, "{answer}");
+    assert!(answer.contains("\"body_too_large\""), "{answer}");
+    assert!(files_in(&uploads).is_empty(), "left behind: {:?}", files_in(&uploads));
+    assert_eq!(catalog_ids(&s).await, before);
+    support::assert_error(&s, "/textures/nope", 404, "unknown_texture").await;
+    let (status, body) = delete(&s, "gravel", Some(TOKEN)).await;
+    assert_eq!((status, body["error"].as_str()), (409, Some("configured_texture")), "{body}");
+    let (status, body) = delete(&s, "nosuch", Some(TOKEN)).await;
+    assert_eq!((status, body["error"].as_str()), (404, Some("unknown_texture")), "{body}");
+    let (status, _) = s.get_bytes("/tiles/gravel/7/0/0.png").await;
+    assert_eq!(status, 200, "still serving");
+}
+
+#[tokio::test]
+async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
+    let data = tempfile::tempdir().unwrap();
+    let uploads = data.path().join("uploads");
+    let s = admin_server(data.path(), &[]);
+
+    // A raw PNG body, fields in the query.
+    let (status, headers, body) = upload(&s, "?id=mine&name=My%20brick", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let location = headers.get("location").expect("Location").to_str().unwrap().to_string();
+    assert_eq!(location, "/textures/mine");
+    assert_eq!(body["status"], "analysing");
+    // Modes that need only the exemplar serve at once.
+    let (status, _) = s.get_bytes("/tiles/mine/7/0/0.png?mode=mosaic").await;
+    assert_eq!(status, 200);
+    let meta = until_ready(&s, &location).await;
+    assert_eq!((meta["name"].as_str(), meta["uploaded"].as_bool()), (Some("My brick"), Some(true)));
+    let (status, tile) = s.get_bytes("/tiles/mine/7/1/2.png?seed=3").await;
+    assert_eq!(status, 200);
+    let out = tempfile::tempdir().unwrap();
+    let rendered = out.path().join("tile.png");
+    let done = std::process::Command::new(support::binary())
+        .args(["render", "--exemplar", &exemplar_path("brick.png"), "--x", "1", "--y", "2", "--seed", "3", "-o"])
+        .arg(&rendered)
+        .output()
+        .expect("render");
+    assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+    assert_eq!(std::fs::read(&rendered).unwrap(), tile, "the uploaded texture's tile equals textile render's");
+
+    // A multipart form with a per-mode setting: brick with κ = 0.5 is the configured brick.
+    let form = reqwest::multipart::Form::new()
+        .text("id", "brick2")
+        .text("synth.kappa", "0.5")
+        .part("image", reqwest::multipart::Part::bytes(brick()).file_name("brick.png").mime_str("image/png").unwrap());
+    let r = s.client.post(s.url("/admin/textures")).bearer_auth(TOKEN).multipart(form).send().await.unwrap();
+    assert_eq!(r.status(), 202);
+    until_ready(&s, "/textures/brick2").await;
+    let (_, a) = s.get_bytes("/tiles/brick2/7/-1/3.png?seed=5").await;
+    let (_, b) = s.get_bytes("/tiles/brick/7/-1/3.png?seed=5").await;
+    assert_eq!(a, b, "settings travel with the upload");
+
+    // Concurrent uploads of one id: one wins, the others are told it exists; nothing is torn.
+    let mut tries = tokio::task::JoinSet::new();
+    for _ in 0..4 {
+        let (client, url) = (s.client.clone(), s.url("/admin/textures?id=race"));
+        tries.spawn(async move {
+            let r = client.post(url).bearer_auth(TOKEN).header("content-type", "image/png").body(brick());
+            r.send().await.expect("upload").status().as_u16()
+        });
+    }
+    let statuses: Vec<u16> = tries.join_all().await;
+    assert_eq!(statuses.iter().filter(|&&st| st == 202).count(), 1, "{statuses:?}");
+    assert_eq!(statuses.iter().filter(|&&st| st == 409).count(), 3, "{statuses:?}");
+    until_ready(&s, "/textures/race").await;
+    assert_eq!(files_in(&uploads), ["brick2.png", "brick2.toml", "mine.png", "mine.toml", "race.png", "race.toml"]);
+
+    // Deletion: gone from the catalogue, its files and analysis removed.
+    let (status, _) = delete(&s, "brick2", Some(TOKEN)).await;
+    assert_eq!(status, 204);
+    support::assert_error(&s, "/textures/brick2", 404, "unknown_texture").await;
+    support::assert_error(&s, "/tiles/brick2/7/0/0.png", 404, "unknown_texture").await;
+    assert!(!data.path().join("brick2.tex").exists());
+    assert_eq!(files_in(&uploads), ["mine.png", "mine.toml", "race.png", "race.toml"]);
+    let ids = catalog_ids(&s).await;
+    assert_eq!(ids, ["gravel", "grass", "brick", "mine", "race"]);
+    drop(s);
+
+    // A restart serves the uploads that were kept, with the same bytes.
+    let s = admin_server(data.path(), &[]);
+    assert_eq!(catalog_ids(&s).await, ["gravel", "grass", "brick", "mine", "race"]);
+    let (status, again) = s.get_bytes("/tiles/mine/7/1/2.png?seed=3").await;
+    assert_eq!((status, again), (200, tile));
+    assert!(s.log_text().contains("texture 'mine': loaded analysis"), "the analysis was kept, not recomputed");
+}
+
+/// An authorized upload declaring `len` bytes, asking `Expect: 100-continue` and sending no
+/// body: the status and raw answer.
+async fn declared_upload(s: &Server, len: usize) -> (u16, String) {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let addr = s.base.trim_start_matches("http://");
+    let mut c = tokio::net::TcpStream::connect(addr).await.expect("connect");
+    let head = format!(
+        "POST /admin/textures?id=big HTTP/1.1\r\nHost: {addr}\r\nAuthorization: Bearer {TOKEN}\r\n\
+         Content-Type: image/png\r\nContent-Length: {len}\r\nExpect: 100-continue\r\nConnection: close\r\n\r\n"
+    );
+    c.write_all(head.as_bytes()).await.expect("write");
+    let mut answer = Vec::new();
+    let read = tokio::time::timeout(Duration::from_secs(20), c.read_to_end(&mut answer)).await;
+    assert!(read.is_ok(), "no answer before the body was sent");
+    let text = String::from_utf8_lossy(&answer).to_string();
+    (text.split(' ').nth(1).and_then(|s| s.parse().ok()).unwrap_or(0), text)
+}
