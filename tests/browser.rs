@@ -29,12 +29,18 @@ fn viewer_in_headless_chromium() {
     let server = Server::builder().queueing().start();
     // A server that sheds almost everything a viewer asks for at once.
     let shedding = Server::builder().args(&["--max-in-flight", "2", "--workers", "1"]).start();
+    // A server with the admin API, on a data directory of its own (the upload test adds to it).
+    let admin_data = tempfile::tempdir().expect("temp dir");
+    let token = "browser-test-token-0123456789";
+    let admin = Server::builder().data_dir(admin_data.path()).env("TEXTILE_ADMIN_TOKEN", token).start();
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("viewer.png");
     let status = Command::new("node")
         .args(["--test", "--test-concurrency=1", "viewer.test.mjs"])
         .current_dir(&dir)
         .env("TEXTILE_URL", &server.base)
         .env("TEXTILE_URL_SHEDDING", &shedding.base)
+        .env("TEXTILE_URL_ADMIN", &admin.base)
+        .env("TEXTILE_ADMIN_TOKEN", token)
         .env("TEXTILE_SCREENSHOT", &shot)
         .env("CHROMIUM", &chromium)
         .status()

@@ -174,6 +174,8 @@ async fn refused_uploads_leave_nothing_behind() {
     assert_eq!((status, body["error"].as_str()), (409, Some("configured_texture")), "{body}");
     let (status, body) = delete(&s, "nosuch", Some(TOKEN)).await;
     assert_eq!((status, body["error"].as_str()), (404, Some("unknown_texture")), "{body}");
+    let r = s.client.delete(s.url("/textures/gravel")).send().await.unwrap();
+    assert_eq!(r.status(), 401, "DELETE /textures/{{id}} is the same route");
     let (status, _) = s.get_bytes("/tiles/gravel/7/0/0.png").await;
     assert_eq!(status, 200, "still serving");
 }
@@ -208,11 +210,12 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     assert_eq!(std::fs::read(&rendered).unwrap(), tile, "the uploaded texture's tile equals textile render's");
 
     // A multipart form with a per-mode setting: brick with κ = 0.5 is the configured brick.
+    // (Sent to `POST /textures`, the contract's name for the same route.)
     let form = reqwest::multipart::Form::new()
         .text("id", "brick2")
         .text("synth.kappa", "0.5")
         .part("image", reqwest::multipart::Part::bytes(brick()).file_name("brick.png").mime_str("image/png").unwrap());
-    let r = s.client.post(s.url("/admin/textures")).bearer_auth(TOKEN).multipart(form).send().await.unwrap();
+    let r = s.client.post(s.url("/textures")).bearer_auth(TOKEN).multipart(form).send().await.unwrap();
     assert_eq!(r.status(), 202);
     until_ready(&s, "/textures/brick2").await;
     let (_, a) = s.get_bytes("/tiles/brick2/7/-1/3.png?seed=5").await;
@@ -269,4 +272,46 @@ async fn declared_upload(s: &Server, len: usize) -> (u16, String) {
     assert!(read.is_ok(), "no answer before the body was sent");
     let text = String::from_utf8_lossy(&answer).to_string();
     (text.split(' ').nth(1).and_then(|s| s.parse().ok()).unwrap_or(0), text)
+}
+
+/// Brick enlarged to 256² (an analysis of some seconds), as PNG.
+fn big_brick() -> Vec<u8> {
+    let img = image::load_from_memory(&brick()).unwrap().to_rgb8();
+    let big = image::imageops::resize(&img, 256, 256, image::imageops::FilterType::Triangle);
+    let mut buf = std::io::Cursor::new(Vec::new());
+    big.write_to(&mut buf, image::ImageFormat::Png).unwrap();
+    buf.into_inner()
+}
+
+#[tokio::test]
+async fn analyses_of_uploads_wait_their_turn_and_stop_on_shutdown() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[("TEXTILE_MAX_CONCURRENT_ANALYSES", "1")]);
+    for id in ["first", "second"] {
+        let (status, _, body) = upload(&s, &format!("?id={id}"), "image/png", big_brick(), Some(TOKEN)).await;
+        assert_eq!(status, 202, "{body}");
+    }
+    // While the first is under way, the second has not started.
+    let mut overlapped = None;
+    for _ in 0..300 {
+        let (a, b) = (s.json("/textures/first").await, s.json("/textures/second").await);
+        if a["status"] == "analysing" && a["progress"].as_u64() > Some(0) {
+            overlapped = Some(b["progress"].as_u64().unwrap());
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    assert_eq!(overlapped, Some(0), "the second analysis started while the first ran");
+    // SIGTERM mid-analysis: the process exits promptly and cleanly, leaving no analysis file.
+    let started = std::time::Instant::now();
+    assert_eq!(s.terminate(), Some(0));
+    assert!(started.elapsed() < Duration::from_secs(5), "shutdown waited {:?}", started.elapsed());
+    let stray: Vec<String> =
+        files_in(data.path()).into_iter().filter(|f| f.contains("first") || f.contains("second")).collect();
+    assert!(stray.is_empty(), "{stray:?}");
+    // The uploads were kept: the next start analyses them, and serves them.
+    let s = admin_server(data.path(), &[]);
+    assert_eq!(s.json("/textures/second").await["status"], "ready");
+    let (status, _) = s.get_bytes("/tiles/first/8/0/0.png").await;
+    assert_eq!(status, 200);
 }

@@ -206,6 +206,62 @@ function onMove() {
   writeHash();
 }
 
+// The upload form (shown when the server has an admin API): the token is kept for this tab only
+// (sessionStorage); the upload's status is polled at its Location until it is ready, then the
+// new texture is added to the list and shown.
+function setupUpload() {
+  if (!catalog.uploads) return;
+  $('upload').hidden = false;
+  const token = $('u-token');
+  token.value = sessionStorage.getItem('textile-admin-token') || '';
+  $('u-file').addEventListener('change', (e) => {
+    const f = e.target.files[0];
+    if (f && !$('u-id').value) {
+      $('u-id').value = f.name.replace(/\.[^.]*$/, '').toLowerCase().replace(/[^a-z0-9_-]+/g, '-').slice(0, 64);
+    }
+  });
+  const status = (text) => { $('u-status').textContent = text; };
+  $('uploadform').addEventListener('submit', async (e) => {
+    e.preventDefault();
+    const file = $('u-file').files[0];
+    if (!file) return;
+    sessionStorage.setItem('textile-admin-token', token.value);
+    const q = new URLSearchParams({ id: $('u-id').value, toroidal: $('u-toroidal').value });
+    if ($('u-name').value) q.set('name', $('u-name').value);
+    $('u-send').disabled = true;
+    status('uploading…');
+    try {
+      const r = await fetch(`/admin/textures?${q}`, {
+        method: 'POST', body: file,
+        headers: { Authorization: `Bearer ${token.value}`, 'Content-Type': file.type || 'application/octet-stream' },
+      });
+      const body = await r.json().catch(() => ({}));
+      if (r.status !== 202) throw new Error(body.message || `HTTP ${r.status}`);
+      const where = r.headers.get('Location') || `/textures/${encodeURIComponent(body.id)}`;
+      const bar = $('u-progress');
+      bar.hidden = false;
+      for (;;) {
+        const m = await (await fetch(where)).json();
+        bar.value = m.progress || 0;
+        if (m.status === 'ready') break;
+        if (m.status !== 'analysing') throw new Error((m.analysis && m.analysis.error) || `analysis ${m.status}`);
+        status(`analysing… ${m.progress} %`);
+        await new Promise((ok) => setTimeout(ok, 400));
+      }
+      bar.hidden = true;
+      catalog = await (await fetch('/catalog')).json();
+      const entry = catalog.textures.find((t) => t.id === body.id);
+      $('texture').append(new Option(entry ? entry.name : body.id, body.id));
+      status(`added “${entry ? entry.name : body.id}”`);
+      await selectTexture(body.id, false);
+    } catch (err) {
+      status(`upload failed: ${err.message}`);
+    } finally {
+      $('u-send').disabled = false;
+    }
+  });
+}
+
 async function init() {
   readHash();
   catalog = await (await fetch('/catalog')).json();
@@ -232,6 +288,7 @@ async function init() {
   });
   $('resetp').addEventListener('click', () => { state.p = {}; buildControls(); refreshLayer(); });
   $('grid').addEventListener('change', (e) => setGrid(e.target.checked));
+  setupUpload();
   $('worldlink').addEventListener('click', (e) => {
     e.currentTarget.href = `/world.html#t=${encodeURIComponent(state.t)}&m=${state.m}&s=${state.s}`;
   });

@@ -2,6 +2,7 @@
 // Run by tests/browser.rs, which starts the real binary; see that file.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
 import { chromium } from 'playwright-core';
 
 const BASE = process.env.TEXTILE_URL;
@@ -227,6 +228,42 @@ test('the Web-Mercator world page wraps the world with world= tiles', async () =
     assert.match(m[4], /world=\d+/);
     assert.equal(t.status, 200, t.url);
   }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('with the admin token, the upload form adds a texture that is then shown', async () => {
+  const admin = process.env.TEXTILE_URL_ADMIN;
+  assert.ok(admin, 'TEXTILE_URL_ADMIN must name a server with an admin token');
+  // Without an admin API there is no form.
+  const plain = await open('/');
+  assert.equal(await plain.page.$eval('#upload', (e) => e.hidden), true);
+  await plain.page.close();
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(admin + '/');
+  await page.waitForSelector('body[data-ready="1"]', { timeout: 20000 });
+  await page.click('#upload summary');
+  const png = readFileSync(new URL('../../config/exemplars/brick.png', import.meta.url));
+  // A wrong token is refused, and said so.
+  await page.fill('#u-token', 'not-the-token-at-all');
+  await page.setInputFiles('#u-file', { name: 'My Bricks.png', mimeType: 'image/png', buffer: png });
+  assert.equal(await page.inputValue('#u-id'), 'my-bricks', 'the id is suggested from the file name');
+  await page.fill('#u-name', 'My bricks');
+  await page.click('#u-send');
+  await page.waitForFunction(() => /upload failed/.test(document.querySelector('#u-status').textContent));
+  assert.match(await page.textContent('#u-status'), /token/);
+  // The right one: progress, then the new texture is selected and its tiles load.
+  await page.fill('#u-token', process.env.TEXTILE_ADMIN_TOKEN);
+  await page.click('#u-send');
+  await page.waitForFunction(() => /added/.test(document.querySelector('#u-status').textContent), null, { timeout: 60000 });
+  assert.equal(await page.inputValue('#texture'), 'my-bricks');
+  assert.match(page.url(), /t=my-bricks/);
+  await settled(page, 4);
+  const stats = await tileStats(page);
+  assert.ok(stats.every((t) => t.src.includes('/tiles/my-bricks/')), JSON.stringify(stats.map((t) => t.src)));
+  assertTexture(stats);
   assert.deepEqual(errors, []);
   await page.close();
 });

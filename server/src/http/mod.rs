@@ -78,6 +78,7 @@ async fn limits(req: Request, next: Next) -> Response {
 
 /// Build the router for a state.
 pub fn router(state: Arc<AppState>) -> Router {
+    let upload_limit = DefaultBodyLimit::max((state.config.max_upload_mib << 20) as usize);
     let routes = Router::new()
         .route("/", get(static_files::index))
         .route("/world.html", get(static_files::world))
@@ -87,11 +88,9 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/catalog", get(meta::catalog))
         .route("/openapi.json", get(openapi::openapi))
         .route("/metrics", get(meta::metrics))
-        .route("/textures/{id}", get(meta::texture_meta))
-        .route(
-            "/admin/textures",
-            post(admin::upload).layer(DefaultBodyLimit::max((state.config.max_upload_mib << 20) as usize)),
-        )
+        .route("/textures", post(admin::upload_alias).layer(upload_limit.clone()))
+        .route("/textures/{id}", get(meta::texture_meta).delete(admin::delete_alias))
+        .route("/admin/textures", post(admin::upload).layer(upload_limit))
         .route("/admin/textures/{id}", delete(admin::delete))
         .route("/textures/{id}/exemplar.png", get(meta::exemplar))
         .route("/tiles/{id}/tilejson.json", get(meta::tilejson))

@@ -27,6 +27,8 @@ use utoipa::{Modify, OpenApi};
         crate::http::samples::samples,
         crate::http::admin::upload,
         crate::http::admin::delete,
+        crate::http::admin::upload_alias,
+        crate::http::admin::delete_alias,
         openapi,
         crate::http::meta::metrics,
         crate::http::static_files::index,
