@@ -88,7 +88,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/catalog", get(meta::catalog))
         .route("/openapi.json", get(openapi::openapi))
         .route("/metrics", get(meta::metrics))
-        .route("/textures", post(admin::upload_alias).layer(upload_limit.clone()))
+        .route("/textures", post(admin::upload_alias).layer(upload_limit))
         .route("/textures/{id}", get(meta::texture_meta).delete(admin::delete_alias))
         .route("/admin/textures", post(admin::upload).layer(upload_limit))
         .route("/admin/textures/{id}", delete(admin::delete))
