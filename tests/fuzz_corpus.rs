@@ -11,6 +11,7 @@ const TARGETS: &[(&str, Entry)] = &[
     ("exemplar", textile_server::robustness::exemplar),
     ("analysis_file", textile_server::robustness::analysis_file),
     ("samples_body", textile_server::robustness::samples_body),
+    ("upload", textile_server::robustness::upload),
 ];
 
 #[test]

@@ -316,3 +316,34 @@ async fn work_for_a_client_that_went_away_is_cancelled() {
     // And the server serves on.
     assert_eq!(s.get_bytes("/tiles/gravel/7/0/0.png").await.0, 200);
 }
+
+#[tokio::test]
+async fn the_memory_budget_admits_windows_by_their_size_and_tiles_always() {
+    let s = Server::builder()
+        .args(&["--workers", "2"])
+        .env("TEXTILE_MEMORY_BUDGET_MIB", "64")
+        .env("TEXTILE_MAX_QUEUE_WAIT_MS", "300")
+        .start();
+    let reserved = |h: &serde_json::Value| h["memory"]["reserved_bytes"].as_u64().unwrap();
+    let health = s.json("/health").await;
+    assert_eq!((health["memory"]["budget_bytes"].as_u64(), reserved(&health)), (Some(64 << 20), 0));
+    // A 4096² window (about 110 MiB of work) takes the whole budget while it runs…
+    let (c, url) = (s.client.clone(), s.url("/windows/gravel.png?x=0&y=0&w=4096&h=4096&seed=31"));
+    let big = tokio::spawn(async move { c.get(url).send().await.map(|r| r.status().as_u16()).unwrap_or(0) });
+    let t = Instant::now();
+    while reserved(&s.json("/health").await) == 0 {
+        assert!(t.elapsed() < Duration::from_secs(20), "the big window never reserved memory");
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    assert_eq!(reserved(&s.json("/health").await), 64 << 20);
+    // …so another window waits for room and, past the queue-wait bound, is shed with 503…
+    let r = s.get("/windows/gravel.png?x=9000&y=0&w=2048&h=2048&seed=31").await;
+    assert_eq!(r.status(), 503);
+    assert!(r.headers().contains_key("retry-after"));
+    // …while tiles, which reserve nothing, are served.
+    assert_eq!(s.get_bytes("/tiles/gravel/7/50/50.png?seed=31").await.0, 200);
+    assert_eq!(big.await.unwrap(), 200);
+    // Given back when the work is done: the next window is served.
+    assert_eq!(reserved(&s.json("/health").await), 0);
+    assert_eq!(s.get_bytes("/windows/gravel.png?x=9000&y=0&w=2048&h=2048&seed=31").await.0, 200);
+}

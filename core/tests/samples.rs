@@ -129,3 +129,34 @@ proptest! {
         prop_assert_eq!(parts, whole);
     }
 }
+
+#[test]
+fn batches_bigger_than_a_chunk_equal_the_window_they_cover() {
+    // 70 000 texels (over one chunk of 65 536) in a shuffled 256² area, with duplicates; and as
+    // many footprints at texel centres, lod 0 (over one footprint chunk).
+    let (ex, an) = (common::small_exemplar(), common::small());
+    let src = Source::new(ex, an);
+    let p = params(&src, "synth");
+    let rect = Rect::new(-100, 40, 256, 256);
+    let window = p.render(&src, &Pyramid::off(), View { zoom_out: 0, rect }).unwrap();
+    let pts: Vec<Texel> = (0..70_000u64)
+        .map(|i| {
+            let h = textile_core::hash::hash(0x7C, 9, i as i64, 0, 0);
+            Texel { x: rect.x0 + (h % 256) as i64, y: rect.y0 + ((h >> 16) % 256) as i64, zoom_out: 0 }
+        })
+        .collect();
+    let cache = Pyramid::new(64 << 20);
+    let got = samples::texels(&p, &src, &cache, &pts).unwrap();
+    for (t, c) in pts.iter().zip(&got.colors) {
+        assert_eq!(*c, window.image.pixel((t.x - rect.x0) as u32, (t.y - rect.y0) as u32), "{t:?}");
+    }
+    let fps: Vec<Footprint> =
+        pts.iter().take(10_000).map(|t| Footprint { u: t.x as f64 + 0.5, v: t.y as f64 + 0.5, lod: 0.0 }).collect();
+    let got = samples::footprints(&p, &src, &cache, &fps, 0).unwrap();
+    assert_eq!(got.colors[..], samples::texels(&p, &src, &cache, &pts[..10_000]).unwrap().colors[..]);
+    // A bad sample past the first chunk is named by its place in the whole batch.
+    let mut bad = fps.clone();
+    bad[9_000].u = f64::NAN;
+    let e = samples::footprints(&p, &src, &cache, &bad, 0).unwrap_err();
+    assert!(e.to_string().contains("9000"), "{e}");
+}

@@ -35,6 +35,7 @@ const ENV_KEYS: &[&str] = &[
     "max_upload_mib",
     "max_concurrent_analyses",
     "max_uploaded_textures",
+    "memory_budget_mib",
 ];
 
 /// Tri-state toroidal setting of a texture.
@@ -199,6 +200,10 @@ fn default_max_uploaded_textures() -> usize {
     100
 }
 
+fn default_memory_budget_mib() -> u64 {
+    1024
+}
+
 fn default_mode() -> String {
     "synth".into()
 }
@@ -271,6 +276,11 @@ pub struct Config {
     /// Uploaded textures kept at most.
     #[serde(default = "default_max_uploaded_textures")]
     pub max_uploaded_textures: usize,
+    /// MiB of working memory that windows, glTF patches, sample batches, uploads and their
+    /// analyses may hold at once (each reserves its estimated size before it starts and waits
+    /// for room, at most `max_queue_wait_ms`, else 503); tiles are not counted: one per worker.
+    #[serde(default = "default_memory_budget_mib")]
+    pub memory_budget_mib: u64,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
     /// Directory relative exemplar paths are resolved against (set by the loader).
@@ -424,6 +434,9 @@ impl Config {
         }
         if self.max_uploaded_textures > 100_000 {
             return bad("max_uploaded_textures", format!("{} is outside 0..=100000", self.max_uploaded_textures));
+        }
+        if !(64..=1 << 20).contains(&self.memory_budget_mib) {
+            return bad("memory_budget_mib", format!("{} is outside 64..=1048576", self.memory_budget_mib));
         }
         if self.textures.is_empty() {
             return bad("textures", "at least one texture is needed".into());

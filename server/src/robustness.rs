@@ -68,3 +68,16 @@ pub fn samples_body(data: &[u8]) {
         _ => parse_binary(tex, body, Records::Footprints),
     };
 }
+
+/// An upload: the first line as the query of a raw-body upload (its fields read into a texture
+/// configuration, as `POST /admin/textures` does), the rest as a stored upload record
+/// (`uploads/ID.toml`, as read at start-up) and as the image whose format is sniffed.
+pub fn upload(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let (query, rest) = text.split_once('\n').unwrap_or((&text, ""));
+    let fields: Vec<(String, String)> =
+        form_urlencoded::parse(query.as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
+    let _ = crate::uploads::texture_config(&fields);
+    let _ = crate::uploads::parse_record(rest);
+    let _ = crate::uploads::image_extension(rest.as_bytes());
+}

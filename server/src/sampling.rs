@@ -27,7 +27,7 @@ pub const MAX_BODY: usize = 8 << 20;
 pub const RECORD: usize = 20;
 /// Pyramidal cache of one batch when the server's is off, so that the batch still computes the
 /// union of its samples' cones once.
-const BATCH_CACHE: u64 = 64 << 20;
+pub const BATCH_CACHE: u64 = 64 << 20;
 
 /// Smallest pixel coordinate at any zoom: the tile range times the tile size.
 const PIXEL_MIN: i64 = COORD_MIN * TILE_SIZE;

@@ -51,9 +51,16 @@ pub struct AppState {
     /// Big windows in flight at once: one fewer than the pool's threads (at least one), so that
     /// however many big windows are asked for, a worker is left for tiles.
     pub big_windows: Arc<Semaphore>,
+    /// The memory budget, in MiB permits (`memory_budget_mib`): see [`AppState::reserve`].
+    pub memory: Arc<Semaphore>,
     /// Prometheus metrics.
     pub metrics: Metrics,
 }
+
+/// Working memory reserved from the budget, given back when dropped.
+pub type Reservation = tokio::sync::OwnedSemaphorePermit;
+
+const MIB: u64 = 1 << 20;
 
 impl AppState {
     /// New state for a configuration.
@@ -76,6 +83,7 @@ impl AppState {
             pyramid: Arc::new(Pyramid::new(config.level_cache_mib << 20)),
             big_windows: Arc::new(Semaphore::new(rayon::current_num_threads().saturating_sub(1).max(1))),
             analyses: Arc::new(Semaphore::new(config.max_concurrent_analyses)),
+            memory: Arc::new(Semaphore::new(config.memory_budget_mib as usize)),
             config,
             registry: RwLock::new(None),
             catalogue_writer: tokio::sync::Mutex::new(()),
@@ -92,6 +100,32 @@ impl AppState {
             .chain(&[crate::metrics::GLTF_LABEL])
             .map(|m| self.metrics.syntheses.with_label_values(&[m]).get())
             .sum()
+    }
+
+    /// Reserve `bytes` of working memory from the budget (at least 1 MiB, at most all of it),
+    /// waiting for room at most the queue-wait bound (else 503, counted as shed).
+    pub async fn reserve(&self, bytes: u64) -> Result<Reservation, ApiError> {
+        let units = bytes.div_ceil(MIB).clamp(1, self.config.memory_budget_mib) as u32;
+        let wait = Duration::from_millis(self.config.max_queue_wait_ms);
+        match tokio::time::timeout(wait, self.memory.clone().acquire_many_owned(units)).await {
+            Ok(Ok(p)) => Ok(p),
+            _ => {
+                self.metrics.shed.inc();
+                Err(ApiError::overloaded())
+            }
+        }
+    }
+
+    /// [`AppState::reserve`] for background work: waits as long as it takes (`None` only if the
+    /// budget is closed).
+    pub async fn reserve_patiently(&self, bytes: u64) -> Option<Reservation> {
+        let units = bytes.div_ceil(MIB).clamp(1, self.config.memory_budget_mib) as u32;
+        self.memory.clone().acquire_many_owned(units).await.ok()
+    }
+
+    /// Working memory reserved now, in bytes.
+    pub fn reserved(&self) -> u64 {
+        (self.config.memory_budget_mib - self.memory.available_permits() as u64) * MIB
     }
 
     /// A place in the big-window lane, waited for at most the queue-wait bound (else 503).

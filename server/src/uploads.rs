@@ -178,16 +178,13 @@ pub fn stored(dir: &Path, log: &dyn Fn(String)) -> Vec<TextureConfig> {
     configs.sort();
     let mut out: Vec<TextureConfig> = Vec::new();
     for (_, path) in configs {
-        let parsed = std::fs::read_to_string(&path)
-            .map_err(|e| e.to_string())
-            .and_then(|s| toml::from_str::<TextureConfig>(&s).map_err(|e| e.to_string()));
+        let parsed = std::fs::read_to_string(&path).map_err(|e| e.to_string()).and_then(|s| parse_record(&s));
         match parsed {
-            Ok(mut t) if path.file_stem().is_some_and(|s| s == t.id.as_str()) && t.validate("upload").is_ok() => {
+            Ok(mut t) if path.file_stem().is_some_and(|s| s == t.id.as_str()) => {
                 t.exemplar = dir.join(&t.exemplar).to_string_lossy().into_owned();
-                t.uploaded = true;
                 out.push(t);
             }
-            Ok(_) => log(format!("warning: {} is not a valid upload record; skipped", path.display())),
+            Ok(_) => log(format!("warning: {} is not named after its id; skipped", path.display())),
             Err(e) => log(format!("warning: {}: {e}; skipped", path.display())),
         }
     }
@@ -211,6 +208,19 @@ pub fn stored(dir: &Path, log: &dyn Fn(String)) -> Vec<TextureConfig> {
     out
 }
 
+/// An upload record (`ID.toml`) read and checked: a texture configuration whose exemplar is a
+/// plain file name beside it.
+pub fn parse_record(text: &str) -> Result<TextureConfig, String> {
+    let mut t: TextureConfig = toml::from_str(text).map_err(|e| e.to_string())?;
+    t.validate("upload").map_err(|(key, msg)| format!("{key}: {msg}"))?;
+    let plain = Path::new(&t.exemplar).file_name().is_some_and(|n| n == t.exemplar.as_str());
+    if !plain || t.exemplar.starts_with('.') {
+        return Err(format!("exemplar '{}' is not a file name beside the record", clip(&t.exemplar)));
+    }
+    t.uploaded = true;
+    Ok(t)
+}
+
 /// A configuration with the stored uploads added after its own textures (an upload whose id a
 /// configured texture has is left out, with a warning).
 pub fn with_stored(cfg: &Config, log: &dyn Fn(String)) -> Config {
@@ -223,6 +233,12 @@ pub fn with_stored(cfg: &Config, log: &dyn Fn(String)) -> Config {
         }
     }
     all
+}
+
+/// Working memory an analysis of an exemplar of side `side` holds at its peak (measured:
+/// 8 MiB for 128², 37 MiB for 256²; about 600 bytes a texel).
+pub fn analysis_bytes(side: u32) -> u64 {
+    (16 << 20) + 600 * side as u64 * side as u64
 }
 
 /// Progress of a background analysis: kept on the texture (in percent), stopped when the
@@ -254,6 +270,7 @@ impl textile_core::Progress for Background<'_> {
 pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
     tokio::spawn(async move {
         let Ok(_permit) = st.analyses.clone().acquire_owned().await else { return };
+        let Some(_memory) = st.reserve_patiently(analysis_bytes(tex.exemplar.side)).await else { return };
         if tex.removed.is_set() || st.stopping.is_set() {
             return;
         }

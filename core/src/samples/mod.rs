@@ -148,9 +148,48 @@ pub fn texels(params: &ModeParams, src: &Source, cache: &Pyramid, texels: &[Texe
     texels_until(params, src, cache, texels, &|| false)
 }
 
+/// Texels planned and rendered together at most: a bigger batch is cut into spatially sorted
+/// chunks of this many (the cache shares what neighbouring chunks have in common), which bounds
+/// the plan's memory whatever the batch size.
+const CHUNK_TEXELS: usize = 1 << 16;
+
+/// Footprints filtered together at most (each has up to 8 taps).
+const CHUNK_FOOTPRINTS: usize = CHUNK_TEXELS / 8;
+
 /// [`texels`], giving up with [`CoreError::Cancelled`] between windows once `cancelled`
 /// answers true (the client went away).
 pub fn texels_until(
+    params: &ModeParams,
+    src: &Source,
+    cache: &Pyramid,
+    texels: &[Texel],
+    cancelled: &(dyn Fn() -> bool + Sync),
+) -> Result<Sampled> {
+    if texels.len() <= CHUNK_TEXELS {
+        return texels_together(params, src, cache, texels, cancelled);
+    }
+    let mut order: Vec<u32> = (0..texels.len() as u32).collect();
+    order.sort_unstable_by_key(|&i| {
+        let t = texels[i as usize];
+        let (cy, cx) = (t.y.div_euclid(MAX_GROUP), t.x.div_euclid(MAX_GROUP));
+        (t.zoom_out, cy.div_euclid(8), cx.div_euclid(8), cy, cx)
+    });
+    let mut colors = vec![[0u8; 3]; texels.len()];
+    let (mut synthesized, mut windows) = (0, 0);
+    for chunk in order.chunks(CHUNK_TEXELS) {
+        let part: Vec<Texel> = chunk.iter().map(|&i| texels[i as usize]).collect();
+        let got = texels_together(params, src, cache, &part, cancelled)?;
+        for (&i, c) in chunk.iter().zip(got.colors) {
+            colors[i as usize] = c;
+        }
+        synthesized += got.synthesized;
+        windows += got.windows;
+    }
+    Ok(Sampled { colors, synthesized, windows })
+}
+
+/// The texels of one chunk, planned into windows together.
+fn texels_together(
     params: &ModeParams,
     src: &Source,
     cache: &Pyramid,
@@ -209,17 +248,23 @@ pub fn footprints_until(
     max_zoom_out: u32,
     cancelled: &(dyn Fn() -> bool + Sync),
 ) -> Result<Sampled> {
-    let taps = filter::taps(points, max_zoom_out)?;
-    let wanted: Vec<Texel> = taps.iter().flat_map(|t| t.iter().map(|&(texel, _)| texel)).collect();
-    let got = texels_until(params, src, cache, &wanted, cancelled)?;
-    let mut at = 0;
-    let colors = taps
-        .iter()
-        .map(|t| {
+    let mut colors = Vec::with_capacity(points.len());
+    let (mut synthesized, mut windows) = (0, 0);
+    for (k, chunk) in points.chunks(CHUNK_FOOTPRINTS).enumerate() {
+        let taps = filter::taps(chunk, max_zoom_out).map_err(|e| match e {
+            CoreError::Sample { index, message } => CoreError::Sample { index: index + k * CHUNK_FOOTPRINTS, message },
+            other => other,
+        })?;
+        let wanted: Vec<Texel> = taps.iter().flat_map(|t| t.iter().map(|&(texel, _)| texel)).collect();
+        let got = texels_until(params, src, cache, &wanted, cancelled)?;
+        let mut at = 0;
+        colors.extend(taps.iter().map(|t| {
             let c = filter::blend(t.iter().map(|&(_, w)| w).zip(&got.colors[at..at + t.len()]));
             at += t.len();
             c
-        })
-        .collect();
-    Ok(Sampled { colors, synthesized: got.synthesized, windows: got.windows })
+        }));
+        synthesized += got.synthesized;
+        windows += got.windows;
+    }
+    Ok(Sampled { colors, synthesized, windows })
 }

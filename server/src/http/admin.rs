@@ -172,6 +172,8 @@ pub async fn upload(
     if declared.is_some_and(|n| n > limit) {
         return Err(too_large(limit));
     }
+    // The body and its decoding (the decoder's own allocations are capped by the image limits).
+    let _memory = st.reserve((16 << 20) + 2 * declared.unwrap_or(limit)).await?;
     let (fields, image) = read_upload(req, query.as_deref(), limit).await?;
     let config = uploads::texture_config(&fields)?;
     let id = config.id.clone();

@@ -39,6 +39,7 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
             "misses": st.cache.stats.misses.get(),
             "evictions": st.cache.stats.evictions.get(),
         },
+        "memory": { "budget_bytes": st.config.memory_budget_mib << 20, "reserved_bytes": st.reserved() },
         "level_cache": {
             "blocks": pyr.blocks, "bytes": pyr.bytes, "limit_bytes": st.config.level_cache_mib << 20,
             "hits": pyr.hits, "misses": pyr.misses, "evictions": pyr.evictions,

@@ -235,6 +235,8 @@ pub async fn gltf_patch(
     if let Some(b) = st.cache.peek(&etag) {
         return Ok(image(b, "model/gltf-binary", &etag, cc, true));
     }
+    // The tiles' PNGs and the document are held together: reserve room for them.
+    let _memory = st.reserve((4 << 20) + (n * n) as u64 * (256 << 10)).await?;
     let mut quads = Vec::new();
     let mut images = Vec::new();
     for j in 0..n {

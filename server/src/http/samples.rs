@@ -74,6 +74,10 @@ pub async fn samples(
     if declared.is_some_and(|n| n > MAX_BODY as u64) {
         return Err(too_large());
     }
+    // The body, the parsed samples, a chunk's plan and the answer (about 12 times the body's
+    // size at most, measured), and a batch cache of its own when the shared one is off.
+    let own_cache = if st.pyramid.is_on() { 0 } else { sampling::BATCH_CACHE };
+    let _memory = st.reserve((16 << 20) + 12 * declared.unwrap_or(MAX_BODY as u64) + own_cache).await?;
     let bytes = to_bytes(body, MAX_BODY).await.map_err(|e| {
         if e.to_string().contains("length limit") {
             too_large()
