@@ -252,8 +252,8 @@ function setupUpload() {
       catalog = await (await fetch('/catalog')).json();
       const entry = catalog.textures.find((t) => t.id === body.id);
       $('texture').append(new Option(entry ? entry.name : body.id, body.id));
-      status(`added “${entry ? entry.name : body.id}”`);
       await selectTexture(body.id, false);
+      status(`added “${entry ? entry.name : body.id}”`);
     } catch (err) {
       status(`upload failed: ${err.message}`);
     } finally {
