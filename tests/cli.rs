@@ -99,7 +99,7 @@ async fn render_writes_the_same_bytes_as_the_server() {
 fn help_describes_every_command() {
     let (code, out, _) = run(&["--help"]);
     assert_eq!(code, 0);
-    for c in ["serve", "analyze", "render", "info"] {
+    for c in ["serve", "analyze", "render", "info", "tileable"] {
         assert!(out.contains(c), "{out}");
     }
     let (code, out, _) = run(&["render", "--help"]);
@@ -160,5 +160,35 @@ async fn camera_view_is_made_of_samples_equal_to_the_texture() {
         assert_ne!(code, 0);
         assert!(err.contains(what), "{cam} {size}: {err}");
         assert!(!bad.exists());
+    }
+}
+
+#[test]
+fn tileable_writes_a_seamless_texture_deterministically_and_refuses_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let gravel = exemplar("gravel.png");
+    let (code, said, err) = run(&["tileable", &gravel, "--size", "64", "--seed", "3", "-o", &out("a.png")]);
+    assert_eq!(code, 0, "{err}");
+    assert!(said.contains("64x64, tileable"), "{said}");
+    let a = image::open(out("a.png")).unwrap().to_rgb8();
+    assert_eq!(a.dimensions(), (64, 64));
+    let (code, _, err) = run(&["tileable", &gravel, "--size", "64", "--seed", "3", "-o", &out("b.png")]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(std::fs::read(out("a.png")).unwrap(), std::fs::read(out("b.png")).unwrap(), "same seed, same bytes");
+    // Bad input: a clear message, a failing exit code, and no file.
+    let tiny = out("tiny.png");
+    image::RgbImage::new(4, 4).save(&tiny).unwrap();
+    for (args, says) in [
+        (vec!["tileable", &gravel, "--size", "100", "-o", &out("c.png")], "multiple of 8"),
+        (vec!["tileable", &gravel, "--size", "16", "-o", &out("c.png")], "outside 32"),
+        (vec!["tileable", &tiny, "-o", &out("c.png")], "4x4"),
+        (vec!["tileable", &gravel, "-o", &out("c.txt")], "must end in"),
+        (vec!["tileable", &gravel, "--backtrack", "0", "-o", &out("c.png")], "at least 1"),
+    ] {
+        let (code, _, err) = run(&args);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!dir.path().join("c.png").exists() && !dir.path().join("c.txt").exists());
     }
 }

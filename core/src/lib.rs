@@ -17,7 +17,9 @@
 //! 4. [`cache`] — the pyramidal cache that lets neighbouring windows share work;
 //! 5. [`image`] — the RGB windows the modes produce;
 //! 6. [`samples`] — per-sample queries (Wei & Levoy 2003): scattered texels and filtered
-//!    footprints in any order, equal to the tiles' pixels, through the same cache.
+//!    footprints in any order, equal to the tiles' pixels, through the same cache;
+//! 7. [`tileable`] — one seamless, finite tileable image by Wei & Levoy's 2000 algorithm,
+//!    its searches through the [`tsvq`] index.
 //!
 //! ```
 //! use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, NoProgress, ParamReader, Pyramid, Rect, Source, View};
@@ -46,6 +48,8 @@ pub mod hash;
 pub mod image;
 pub mod modes;
 pub mod samples;
+pub mod tileable;
+pub mod tsvq;
 
 pub use analysis::{Analysis, AnalysisHeader, NoProgress, Progress, ALGORITHM_VERSION};
 pub use cache::{Pyramid, PyramidStats};

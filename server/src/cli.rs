@@ -1,5 +1,5 @@
 //! Command-line interface: argument definitions (clap) for `serve` (the default), `analyze`,
-//! `render` and `info`.
+//! `render`, `tileable`, `info`, `export` and `loadtest`.
 
 use std::path::PathBuf;
 
@@ -28,6 +28,8 @@ pub enum Command {
     Serve(ServeArgs),
     /// Analyse an exemplar image and store the analysis file.
     Analyze(AnalyzeArgs),
+    /// Synthesize one seamless, tileable texture image from an exemplar (Wei & Levoy 2000).
+    Tileable(TileableArgs),
     /// Render a tile or any window of a texture to an image file.
     Render(RenderArgs),
     /// Print the header of an analysis file.
@@ -82,6 +84,35 @@ pub struct AnalyzeArgs {
     /// Output analysis file.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
+    /// Toroidal (wrap-around) exemplar: auto, true or false.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "true", "false"])]
+    pub toroidal: String,
+    /// Largest accepted exemplar side.
+    #[arg(long, default_value_t = 1024)]
+    pub max_side: u32,
+}
+
+/// `textile tileable`.
+#[derive(Debug, Args)]
+pub struct TileableArgs {
+    /// Exemplar image (PNG, JPEG, WebP, TGA or BMP).
+    pub exemplar: PathBuf,
+    /// Output side in pixels: a multiple of 2^(levels−1) (8 for exemplars of 128² and up),
+    /// 32–4096.
+    #[arg(long, default_value_t = 256)]
+    pub size: u32,
+    /// Output image (.png, .jpg, .jpeg or .webp).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Seed of the starting noise: the same seed gives the same bytes.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Search every exemplar neighbourhood instead of the TSVQ (slow; for comparison).
+    #[arg(long, conflicts_with = "backtrack")]
+    pub exact: bool,
+    /// Leaves of the TSVQ scanned per pixel (limited backtracking; 1 is greedy).
+    #[arg(long, default_value_t = textile_core::tileable::DEFAULT_BACKTRACK)]
+    pub backtrack: usize,
     /// Toroidal (wrap-around) exemplar: auto, true or false.
     #[arg(long, default_value = "auto", value_parser = ["auto", "true", "false"])]
     pub toroidal: String,

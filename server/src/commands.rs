@@ -1,4 +1,4 @@
-//! The one-shot commands: `analyze` (with a progress bar), `render` (a tile, a window or a
+//! The one-shot commands: `analyze` and `tileable` (with progress bars), `render` (a tile, a window or a
 //! perspective camera view through per-sample queries, to an image file, for scripts), `export`
 //! (an archive of tiles) and `info` (an analysis file's header).
 
@@ -10,7 +10,7 @@ use textile_core::modes::params::{Scope, COMMON};
 use textile_core::samples::{self, camera::GroundCamera, Footprint};
 use textile_core::{Analysis, Exemplar, ExemplarOptions, ModeParams, ParamReader, Progress, Pyramid};
 
-use crate::cli::{AnalyzeArgs, CliResult, ConfigArgs, ExportArgs, InfoArgs, RenderArgs};
+use crate::cli::{AnalyzeArgs, CliResult, ConfigArgs, ExportArgs, InfoArgs, RenderArgs, TileableArgs};
 use crate::config::{Config, Overrides, TextureConfig};
 use crate::encode::{encode, Effort, Format};
 use crate::export;
@@ -18,15 +18,16 @@ use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::textures::{exemplar_bytes, load_registry, Texture};
 
-struct Bar(Mutex<Option<ProgressBar>>);
+/// A progress bar on the terminal, labelled with what the work is.
+struct Bar(Mutex<Option<ProgressBar>>, &'static str);
 
 impl Progress for Bar {
     fn step(&self, done: u32, total: u32, what: &str) {
         let mut g = self.0.lock().unwrap_or_else(|e| e.into_inner());
         let bar = g.get_or_insert_with(|| {
             let b = ProgressBar::new(total as u64);
-            if let Ok(s) = ProgressStyle::with_template("{spinner} analysing [{bar:30}] {pos}/{len} {msg} ({elapsed})")
-            {
+            let template = format!("{{spinner}} {} [{{bar:30}}] {{pos}}/{{len}} {{msg}} ({{elapsed}})", self.1);
+            if let Ok(s) = ProgressStyle::with_template(&template) {
                 b.set_style(s.progress_chars("=> "));
             }
             b
@@ -53,7 +54,7 @@ pub fn analyze(a: AnalyzeArgs) -> CliResult {
     };
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
     let t = std::time::Instant::now();
-    let an = Analysis::build(&ex, &Bar(Mutex::new(None)));
+    let an = Analysis::build(&ex, &Bar(Mutex::new(None), "analysing"));
     an.save(&a.output)?;
     println!(
         "analysed {} ({}x{} → {}x{}, toroidal {}) in {:.2}s → {} (id {})",
@@ -66,6 +67,43 @@ pub fn analyze(a: AnalyzeArgs) -> CliResult {
         t.elapsed().as_secs_f64(),
         a.output.display(),
         an.header.id
+    );
+    Ok(())
+}
+
+/// `textile tileable EXEMPLAR --size N -o FILE`.
+pub fn tileable(a: TileableArgs) -> CliResult {
+    use textile_core::tileable::{synthesize, Search, TileableOptions};
+    let format = a
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .and_then(Format::from_ext)
+        .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
+    let toroidal = match a.toroidal.as_str() {
+        "true" => Some(true),
+        "false" => Some(false),
+        _ => None,
+    };
+    let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
+    let search = if a.exact { Search::Exact } else { Search::Tsvq { backtrack: a.backtrack } };
+    let opts = TileableOptions { size: a.size, seed: a.seed, search };
+    textile_core::tileable::check(&ex, &opts)?;
+    let t = std::time::Instant::now();
+    let img = synthesize(&ex, &opts, &Bar(Mutex::new(None), "synthesizing"))?;
+    let bytes = encode(&img.pixels, img.width, img.height, format, Effort::Tight)?;
+    write_atomic(&a.output, &bytes)?;
+    println!(
+        "wrote {} ({}x{}, tileable) from {} ({}x{}, toroidal {}) in {:.2}s, {}",
+        a.output.display(),
+        a.size,
+        a.size,
+        a.exemplar.display(),
+        ex.side,
+        ex.side,
+        ex.toroidal,
+        t.elapsed().as_secs_f64(),
+        if a.exact { "exhaustive search".to_string() } else { format!("TSVQ search, {} leaves", a.backtrack) }
     );
     Ok(())
 }

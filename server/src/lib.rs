@@ -39,6 +39,7 @@ pub fn run() -> std::process::ExitCode {
         None => http::serve::run(cli.serve),
         Some(cli::Command::Serve(a)) => http::serve::run(a),
         Some(cli::Command::Analyze(a)) => commands::analyze(a),
+        Some(cli::Command::Tileable(a)) => commands::tileable(a),
         Some(cli::Command::Render(a)) => commands::render(a),
         Some(cli::Command::Info(a)) => commands::info(a),
         Some(cli::Command::Export(a)) => commands::export(a),

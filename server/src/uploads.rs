@@ -250,11 +250,12 @@ struct Background<'a> {
 
 impl textile_core::Progress for Background<'_> {
     fn step(&self, done: u32, total: u32, _: &str) {
-        // Analysis time grows with the level's area: weigh step `done` by it (the finest step,
-        // the last before "done", is about three quarters of the work).
-        let weight = |d: u32| 4f64.powi(d as i32);
-        let all: f64 = (0..=total).map(weight).sum();
-        let finished: f64 = (0..done.min(total + 1)).map(weight).sum();
+        // Step k is the work between the k-th and the (k+1)-th report: the Gaussian stack, then
+        // one corrected level after another, each about four times the one before (the finest
+        // is about three quarters of the work).
+        let weight = |k: u32| if k == 0 { 1.0 } else { 4f64.powi(k as i32) };
+        let all: f64 = (0..total).map(weight).sum();
+        let finished: f64 = (0..done.min(total)).map(weight).sum();
         let pct = if done >= total { 100 } else { ((finished / all) * 100.0).floor().min(99.0) as u32 };
         self.tex.progress.store(pct, std::sync::atomic::Ordering::Relaxed);
     }
