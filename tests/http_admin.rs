@@ -222,6 +222,21 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     let (_, b) = s.get_bytes("/tiles/brick/7/-1/3.png?seed=5").await;
     assert_eq!(a, b, "settings travel with the upload");
 
+    // toroidal=synthesize: the exemplar is replaced by a seamless one synthesized from it, which
+    // wraps (and so differs from the plain upload's).
+    let (status, _, body) = upload(&s, "?id=seamless&toroidal=synthesize", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let meta = until_ready(&s, "/textures/seamless").await;
+    assert_eq!(meta["exemplar"]["toroidal"], true, "{meta}");
+    assert_eq!(meta["exemplar"]["toroidal_synthesized"], true, "{meta}");
+    let (_, own) = s.get_bytes("/textures/seamless/exemplar.png").await;
+    let (_, plain) = s.get_bytes("/textures/mine/exemplar.png").await;
+    assert_ne!(own, plain);
+    let (status, _) = s.get_bytes("/tiles/seamless/7/1/2.png?seed=3").await;
+    assert_eq!(status, 200);
+    let (status, _) = delete(&s, "seamless", Some(TOKEN)).await;
+    assert_eq!(status, 204);
+
     // Concurrent uploads of one id: one wins, the others are told it exists; nothing is torn.
     let mut tries = tokio::task::JoinSet::new();
     for _ in 0..4 {

@@ -47,6 +47,9 @@ pub struct Preparation {
     pub toroidal_forced: bool,
     /// Seam energy ÷ interior gradient energy (≤ 1.5 means toroidal when detected).
     pub seam_ratio: f64,
+    /// Whether the exemplar was remade toroidal by synthesis ([`crate::tileable::make_toroidal`]).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub toroidal_synthesized: bool,
 }
 
 /// A prepared exemplar: `side × side` RGB8 pixels, `side` a power of two.
@@ -118,6 +121,7 @@ impl Exemplar {
                 side,
                 toroidal_forced: opts.toroidal.is_some(),
                 seam_ratio,
+                toroidal_synthesized: false,
             },
         }
     }
@@ -205,7 +209,7 @@ fn area_resample(src: &[[u8; 3]], s: usize, t: usize) -> Vec<[u8; 3]> {
 }
 
 /// Mean absolute gradient across the wrap-around edges divided by the interior mean.
-fn seam_ratio(px: &[[u8; 3]], m: usize) -> f64 {
+pub(crate) fn seam_ratio(px: &[[u8; 3]], m: usize) -> f64 {
     let diff = |a: [u8; 3], b: [u8; 3]| -> u64 { (0..3).map(|c| a[c].abs_diff(b[c]) as u64).sum() };
     let (mut inner, mut n_inner) = (0u64, 0u64);
     let (mut seam, mut n_seam) = (0u64, 0u64);

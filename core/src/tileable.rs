@@ -270,3 +270,20 @@ pub fn synthesize(ex: &Exemplar, opts: &TileableOptions, progress: &dyn Progress
     let pixels = finest.px.iter().flat_map(|p| p.map(|c| c.round().clamp(0.0, 255.0) as u8)).collect();
     Ok(RgbWindow { width: opts.size, height: opts.size, pixels })
 }
+
+/// A toroidal exemplar made from a non-toroidal one: a seamless texture of the same side
+/// synthesized from it (TSVQ, [`DEFAULT_BACKTRACK`] leaves), so that the main engine can wrap
+/// around it with no border rule. Deterministic for a seed.
+pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
+    let opts = TileableOptions { size: ex.side, seed, search: Search::Tsvq { backtrack: DEFAULT_BACKTRACK } };
+    let img = synthesize(ex, &opts, &crate::analysis::NoProgress)?;
+    let pixels: Vec<[u8; 3]> = img.pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+    let seam_ratio = crate::exemplar::seam_ratio(&pixels, ex.side as usize);
+    let preparation = crate::exemplar::Preparation {
+        toroidal_forced: true,
+        seam_ratio,
+        toroidal_synthesized: true,
+        ..ex.preparation.clone()
+    };
+    Ok(Exemplar { side: ex.side, pixels, toroidal: true, preparation })
+}

@@ -48,6 +48,9 @@ pub enum Toroidal {
     True,
     /// The exemplar does not wrap.
     False,
+    /// The exemplar does not wrap: replace it by a seamless texture of the same size
+    /// synthesized from it (Wei & Levoy 2000, as `textile tileable`), which wraps.
+    Synthesize,
 }
 
 impl Toroidal {
@@ -56,7 +59,7 @@ impl Toroidal {
         match self {
             Toroidal::Auto => None,
             Toroidal::True => Some(true),
-            Toroidal::False => Some(false),
+            Toroidal::False | Toroidal::Synthesize => Some(false),
         }
     }
 }

@@ -314,7 +314,17 @@ pub fn prepare_texture(
     log: &dyn Fn(String),
 ) -> Result<Texture, LoadError> {
     let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
-    let ex = Exemplar::from_bytes(bytes, &opts).map_err(|source| LoadError::Core { id: t.id.clone(), source })?;
+    let core = |source| LoadError::Core { id: t.id.clone(), source };
+    let mut ex = Exemplar::from_bytes(bytes, &opts).map_err(core)?;
+    if t.toroidal == crate::config::Toroidal::Synthesize {
+        let started = std::time::Instant::now();
+        ex = textile_core::tileable::make_toroidal(&ex, 0).map_err(core)?;
+        log(format!(
+            "texture '{}': exemplar made toroidal by synthesis (toroidal = \"synthesize\") in {:.2}s",
+            t.id,
+            started.elapsed().as_secs_f64()
+        ));
+    }
     let prep = &ex.preparation;
     if prep.input_width != prep.input_height || prep.crop_side != ex.side {
         log(format!(

@@ -52,7 +52,7 @@ const ORPHAN_AGE: std::time::Duration = std::time::Duration::from_secs(60);
 pub const MAX_FIELDS: usize = 64;
 
 /// A texture configuration from an upload's fields (query pairs or multipart fields): `id`
-/// (required), `name`, `toroidal` (`auto|true|false`), `default_mode`, `default_seed`,
+/// (required), `name`, `toroidal` (`auto|true|false|synthesize`), `default_mode`, `default_seed`,
 /// `attribution`, and `MODE.KEY` for a per-mode setting (`synth.kappa=0.5`). Checked as a
 /// configured texture is, so an upload is refused for what a configuration file would be.
 pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiError> {
@@ -86,7 +86,10 @@ pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiE
                     "auto" => Toroidal::Auto,
                     "true" => Toroidal::True,
                     "false" => Toroidal::False,
-                    _ => return Err(bad(format!("toroidal '{}' is not one of auto, true, false", clip(v)))),
+                    "synthesize" => Toroidal::Synthesize,
+                    _ => {
+                        return Err(bad(format!("toroidal '{}' is not one of auto, true, false, synthesize", clip(v))))
+                    }
                 }
             }
             other => {

@@ -110,6 +110,7 @@ pub async fn texture_meta(
             "width": ex.side, "height": ex.side, "toroidal": ex.toroidal,
             "input_width": prep.input_width, "input_height": prep.input_height,
             "crop_side": prep.crop_side, "toroidal_forced": prep.toroidal_forced,
+            "toroidal_synthesized": prep.toroidal_synthesized,
         },
         "analysis": analysis,
         "modes": MODE_NAMES,
