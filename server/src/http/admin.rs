@@ -5,7 +5,7 @@
 //! need `Authorization: Bearer TOKEN` (the configured `admin_token`); without a configured token
 //! the routes do not exist (404). The catalogue is changed under one lock and replaced whole.
 //! `POST /textures` and `DELETE /textures/{id}` (the names the API contract gives them) are the
-//! same handlers. Storage and field rules are [`crate::uploads`]'s.
+//! same handlers (documented by copy in [`crate::http::openapi`]). Storage and field rules are [`crate::uploads`]'s.
 
 use std::sync::Arc;
 
@@ -285,44 +285,4 @@ pub async fn delete(
     }
     tracing::info!("texture '{}': deleted", tex.config.id);
     Ok(StatusCode::NO_CONTENT.into_response())
-}
-
-/// `POST /textures`: the same as `POST /admin/textures` (the name the API contract gives it).
-#[utoipa::path(post, path = "/textures", tag = "admin",
-    request_body(description = "as for POST /admin/textures",
-        content(("image/png"), ("image/jpeg"), ("image/webp"), ("multipart/form-data"))),
-    responses((status = 202, description = "accepted; see POST /admin/textures"),
-              (status = 400, description = "a field is invalid, or the image is corrupt or of another format"),
-              (status = 401, description = "no or wrong bearer token"),
-              (status = 404, description = "the admin API is off (no admin token configured)"),
-              (status = 409, description = "the id is in use, or the upload limit is reached"),
-              (status = 413, description = "the body or the image's dimensions are over the limits"),
-              (status = 415, description = "neither an image nor a multipart form"),
-              (status = 503, description = "still loading")),
-    security(("admin_token" = [])))]
-pub async fn upload_alias(
-    st: State<Arc<AppState>>,
-    uri: OriginalUri,
-    query: RawQuery,
-    req: Request,
-) -> Result<Response, ApiError> {
-    upload(st, uri, query, req).await
-}
-
-/// `DELETE /textures/{id}`: the same as `DELETE /admin/textures/{id}`.
-#[utoipa::path(delete, path = "/textures/{id}", tag = "admin",
-    params(("id" = String, Path, description = "texture id")),
-    responses((status = 204, description = "removed"),
-              (status = 401, description = "no or wrong bearer token"),
-              (status = 404, description = "no such texture, or the admin API is off"),
-              (status = 409, description = "a configured texture (remove it from the configuration instead)"),
-              (status = 503, description = "still loading")),
-    security(("admin_token" = [])))]
-pub async fn delete_alias(
-    st: State<Arc<AppState>>,
-    uri: OriginalUri,
-    headers: HeaderMap,
-    path: Result<Path<String>, PathRejection>,
-) -> Result<Response, ApiError> {
-    delete(st, uri, headers, path).await
 }

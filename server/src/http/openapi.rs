@@ -14,7 +14,7 @@ use utoipa::{Modify, OpenApi};
 #[derive(OpenApi)]
 #[openapi(
     info(title = "textile", description = "Infinite, deterministic, example-based texture tiles"),
-    modifiers(&ModeParameters, &ErrorResponses, &AdminToken),
+    modifiers(&AdminAliases, &ModeParameters, &ErrorResponses, &AdminToken),
     paths(
         crate::http::meta::health,
         crate::http::meta::ready,
@@ -27,8 +27,6 @@ use utoipa::{Modify, OpenApi};
         crate::http::samples::samples,
         crate::http::admin::upload,
         crate::http::admin::delete,
-        crate::http::admin::upload_alias,
-        crate::http::admin::delete_alias,
         openapi,
         crate::http::meta::metrics,
         crate::http::static_files::index,
@@ -151,6 +149,27 @@ impl Modify for ErrorResponses {
                     }
                 }
             }
+        }
+    }
+}
+
+/// Documents `POST /textures` and `DELETE /textures/{id}`, the API contract's names of the admin
+/// routes, as copies of `POST /admin/textures` and `DELETE /admin/textures/{id}` (with operation
+/// ids of their own).
+struct AdminAliases;
+
+impl Modify for AdminAliases {
+    fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
+        let paths = &mut doc.paths.paths;
+        let post = paths.get("/admin/textures").and_then(|i| i.post.clone());
+        let delete = paths.get("/admin/textures/{id}").and_then(|i| i.delete.clone());
+        if let Some(mut op) = post {
+            op.operation_id = Some("upload_alias".into());
+            paths.entry("/textures".into()).or_default().post = Some(op);
+        }
+        if let Some(mut op) = delete {
+            op.operation_id = Some("delete_alias".into());
+            paths.entry("/textures/{id}".into()).or_default().delete = Some(op);
         }
     }
 }
