@@ -14,6 +14,7 @@ use crate::cli::{AnalyzeArgs, CliResult, ConfigArgs, ExportArgs, InfoArgs, Rende
 use crate::config::{Config, Overrides, TextureConfig};
 use crate::encode::{encode, Effort, Format};
 use crate::export;
+use crate::files::write_atomic;
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::textures::{exemplar_bytes, load_registry, Texture};
@@ -40,6 +41,15 @@ impl Progress for Bar {
     }
 }
 
+/// `--toroidal auto|true|false` as the exemplar option (`auto`: detected).
+fn toroidal_flag(s: &str) -> Option<bool> {
+    match s {
+        "true" => Some(true),
+        "false" => Some(false),
+        _ => None,
+    }
+}
+
 fn read_exemplar(path: &Path, opts: &ExemplarOptions) -> Result<Exemplar, Box<dyn std::error::Error>> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     Ok(Exemplar::from_bytes(&bytes, opts).map_err(|e| format!("{}: {e}", path.display()))?)
@@ -47,11 +57,7 @@ fn read_exemplar(path: &Path, opts: &ExemplarOptions) -> Result<Exemplar, Box<dy
 
 /// `textile analyze EXEMPLAR -o FILE`.
 pub fn analyze(a: AnalyzeArgs) -> CliResult {
-    let toroidal = match a.toroidal.as_str() {
-        "true" => Some(true),
-        "false" => Some(false),
-        _ => None,
-    };
+    let toroidal = toroidal_flag(&a.toroidal);
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
     let t = std::time::Instant::now();
     let an = Analysis::build(&ex, &Bar(Mutex::new(None), "analysing"));
@@ -80,15 +86,10 @@ pub fn tileable(a: TileableArgs) -> CliResult {
         .and_then(|e| e.to_str())
         .and_then(Format::from_ext)
         .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
-    let toroidal = match a.toroidal.as_str() {
-        "true" => Some(true),
-        "false" => Some(false),
-        _ => None,
-    };
+    let toroidal = toroidal_flag(&a.toroidal);
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
     let search = if a.exact { Search::Exact } else { Search::Tsvq { backtrack: a.backtrack } };
     let opts = TileableOptions { size: a.size, seed: a.seed, search };
-    textile_core::tileable::check(&ex, &opts)?;
     let t = std::time::Instant::now();
     let img = synthesize(&ex, &opts, &Bar(Mutex::new(None), "synthesizing"))?;
     let bytes = encode(&img.pixels, img.width, img.height, format, Effort::Tight)?;
@@ -355,12 +356,4 @@ fn render_camera(tex: &Texture, params: &ModeParams, cam: &str, at: &str, size: 
         s.windows
     );
     Ok(())
-}
-
-fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension(format!("tmp-{}", std::process::id()));
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
 }

@@ -276,7 +276,6 @@ mod tests {
             exemplar_hash: a.exemplar_hash.clone(),
             exemplar_png: Vec::new(),
             defaults: a.defaults.clone(),
-            uploaded: false,
             progress: Default::default(),
             failure: Default::default(),
             removed: Default::default(),

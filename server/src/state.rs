@@ -105,22 +105,35 @@ impl AppState {
     /// Reserve `bytes` of working memory from the budget (at least 1 MiB, at most all of it),
     /// waiting for room at most the queue-wait bound (else 503, counted as shed).
     pub async fn reserve(&self, bytes: u64) -> Result<Reservation, ApiError> {
-        let units = bytes.div_ceil(MIB).clamp(1, self.config.memory_budget_mib) as u32;
+        self.within_queue_wait(&self.memory, self.mib_of(bytes)).await
+    }
+
+    /// [`AppState::reserve`] for background work: waits as long as it takes (`None` only if the
+    /// budget is closed).
+    pub async fn reserve_patiently(&self, bytes: u64) -> Option<Reservation> {
+        self.memory.clone().acquire_many_owned(self.mib_of(bytes)).await.ok()
+    }
+
+    /// Budget permits (MiB) for `bytes`: at least one, at most the whole budget.
+    fn mib_of(&self, bytes: u64) -> u32 {
+        bytes.div_ceil(MIB).clamp(1, self.config.memory_budget_mib) as u32
+    }
+
+    /// `units` permits of `sem`, waited for at most the queue-wait bound (else 503, counted as
+    /// shed).
+    async fn within_queue_wait(
+        &self,
+        sem: &Arc<Semaphore>,
+        units: u32,
+    ) -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
         let wait = Duration::from_millis(self.config.max_queue_wait_ms);
-        match tokio::time::timeout(wait, self.memory.clone().acquire_many_owned(units)).await {
+        match tokio::time::timeout(wait, sem.clone().acquire_many_owned(units)).await {
             Ok(Ok(p)) => Ok(p),
             _ => {
                 self.metrics.shed.inc();
                 Err(ApiError::overloaded())
             }
         }
-    }
-
-    /// [`AppState::reserve`] for background work: waits as long as it takes (`None` only if the
-    /// budget is closed).
-    pub async fn reserve_patiently(&self, bytes: u64) -> Option<Reservation> {
-        let units = bytes.div_ceil(MIB).clamp(1, self.config.memory_budget_mib) as u32;
-        self.memory.clone().acquire_many_owned(units).await.ok()
     }
 
     /// Working memory reserved now, in bytes.
@@ -130,14 +143,7 @@ impl AppState {
 
     /// A place in the big-window lane, waited for at most the queue-wait bound (else 503).
     pub async fn big_window_lane(&self) -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
-        let wait = Duration::from_millis(self.config.max_queue_wait_ms);
-        match tokio::time::timeout(wait, self.big_windows.clone().acquire_owned()).await {
-            Ok(Ok(p)) => Ok(p),
-            _ => {
-                self.metrics.shed.inc();
-                Err(ApiError::overloaded())
-            }
-        }
+        self.within_queue_wait(&self.big_windows, 1).await
     }
 
     /// The catalogue, or 503 while loading.

@@ -42,8 +42,6 @@ pub struct Texture {
     pub exemplar_png: Vec<u8>,
     /// Parameters a request starts from: default mode, and each mode's configured defaults.
     pub defaults: Defaults,
-    /// Added through the admin API (stored in the data directory's uploads), not configured.
-    pub uploaded: bool,
     /// Analysis progress, in percent.
     pub progress: AtomicU32,
     /// Why the analysis failed, if it did.
@@ -96,7 +94,6 @@ impl Texture {
         }
         let exemplar_hash = h.finalize().to_hex()[..16].to_string();
         Ok(Texture {
-            uploaded: config.uploaded,
             config,
             exemplar,
             analysis: OnceLock::new(),
@@ -192,7 +189,7 @@ impl Registry {
 
     /// Uploaded textures in it.
     pub fn uploads(&self) -> usize {
-        self.list.iter().filter(|t| t.uploaded).count()
+        self.list.iter().filter(|t| t.config.uploaded).count()
     }
 
     /// The texture with this id.
@@ -285,11 +282,10 @@ fn remove_stale_temp_files(dir: &std::path::Path, log: &dyn Fn(String)) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        let Some(pid) = name.strip_prefix('.').and_then(|n| n.rsplit_once(".tex.tmp-")).map(|(_, pid)| pid) else {
+        if !(name.starts_with('.') && name.contains(".tex.tmp-")) {
             continue;
-        };
-        let alive = pid.parse::<u32>().is_ok_and(|p| std::path::Path::new(&format!("/proc/{p}")).exists());
-        if !alive && std::fs::remove_file(e.path()).is_ok() {
+        }
+        if crate::files::writer_alive(&name) != Some(true) && std::fs::remove_file(e.path()).is_ok() {
             log(format!("removed {}, left by an interrupted analysis", e.path().display()));
         }
     }
@@ -391,7 +387,7 @@ pub fn analyse_registry(
 
 /// Whether analyses can be stored in the data directory (checked first, with stale temporary
 /// files of interrupted writes removed); if not, a warning is logged.
-pub fn data_dir_storable(cfg: &Config, log: &dyn Fn(String)) -> bool {
+fn data_dir_storable(cfg: &Config, log: &dyn Fn(String)) -> bool {
     let data_dir = cfg.data_dir();
     match writable(&data_dir) {
         Ok(()) => {

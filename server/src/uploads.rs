@@ -14,6 +14,7 @@ use std::sync::Arc;
 
 use crate::config::{Config, TextureConfig, Toroidal};
 use crate::error::ApiError;
+use crate::files::{write_atomic, writer_alive};
 use crate::state::{AppState, Cancel};
 use crate::textures::Texture;
 
@@ -129,23 +130,6 @@ pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> std::io:
     write_atomic(&dir.join(format!("{}.toml", t.id)), text.as_bytes())
 }
 
-/// Write `bytes` to `path` through a temporary file beside it, synced, then renamed.
-fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::io::Write;
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let written = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written
-}
-
 /// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
 /// orphan that start-up removes, never a half texture), then its exemplar, then its analysis
 /// in `data_dir`.
@@ -194,8 +178,8 @@ pub fn stored(dir: &Path, log: &dyn Fn(String)) -> Vec<TextureConfig> {
     for path in others {
         let owned = out.iter().any(|t| Path::new(&t.exemplar) == path);
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let writer = name.rsplit_once(".tmp-").and_then(|(_, pid)| pid.parse::<u32>().ok());
-        if writer.is_some_and(|p| Path::new(&format!("/proc/{p}")).exists()) {
+        let writer = writer_alive(&name);
+        if writer == Some(true) {
             continue; // being written by a live process (another replica sharing the directory)
         }
         // An exemplar renamed into place a moment ago may be an upload whose configuration is
@@ -283,10 +267,11 @@ pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
             move || {
                 let data_dir = st.config.data_dir();
                 let log = |s: String| tracing::info!("{s}");
-                let storable = crate::textures::data_dir_storable(&st.config, &log);
                 let progress = Background { tex: &tex, stopping: &st.stopping };
+                // The upload was just stored beside it, so the data directory is writable (a
+                // failed save is still only a warning).
                 std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    crate::textures::analyse_texture(&data_dir, storable, &tex, &log, &progress)
+                    crate::textures::analyse_texture(&data_dir, true, &tex, &log, &progress)
                 }))
             }
         };

@@ -118,16 +118,19 @@ fn split(texels: &[Texel], members: &mut [u32], g: i64) -> (i64, Vec<Window>) {
     }
 }
 
+/// Where a texel's planning cell comes in a batch: by zoom, then by blocks of 8 × 8 cells of
+/// side [`MAX_GROUP`] (neighbours together, for the cache to share their cones), then by cell.
+fn cell_order(t: &Texel) -> (u32, i64, i64, i64, i64) {
+    let (cy, cx) = (t.y.div_euclid(MAX_GROUP), t.x.div_euclid(MAX_GROUP));
+    (t.zoom_out, cy.div_euclid(8), cx.div_euclid(8), cy, cx)
+}
+
 /// The windows of a batch: per zoom and aligned cell of side [`MAX_GROUP`], the cheapest
 /// split into windows over quadrants down to cells of side [`GROUP`] (dense texels make one
 /// big window, sparse ones small windows around them). Windows are ordered so that neighbours
 /// follow each other (cells of 8 × 8 big cells together), for the cache to share their cones.
 fn plan(texels: &[Texel]) -> Vec<Window> {
-    let cell = |i: &u32| {
-        let t = texels[*i as usize];
-        let (cy, cx) = (t.y.div_euclid(MAX_GROUP), t.x.div_euclid(MAX_GROUP));
-        (t.zoom_out, cy.div_euclid(8), cx.div_euclid(8), cy, cx)
-    };
+    let cell = |i: &u32| cell_order(&texels[*i as usize]);
     let mut all: Vec<u32> = (0..texels.len() as u32).collect();
     all.sort_unstable_by_key(cell);
     let mut out = Vec::new();
@@ -169,11 +172,7 @@ pub fn texels_until(
         return texels_together(params, src, cache, texels, cancelled);
     }
     let mut order: Vec<u32> = (0..texels.len() as u32).collect();
-    order.sort_unstable_by_key(|&i| {
-        let t = texels[i as usize];
-        let (cy, cx) = (t.y.div_euclid(MAX_GROUP), t.x.div_euclid(MAX_GROUP));
-        (t.zoom_out, cy.div_euclid(8), cx.div_euclid(8), cy, cx)
-    });
+    order.sort_unstable_by_key(|&i| cell_order(&texels[i as usize]));
     let mut colors = vec![[0u8; 3]; texels.len()];
     let (mut synthesized, mut windows) = (0, 0);
     for chunk in order.chunks(CHUNK_TEXELS) {

@@ -16,7 +16,7 @@
 pub mod mbtiles_sink;
 pub mod pmtiles_sink;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -233,13 +233,6 @@ impl Plan {
     }
 }
 
-/// `path` with its final name prefixed by a dot and suffixed by the process id: the name an
-/// archive is written under until it is complete.
-pub fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
-}
-
 /// What an export did.
 #[derive(Debug, Clone, Copy)]
 pub struct Report {
@@ -253,7 +246,7 @@ pub struct Report {
 
 /// Run an export to `output` (`.pmtiles` or `.mbtiles`).
 pub fn run(plan: &Plan, output: &Path) -> Result<Report, String> {
-    let tmp = temp_path(output);
+    let tmp = crate::files::temp_path(output);
     let started = std::time::Instant::now();
     let result = write(plan, output, &tmp);
     match result {

@@ -19,7 +19,7 @@ use textile_core::error::clip;
 use textile_core::CoreError;
 
 use crate::error::{ApiError, Kind};
-use crate::http::extract::path_error;
+use crate::http::extract::{media_type, path_error};
 use crate::state::AppState;
 use crate::textures::{prepare_texture, LoadError};
 use crate::uploads;
@@ -54,16 +54,7 @@ async fn read_upload(
 ) -> Result<(Vec<(String, String)>, axum::body::Bytes), ApiError> {
     let mut fields: Vec<(String, String)> =
         form_urlencoded::parse(query.unwrap_or("").as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
-    let media = req
-        .headers()
-        .get(header::CONTENT_TYPE)
-        .and_then(|v| v.to_str().ok())
-        .unwrap_or("")
-        .split(';')
-        .next()
-        .unwrap_or("")
-        .trim()
-        .to_ascii_lowercase();
+    let media = media_type(req.headers());
     let read_error = |e: String| {
         if e.contains("length limit") || e.contains("limit exceeded") || e.contains("too large") {
             too_large(limit)
@@ -266,7 +257,7 @@ pub async fn delete(
     let _writer = st.catalogue_writer.lock().await;
     let reg = st.ready()?;
     let tex = crate::http::extract::texture(&reg, &id)?;
-    if !tex.uploaded {
+    if !tex.config.uploaded {
         return Err(ApiError::new(
             Kind::Conflict,
             "configured_texture",

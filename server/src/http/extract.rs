@@ -24,6 +24,12 @@ pub fn texture(reg: &Registry, id: &str) -> Result<Arc<Texture>, ApiError> {
     })
 }
 
+/// The media type of a request body, without parameters, lower-cased (empty if none).
+pub fn media_type(headers: &HeaderMap) -> String {
+    let ct = headers.get(header::CONTENT_TYPE).and_then(|v| v.to_str().ok()).unwrap_or("");
+    ct.split(';').next().unwrap_or("").trim().to_ascii_lowercase()
+}
+
 /// The address of the client connected to us (a proxy, when there is one); `None` where the
 /// service runs without connection information (in-process tests).
 #[derive(Debug, Clone, Copy)]

@@ -69,7 +69,7 @@ pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap, peer: 
         .map(|t| {
             json!({
                 "id": t.config.id, "name": t.config.name, "modes": MODE_NAMES, "default_mode": t.defaults.mode,
-                "status": t.status().as_str(), "uploaded": t.uploaded,
+                "status": t.status().as_str(), "uploaded": t.config.uploaded,
                 "tilejson": format!("{base}/tiles/{}/tilejson.json", t.config.id),
                 "exemplar": format!("{base}/textures/{}/exemplar.png", t.config.id),
             })
@@ -104,7 +104,7 @@ pub async fn texture_meta(
         "name": t.config.name,
         "status": t.status().as_str(),
         "progress": t.progress.load(std::sync::atomic::Ordering::Relaxed),
-        "uploaded": t.uploaded,
+        "uploaded": t.config.uploaded,
         "attribution": t.config.attribution,
         "exemplar": {
             "width": ex.side, "height": ex.side, "toroidal": ex.toroidal,

@@ -14,16 +14,10 @@ use axum::response::{IntoResponse, Response};
 use axum::Json;
 
 use crate::error::{ApiError, Kind};
-use crate::http::extract::{path_error, texture};
+use crate::http::extract::{media_type, path_error, texture};
 use crate::request::{params, query_reader};
 use crate::sampling::{self, parse_binary, parse_json, Records, MAX_BODY};
 use crate::state::AppState;
-
-/// The media type of a request body, without parameters.
-fn media_type(headers: &HeaderMap) -> String {
-    let ct = headers.get(header::CONTENT_TYPE).and_then(|v| v.to_str().ok()).unwrap_or("");
-    ct.split(';').next().unwrap_or("").trim().to_ascii_lowercase()
-}
 
 /// Colours of scattered samples of the texture, equal to the pixels of the tiles that hold them.
 #[utoipa::path(post, path = "/samples/{id}", tag = "tiles",
