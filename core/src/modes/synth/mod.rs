@@ -46,7 +46,7 @@ const PASSES: ParamSpec = ParamSpec {
     name: "passes",
     kind: Kind::Integer { min: 0, max: MAX_PASSES as u64 },
     scope: Scope::Texture,
-    help: "correction passes per corrected level (0 switches correction off)",
+    help: "correction passes per corrected level, one more at the third-finest (0 switches correction off)",
 };
 const SUBPASSES: ParamSpec = ParamSpec {
     name: "subpasses",
@@ -63,7 +63,7 @@ fn unit_value(v: u32) -> f64 {
 
 impl Mode for Synth {
     const NAME: &'static str = "synth";
-    const VERSION: u32 = 2;
+    const VERSION: u32 = 3;
     const SUMMARY: &'static str = "parallel controllable texture synthesis (Lefebvre & Hoppe 2005)";
     const NEEDS: Needs = Needs::Analysis;
     const COST: Cost = Cost::Heavy;

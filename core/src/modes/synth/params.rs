@@ -1,6 +1,7 @@
 //! Validated synthesis parameters (design note §1.9–1.10). Everything is parsed once into
 //! canonical fixed point, so "0.5" and "0.50" are the same request, and the engine trusts it.
 
+use crate::analysis::FIRST_CORRECTED_LEVEL;
 use crate::error::{CoreError, Result};
 use crate::modes::params::{check_period, parse_unit, ONE_Q16};
 
@@ -19,13 +20,18 @@ pub enum Randomness {
 }
 
 /// The default schedule, coarse to fine: 1.0 at levels 0–1, 0.8 at 2, 0.6 at 3, then a
-/// linear decrease to 0.1 at the finest level `L` (fixed point).
+/// linear decrease to 0.1 at the finest level `L` — except at `L − 2` (when corrected), which
+/// gets 0.14: at its stride `h = 4` that moves about one pixel in nine by one texel, where the
+/// linear schedule (0.35 for `L = 7`) moved most by one or two, more than correction repairs
+/// (the texture's fine structure came out choppier: mean nn_err/nn_ref 1.32 → 1.20 together
+/// with the extra pass of [`super::plan::Schedules`]; bench/README.md). Values in fixed point.
 pub fn default_randomness(levels: u32) -> Vec<u32> {
     (0..=levels)
         .map(|l| {
             let r = match l {
                 0 | 1 => 1.0,
                 2 => 0.8,
+                _ if l + 2 == levels && l >= FIRST_CORRECTED_LEVEL => 0.14,
                 _ => {
                     let span = (levels as f64 - 3.0).max(1.0);
                     0.6 - 0.5 * (l as f64 - 3.0) / span
@@ -72,7 +78,8 @@ pub struct SynthParams {
     pub seed: u64,
     /// Per-level jitter strength.
     pub randomness: Randomness,
-    /// Correction passes per corrected level (0 switches correction off).
+    /// Correction passes per corrected level; level `L − 2` gets one more (see
+    /// [`super::plan::Schedules`]). 0 switches correction off.
     pub passes: u32,
     /// Subpasses per pass: 4 (parity classes, the paper's order) or 1 (all pixels at once).
     pub subpasses: u32,
@@ -168,5 +175,7 @@ mod tests {
         assert_eq!(r.len(), 8);
         assert_eq!(r[0], 65536);
         assert_eq!(r[7], (0.1f64 * 65536.0).round() as u32);
+        assert_eq!(r[5], (0.14f64 * 65536.0).round() as u32);
+        assert_eq!(default_randomness(5)[3], (0.6f64 * 65536.0).round() as u32, "uncorrected L − 2 keeps its jitter");
     }
 }

@@ -20,7 +20,7 @@ use super::kernel::{projection_pairs, Kernel};
 use super::params::SynthParams;
 use super::Synth;
 use crate::modes::Mode;
-use super::plan::{pad_for_correction, plan_window, schedule, Class};
+use super::plan::{pad_for_correction, plan_window, Class, Schedules};
 use crate::cache::{Block, BlockGrid, BlockKey, Pyramid, StreamId, BLOCK};
 
 /// Largest number of pixels synthesized at the finest requested level in one call (2^26).
@@ -109,7 +109,7 @@ pub fn synthesize_with(
 
 /// Pixels a cold call to [`synthesize`] computes at all levels (padding included), from its plan.
 pub fn synthesis_cost(an: &Analysis, params: &SynthParams, level: u32, rect: Rect) -> u64 {
-    plan_window(level.min(an.levels()), rect, &schedule(params.passes, params.subpasses))
+    plan_window(level.min(an.levels()), rect, &Schedules::new(params.passes, params.subpasses, an.levels()))
         .iter()
         .map(|lp| lp.padded.area() as u64)
         .sum()
@@ -119,7 +119,7 @@ struct Ctx<'a> {
     an: &'a Analysis,
     pyr: &'a Pyramid,
     stream: StreamId,
-    sched: Vec<Class>,
+    scheds: Schedules,
     seed: u64,
     r: Vec<u32>,
     phi: [u64; 2],
@@ -134,7 +134,7 @@ impl<'a> Ctx<'a> {
             an,
             pyr,
             stream: StreamId::new(&format!("{}|v{}|{}|{}", Synth::NAME, Synth::VERSION, an.header.id, p.canonical())),
-            sched: schedule(p.passes, p.subpasses),
+            scheds: Schedules::new(p.passes, p.subpasses, an.levels()),
             seed: p.seed,
             r: p.randomness.resolve(an.levels()),
             phi: p.phi(),
@@ -149,8 +149,8 @@ impl<'a> Ctx<'a> {
     /// per pixel, `top` is the highest generation this call needs and `lo` the highest the
     /// cache holds (−1: none), so the pixel is computed at generations `lo+1 ..= top`.
     fn level(&self, l: u32, need: Rect, count: &mut u64) -> Buf {
-        let cl = self.an.correction_level(l).filter(|_| !self.sched.is_empty());
-        let gens: &[Class] = if cl.is_some() { &self.sched } else { &[] };
+        let cl = self.an.correction_level(l).filter(|_| !self.scheds.level(l).is_empty());
+        let gens: &[Class] = if cl.is_some() { self.scheds.level(l) } else { &[] };
         let kk = gens.len();
         let ext = if kk > 0 { pad_for_correction(need, gens).0 } else { need };
         let w = ext.width() as usize;
