@@ -30,6 +30,19 @@ fn analyze_then_info() {
     let (code, info, err) = run(&["info", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert!(info.contains("128x128") && info.contains("analysis id"), "{info}");
+    assert!(info.contains("candidate search:  exact"), "128² is searched exactly by default: {info}");
+    let coherent = dir.path().join("coherent.tex");
+    let (code, stdout, err) =
+        run(&["analyze", &exemplar("grass.png"), "--index", "coherent", "-o", coherent.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("coherent search"), "{stdout}");
+    let (_, info2, _) = run(&["info", coherent.to_str().unwrap()]);
+    assert!(info2.contains("candidate search:  coherent"), "{info2}");
+    let id = |s: &str| s.lines().find(|l| l.starts_with("analysis id")).map(str::to_string);
+    assert_ne!(id(&info), id(&info2), "the search is part of the analysis id");
+    let (code, _, err) = run(&["analyze", &exemplar("grass.png"), "--index", "tsvq", "-o", coherent.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("tsvq") && err.contains("coherent"), "{err}");
 }
 
 #[test]

@@ -224,9 +224,11 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
 
     // toroidal=synthesize: the exemplar is replaced by a seamless one synthesized from it, which
     // wraps (and so differs from the plain upload's).
-    let (status, _, body) = upload(&s, "?id=seamless&toroidal=synthesize", "image/png", brick(), Some(TOKEN)).await;
+    let (status, _, body) =
+        upload(&s, "?id=seamless&toroidal=synthesize&index=coherent", "image/png", brick(), Some(TOKEN)).await;
     assert_eq!(status, 202, "{body}");
     let meta = until_ready(&s, "/textures/seamless").await;
+    assert_eq!(meta["analysis"]["index"], "coherent", "the upload's candidate search: {meta}");
     assert_eq!(meta["exemplar"]["toroidal"], true, "{meta}");
     assert_eq!(meta["exemplar"]["toroidal_synthesized"], true, "{meta}");
     let (_, own) = s.get_bytes("/textures/seamless/exemplar.png").await;

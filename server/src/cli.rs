@@ -87,6 +87,10 @@ pub struct AnalyzeArgs {
     /// Toroidal (wrap-around) exemplar: auto, true or false.
     #[arg(long, default_value = "auto", value_parser = ["auto", "true", "false"])]
     pub toroidal: String,
+    /// Candidate search: exact (k-d tree, every texel), coherent (exact on a grid, propagated;
+    /// several times faster on large exemplars) or auto (coherent from 256² up).
+    #[arg(long, default_value = "auto", value_parser = ["auto", "exact", "coherent"])]
+    pub index: String,
     /// Largest accepted exemplar side.
     #[arg(long, default_value_t = 1024)]
     pub max_side: u32,
@@ -132,6 +136,9 @@ pub struct RenderArgs {
     /// An exemplar image, analysed on the fly.
     #[arg(long, value_name = "IMAGE")]
     pub exemplar: Option<PathBuf>,
+    /// Candidate search of the on-the-fly analysis (with --exemplar): auto, exact or coherent.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "exact", "coherent"], requires = "exemplar")]
+    pub index: String,
     /// Zoom (default: the texture's native zoom).
     #[arg(long)]
     pub z: Option<u32>,

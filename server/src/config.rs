@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use figment::providers::{Env, Format, Serialized, Toml};
 use figment::Figment;
 use serde::{Deserialize, Serialize};
+use textile_core::analysis::IndexChoice;
 use textile_core::error::clip;
 use textile_core::MODE_NAMES;
 
@@ -82,6 +83,9 @@ pub struct TextureConfig {
     /// Toroidal flag.
     #[serde(default = "default_toroidal")]
     pub toroidal: Toroidal,
+    /// Candidate search of the analysis: `auto` (coherent from 256² up), `exact`, `coherent`.
+    #[serde(default)]
+    pub index: IndexChoice,
     /// Mode used when a request names none.
     #[serde(default = "default_mode")]
     pub default_mode: String,
@@ -107,6 +111,7 @@ impl TextureConfig {
             name: id.into(),
             exemplar: exemplar.into(),
             toroidal: Toroidal::Auto,
+            index: IndexChoice::Auto,
             default_mode: default_mode(),
             default_seed: 0,
             attribution: String::new(),

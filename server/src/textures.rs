@@ -416,7 +416,7 @@ pub fn analyse_texture(
     let t = &tex.config;
     let ex = &tex.exemplar;
     let path = data_dir.join(format!("{}.tex", t.id));
-    let expected = Analysis::id_for(ex);
+    let expected = Analysis::id_for(ex, t.index);
     let analysis = match Analysis::load(&path) {
         Ok(a) if a.header.id == expected => {
             log(format!("texture '{}': loaded analysis {} from {}", t.id, a.header.id, path.display()));
@@ -431,7 +431,7 @@ pub fn analyse_texture(
                 Err(e) => log(format!("texture '{}': {e}; recomputing", t.id)),
             }
             let started = std::time::Instant::now();
-            let a = Analysis::try_build(ex, progress)?;
+            let a = Analysis::try_build_with(ex, t.index, progress)?;
             // A texture removed while it was analysed leaves nothing behind.
             let stored = if tex.removed.is_set() {
                 "not stored (the texture was removed)".to_string()

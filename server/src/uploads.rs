@@ -8,6 +8,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use textile_core::analysis::IndexChoice;
 use textile_core::error::clip;
 
 use std::sync::Arc;
@@ -53,7 +54,8 @@ const ORPHAN_AGE: std::time::Duration = std::time::Duration::from_secs(60);
 pub const MAX_FIELDS: usize = 64;
 
 /// A texture configuration from an upload's fields (query pairs or multipart fields): `id`
-/// (required), `name`, `toroidal` (`auto|true|false|synthesize`), `default_mode`, `default_seed`,
+/// (required), `name`, `toroidal` (`auto|true|false|synthesize`), `index`
+/// (`auto|exact|coherent`), `default_mode`, `default_seed`,
 /// `attribution`, and `MODE.KEY` for a per-mode setting (`synth.kappa=0.5`). Checked as a
 /// configured texture is, so an upload is refused for what a configuration file would be.
 pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiError> {
@@ -93,10 +95,11 @@ pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiE
                     }
                 }
             }
+            "index" => t.index = IndexChoice::parse(v).map_err(|e| bad(e.to_string()))?,
             other => {
                 let Some((mode, key)) = other.split_once('.') else {
                     return Err(bad(format!(
-                        "unknown field '{}'; fields are id, name, toroidal, default_mode, default_seed, \
+                        "unknown field '{}'; fields are id, name, toroidal, index, default_mode, default_seed, \
                          attribution and MODE.KEY settings",
                         clip(other)
                     )));

@@ -38,6 +38,47 @@ impl<const D: usize> KdTree<D> {
         (best.1 != u32::MAX).then_some(best)
     }
 
+    /// The `k` items nearest to `q` among those `keep` accepts, nearest first (ties to the
+    /// smallest item).
+    pub fn nearest_k(&self, q: &[f64; D], k: usize, keep: impl Fn(u32) -> bool) -> Vec<(f64, u32)> {
+        let mut best = Vec::with_capacity(k + 1);
+        if !self.nodes.is_empty() && k > 0 {
+            self.search_k(0, q, k, &keep, &mut best);
+        }
+        best
+    }
+
+    fn search_k(&self, node: usize, q: &[f64; D], k: usize, keep: &impl Fn(u32) -> bool, best: &mut Vec<(f64, u32)>) {
+        let bound = |best: &Vec<(f64, u32)>| if best.len() < k { f64::INFINITY } else { best[k - 1].0 };
+        match self.nodes[node] {
+            Node::Leaf { start, end } => {
+                for i in start..end {
+                    let p = &self.points[i];
+                    let mut d = 0.0;
+                    for j in 0..D {
+                        let e = p[j] - q[j];
+                        d += e * e;
+                    }
+                    let item = self.items[i];
+                    let worst = if best.len() < k { (f64::INFINITY, u32::MAX) } else { best[k - 1] };
+                    if (d < worst.0 || (d == worst.0 && item < worst.1)) && keep(item) {
+                        let at = best.partition_point(|b| b.0 < d || (b.0 == d && b.1 < item));
+                        best.insert(at, (d, item));
+                        best.truncate(k);
+                    }
+                }
+            }
+            Node::Split { dim, value, left, right } => {
+                let diff = q[dim] - value;
+                let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
+                self.search_k(near, q, k, keep, best);
+                if diff * diff <= bound(best) {
+                    self.search_k(far, q, k, keep, best);
+                }
+            }
+        }
+    }
+
     fn search(&self, node: usize, q: &[f64; D], keep: &impl Fn(u32) -> bool, best: &mut (f64, u32)) {
         match self.nodes[node] {
             Node::Leaf { start, end } => {

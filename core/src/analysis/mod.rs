@@ -10,7 +10,7 @@ pub mod stack;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::candidates::{candidate_sets, CandidateRules};
+use crate::analysis::candidates::{candidate_sets_on_grid, grid_step, CandidateRules};
 use crate::analysis::features::{
     principal_directions, project_runtime, project_search, quantise_projection, LevelColours, RUNTIME_DIMS, SEARCH_DIMS,
 };
@@ -28,6 +28,63 @@ pub const ALGORITHM_VERSION: u32 = 2;
 /// out (texq `streak` 3.5–6.6 on the development set; 1.5–2.6 without, bench/README.md).
 /// From level 4 on (`h ≤ m/16`) neighbourhoods span at most a quarter of the exemplar.
 pub const FIRST_CORRECTED_LEVEL: u32 = 4;
+
+/// Exemplars at least this wide are analysed with the coherent search by default
+/// ([`IndexChoice::Auto`]); smaller ones exactly.
+pub const COHERENT_FROM_SIDE: u32 = 256;
+
+/// How the candidate sets are searched (design note §1.2d).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SearchIndex {
+    /// Exact nearest neighbours of every texel in a k-d tree.
+    Exact,
+    /// Exact matches on a grid of texels, propagated to the texels between by coherence and
+    /// refined locally ([`candidates::candidate_sets_on_grid`]): several times faster on large
+    /// exemplars, most candidates identical or one texel off.
+    Coherent,
+}
+
+/// The search asked for: one of [`SearchIndex`], or chosen by exemplar size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum IndexChoice {
+    /// [`SearchIndex::Coherent`] from [`COHERENT_FROM_SIDE`] texels wide, else exact.
+    #[default]
+    Auto,
+    /// Always [`SearchIndex::Exact`].
+    Exact,
+    /// Always [`SearchIndex::Coherent`].
+    Coherent,
+}
+
+impl IndexChoice {
+    /// Names accepted by [`IndexChoice::parse`].
+    pub const NAMES: [&'static str; 3] = ["auto", "exact", "coherent"];
+
+    /// Parse `auto`, `exact` or `coherent`.
+    pub fn parse(s: &str) -> Result<IndexChoice> {
+        match s {
+            "auto" => Ok(IndexChoice::Auto),
+            "exact" => Ok(IndexChoice::Exact),
+            "coherent" => Ok(IndexChoice::Coherent),
+            _ => Err(CoreError::Param {
+                name: "index",
+                message: format!("must be auto, exact or coherent, not {:?}", crate::error::clip(s)),
+            }),
+        }
+    }
+
+    /// The search used for an exemplar of side `side`.
+    pub fn resolve(self, side: u32) -> SearchIndex {
+        match self {
+            IndexChoice::Exact => SearchIndex::Exact,
+            IndexChoice::Coherent => SearchIndex::Coherent,
+            IndexChoice::Auto if side >= COHERENT_FROM_SIDE => SearchIndex::Coherent,
+            IndexChoice::Auto => SearchIndex::Exact,
+        }
+    }
+}
 
 /// Receives progress from long computations (analysis), so front ends can show it.
 pub trait Progress: Sync {
@@ -80,6 +137,13 @@ pub struct AnalysisHeader {
     pub toroidal: bool,
     /// How the input image was prepared.
     pub preparation: Preparation,
+    /// How the candidate sets were searched (files from before the choice existed: exact).
+    #[serde(default = "exact_index")]
+    pub index: SearchIndex,
+}
+
+fn exact_index() -> SearchIndex {
+    SearchIndex::Exact
 }
 
 /// A complete exemplar analysis.
@@ -98,8 +162,8 @@ pub struct Analysis {
 }
 
 impl Analysis {
-    /// Analyse a prepared exemplar. Deterministic: the same exemplar always gives the same
-    /// analysis, whatever the thread count.
+    /// Analyse a prepared exemplar with the search [`IndexChoice::Auto`] picks. Deterministic:
+    /// the same exemplar always gives the same analysis, whatever the thread count.
     pub fn build(ex: &Exemplar, progress: &dyn Progress) -> Analysis {
         struct Uncancellable<'a>(&'a dyn Progress);
         impl Progress for Uncancellable<'_> {
@@ -116,6 +180,12 @@ impl Analysis {
     /// [`Analysis::build`], stopped between steps with [`CoreError::Cancelled`] once
     /// `progress` says it is [`Progress::cancelled`].
     pub fn try_build(ex: &Exemplar, progress: &dyn Progress) -> Result<Analysis> {
+        Self::try_build_with(ex, IndexChoice::Auto, progress)
+    }
+
+    /// [`Analysis::try_build`] with the candidate search chosen by `index`.
+    pub fn try_build_with(ex: &Exemplar, index: IndexChoice, progress: &dyn Progress) -> Result<Analysis> {
+        let search = index.resolve(ex.side);
         let m = ex.side as usize;
         let levels = ex.side.trailing_zeros();
         let total = levels - FIRST_CORRECTED_LEVEL + 2;
@@ -128,24 +198,25 @@ impl Analysis {
                 return Err(CoreError::Cancelled);
             }
             progress.step(l - FIRST_CORRECTED_LEVEL + 1, total, "neighbourhoods and candidates");
-            corrected.push(analyse_level(&stack8[l as usize], m, ex.toroidal, 1 << (levels - l)));
+            corrected.push(analyse_level(&stack8[l as usize], m, ex.toroidal, 1 << (levels - l), search));
         }
         progress.step(total, total, "done");
         let header = AnalysisHeader {
-            id: analysis_id(ex),
+            id: analysis_id(ex, search),
             algorithm_version: ALGORITHM_VERSION,
             side: ex.side,
             levels,
             toroidal: ex.toroidal,
             preparation: ex.preparation.clone(),
+            index: search,
         };
         Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8 })
     }
 
-    /// The analysis id an exemplar would get: compare with a stored analysis's
-    /// `header.id` to know whether it is still current.
-    pub fn id_for(ex: &Exemplar) -> String {
-        analysis_id(ex)
+    /// The analysis id an exemplar would get with the search `index` chooses: compare with a
+    /// stored analysis's `header.id` to know whether it is still current.
+    pub fn id_for(ex: &Exemplar, index: IndexChoice) -> String {
+        analysis_id(ex, index.resolve(ex.side))
     }
 
     /// Exemplar side `m`.
@@ -189,11 +260,15 @@ fn derive_stack8(stack: &[Vec<[u16; 3]>]) -> Vec<Vec<[u8; 3]>> {
     stack.iter().map(|lv| lv.iter().map(|p| p.map(to_u8)).collect()).collect()
 }
 
-/// Content hash of what determines an analysis: algorithm version, side, toroidal flag, pixels.
-fn analysis_id(ex: &Exemplar) -> String {
+/// Content hash of what determines an analysis: algorithm version, side, toroidal flag, pixels,
+/// and the search (only when not exact, so exact analyses keep the ids they always had).
+fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
     let mut h = blake3::Hasher::new();
     h.update(b"textile-analysis");
     h.update(&ALGORITHM_VERSION.to_le_bytes());
+    if search == SearchIndex::Coherent {
+        h.update(b"coherent");
+    }
     h.update(&ex.side.to_le_bytes());
     h.update(&[ex.toroidal as u8]);
     for p in &ex.pixels {
@@ -202,7 +277,7 @@ fn analysis_id(ex: &Exemplar) -> String {
     h.finalize().to_hex()[..16].to_string()
 }
 
-fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize) -> CorrectionLevel {
+fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_index: SearchIndex) -> CorrectionLevel {
     use rayon::prelude::*;
     let cols = LevelColours { px, m: m as i64, toroidal, h: h as i64 };
     let dirs5 = principal_directions(&cols, 2, RUNTIME_DIMS);
@@ -218,7 +293,8 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize) -> Correcti
             (r, project_search(&dirs7, buf))
         })
         .unzip();
-    let sets = candidate_sets(&search, &CandidateRules::for_level(m, toroidal, h));
+    let step = if search_index == SearchIndex::Coherent { grid_step(h) } else { 1 };
+    let sets = candidate_sets_on_grid(&search, &CandidateRules::for_level(m, toroidal, h), step);
     let cand = |i: u32| {
         let i = i as usize;
         Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }

@@ -93,6 +93,7 @@ pub async fn texture_meta(
     let analysis = match (t.analysis(), t.file_hash()) {
         (Some(a), Some(hash)) => json!({
             "status": "ready", "id": a.header.id, "file_hash": hash, "algorithm_version": a.header.algorithm_version,
+            "index": a.header.index,
         }),
         _ => match t.failure.get() {
             Some(why) => json!({ "status": "failed", "error": why }),
