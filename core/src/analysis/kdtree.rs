@@ -31,11 +31,7 @@ impl<const D: usize> KdTree<D> {
     /// The item nearest to `q` (squared Euclidean distance) among those `keep` accepts, with its
     /// distance; ties go to the smallest item. `None` if no item is accepted.
     pub fn nearest(&self, q: &[f64; D], keep: impl Fn(u32) -> bool) -> Option<(f64, u32)> {
-        let mut best = (f64::INFINITY, u32::MAX);
-        if !self.nodes.is_empty() {
-            self.search(0, q, &keep, &mut best);
-        }
-        (best.1 != u32::MAX).then_some(best)
+        self.nearest_k(q, 1, keep).first().copied()
     }
 
     /// The `k` items nearest to `q` among those `keep` accepts, nearest first (ties to the
@@ -43,12 +39,12 @@ impl<const D: usize> KdTree<D> {
     pub fn nearest_k(&self, q: &[f64; D], k: usize, keep: impl Fn(u32) -> bool) -> Vec<(f64, u32)> {
         let mut best = Vec::with_capacity(k + 1);
         if !self.nodes.is_empty() && k > 0 {
-            self.search_k(0, q, k, &keep, &mut best);
+            self.search(0, q, k, &keep, &mut best);
         }
         best
     }
 
-    fn search_k(&self, node: usize, q: &[f64; D], k: usize, keep: &impl Fn(u32) -> bool, best: &mut Vec<(f64, u32)>) {
+    fn search(&self, node: usize, q: &[f64; D], k: usize, keep: &impl Fn(u32) -> bool, best: &mut Vec<(f64, u32)>) {
         let bound = |best: &Vec<(f64, u32)>| if best.len() < k { f64::INFINITY } else { best[k - 1].0 };
         match self.nodes[node] {
             Node::Leaf { start, end } => {
@@ -71,36 +67,9 @@ impl<const D: usize> KdTree<D> {
             Node::Split { dim, value, left, right } => {
                 let diff = q[dim] - value;
                 let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
-                self.search_k(near, q, k, keep, best);
+                self.search(near, q, k, keep, best);
                 if diff * diff <= bound(best) {
-                    self.search_k(far, q, k, keep, best);
-                }
-            }
-        }
-    }
-
-    fn search(&self, node: usize, q: &[f64; D], keep: &impl Fn(u32) -> bool, best: &mut (f64, u32)) {
-        match self.nodes[node] {
-            Node::Leaf { start, end } => {
-                for i in start..end {
-                    let p = &self.points[i];
-                    let mut d = 0.0;
-                    for k in 0..D {
-                        let e = p[k] - q[k];
-                        d += e * e;
-                    }
-                    let item = self.items[i];
-                    if (d < best.0 || (d == best.0 && item < best.1)) && keep(item) {
-                        *best = (d, item);
-                    }
-                }
-            }
-            Node::Split { dim, value, left, right } => {
-                let diff = q[dim] - value;
-                let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
-                self.search(near, q, keep, best);
-                if diff * diff <= best.0 {
-                    self.search(far, q, keep, best);
+                    self.search(far, q, k, keep, best);
                 }
             }
         }
@@ -140,7 +109,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn matches_brute_force_with_a_predicate() {
+    fn nearest_and_k_nearest_match_brute_force_with_a_predicate() {
         let pts: Vec<[f64; 3]> =
             (0..500u32).map(|i| [((i * 37) % 101) as f64, ((i * 53) % 97) as f64, ((i * 11) % 7) as f64]).collect();
         let tree = KdTree::new(pts.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect());
@@ -154,6 +123,14 @@ mod tests {
                 .map(|(i, p)| (p.iter().zip(&q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>(), i as u32))
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             assert_eq!(tree.nearest(&q, keep), brute);
+            let mut all: Vec<(f64, u32)> = pts
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| keep(*i as u32))
+                .map(|(i, p)| (p.iter().zip(&q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>(), i as u32))
+                .collect();
+            all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            assert_eq!(tree.nearest_k(&q, 7, keep), all[..7]);
         }
     }
 }
