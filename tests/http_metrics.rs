@@ -38,19 +38,20 @@ async fn metrics_count_requests_cache_and_syntheses() {
     assert!(text.contains("textile_shed_total"));
     assert!(text.contains("textile_cache_evictions_total"));
     // Computation ratio parts. One native synth tile at even coordinates (m = 128) computes the
-    // padded pyramid of design note §1.6 with level 3 uncorrected (core's FIRST_CORRECTED_LEVEL):
-    // 275×277 + 157×161 + 97×101 + 69×73 + 35×37 + 18×19 + 10×10 + 6×6 = 118 059 pixels for
-    // 65 536 delivered (ratio 1.80). One mosaic tile evaluates
+    // padded pyramid of design note §1.6 with level 3 uncorrected (core's FIRST_CORRECTED_LEVEL)
+    // and one pass more at level 5 (L − 2, core's plan::Schedules):
+    // 275×277 + 157×161 + 109×109 + 73×77 + 37×39 + 19×20 + 10×10 + 6×6 = 120 913 pixels for
+    // 65 536 delivered (ratio 1.84). One mosaic tile evaluates
     // its tile grown by the 4-pixel smoothing margin, 264² = 69 696.
-    assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#), 118_059.0);
+    assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#), 120_913.0);
     assert_eq!(value(&text, r#"textile_pixels_delivered_total{mode="synth"}"#), 65_536.0);
     assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="mosaic"}"#), 69_696.0);
     assert_eq!(value(&text, r#"textile_pixels_delivered_total{mode="mosaic"}"#), 65_536.0);
     // The right-hand neighbour reuses the first tile's coarse levels and shared padding from the
-    // pyramidal cache: it synthesizes less than a cold tile (118 059), at least its own pixels.
+    // pyramidal cache: it synthesizes less than a cold tile (120 913), at least its own pixels.
     assert_eq!(s.get("/tiles/gravel/7/5/5.png").await.status(), 200);
     let text = s.get("/metrics").await.text().await.unwrap();
-    let second = value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#) - 118_059.0;
+    let second = value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#) - 120_913.0;
     assert!((65_536.0..110_000.0).contains(&second), "neighbour synthesized {second}");
     assert!(value(&text, "textile_level_cache_hits_total") > 0.0);
     assert!(value(&text, "textile_level_cache_bytes") > 0.0);
