@@ -5,9 +5,15 @@ use std::path::PathBuf;
 
 use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
+use textile_core::analysis::IndexChoice;
 
 /// Any error ending a command, as text for the user.
 pub type CliResult = Result<(), Box<dyn std::error::Error>>;
+
+/// `--index auto|exact|coherent`, read once here.
+fn index_choice(s: &str) -> Result<IndexChoice, String> {
+    IndexChoice::parse(s).map_err(|e| e.to_string())
+}
 
 /// textile — an infinite, deterministic, example-based texture as map tiles.
 #[derive(Debug, Parser)]
@@ -89,8 +95,8 @@ pub struct AnalyzeArgs {
     pub toroidal: String,
     /// Candidate search: exact (k-d tree, every texel), coherent (exact on a grid, propagated;
     /// several times faster on large exemplars) or auto (coherent from 256² up).
-    #[arg(long, default_value = "auto", value_parser = ["auto", "exact", "coherent"])]
-    pub index: String,
+    #[arg(long, default_value = "auto", value_parser = index_choice)]
+    pub index: IndexChoice,
     /// Largest accepted exemplar side.
     #[arg(long, default_value_t = 1024)]
     pub max_side: u32,
@@ -137,8 +143,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "IMAGE")]
     pub exemplar: Option<PathBuf>,
     /// Candidate search of the on-the-fly analysis (with --exemplar): auto, exact or coherent.
-    #[arg(long, default_value = "auto", value_parser = ["auto", "exact", "coherent"], requires = "exemplar")]
-    pub index: String,
+    #[arg(long, default_value = "auto", value_parser = index_choice, requires = "exemplar")]
+    pub index: IndexChoice,
     /// Zoom (default: the texture's native zoom).
     #[arg(long)]
     pub z: Option<u32>,

@@ -6,7 +6,6 @@ use std::path::Path;
 use std::sync::{Arc, Mutex};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use textile_core::analysis::{IndexChoice, SearchIndex};
 use textile_core::modes::params::{Scope, COMMON};
 use textile_core::samples::{self, camera::GroundCamera, Footprint};
 use textile_core::{Analysis, Exemplar, ExemplarOptions, ModeParams, ParamReader, Progress, Pyramid};
@@ -51,14 +50,6 @@ fn toroidal_flag(s: &str) -> Option<bool> {
     }
 }
 
-/// The name of a candidate search, as `--index` and the configuration spell it.
-fn index_name(i: SearchIndex) -> &'static str {
-    match i {
-        SearchIndex::Exact => "exact",
-        SearchIndex::Coherent => "coherent",
-    }
-}
-
 fn read_exemplar(path: &Path, opts: &ExemplarOptions) -> Result<Exemplar, Box<dyn std::error::Error>> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     Ok(Exemplar::from_bytes(&bytes, opts).map_err(|e| format!("{}: {e}", path.display()))?)
@@ -68,9 +59,8 @@ fn read_exemplar(path: &Path, opts: &ExemplarOptions) -> Result<Exemplar, Box<dy
 pub fn analyze(a: AnalyzeArgs) -> CliResult {
     let toroidal = toroidal_flag(&a.toroidal);
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
-    let index = IndexChoice::parse(&a.index)?;
     let t = std::time::Instant::now();
-    let an = Analysis::try_build_with(&ex, index, &Bar(Mutex::new(None), "analysing"))?;
+    let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"))?;
     an.save(&a.output)?;
     println!(
         "analysed {} ({}x{} → {}x{}, toroidal {}, {} search) in {:.2}s → {} (id {})",
@@ -80,7 +70,7 @@ pub fn analyze(a: AnalyzeArgs) -> CliResult {
         ex.side,
         ex.side,
         ex.toroidal,
-        index_name(an.header.index),
+        an.header.index.name(),
         t.elapsed().as_secs_f64(),
         a.output.display(),
         an.header.id
@@ -139,7 +129,7 @@ pub fn info(a: InfoArgs) -> CliResult {
         if h.preparation.toroidal_forced { "forced" } else { "detected" }
     );
     println!("levels:            {} (native zoom {})", h.levels + 1, h.levels);
-    println!("candidate search:  {}", index_name(h.index));
+    println!("candidate search:  {}", h.index.name());
     Ok(())
 }
 
@@ -183,7 +173,7 @@ pub fn render(a: RenderArgs) -> CliResult {
     let output = a.output.clone().ok_or("--output is required")?;
     let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
         let ex = read_exemplar(path, &ExemplarOptions::default())?;
-        let an = Analysis::try_build_with(&ex, IndexChoice::parse(&a.index)?, &textile_core::NoProgress)?;
+        let an = Analysis::try_build_with(&ex, a.index, &textile_core::NoProgress)?;
         Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
     } else {
         configured_texture(&a.config, a.texture.as_deref().unwrap_or_default())?

@@ -61,15 +61,10 @@ impl CandidateRules {
     }
 }
 
-/// Compute `[C_1(u), C_2(u)]` (texel indices `y·m + x`) for every texel `u`, exactly.
-pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules) -> Vec<[u32; 2]> {
-    candidate_sets_on_grid(feats, rules, 1)
-}
-
 /// Offsets of the local refinement around each proposal.
 const AROUND: [(i64, i64); 9] = [(-1, -1), (0, -1), (1, -1), (-1, 0), (0, 0), (1, 0), (-1, 1), (0, 1), (1, 1)];
 
-/// Nearest matches kept per grid texel by [`candidate_sets_on_grid`].
+/// Nearest matches kept per grid texel by [`candidate_sets`].
 pub const GRID_MATCHES: usize = 8;
 
 /// The grid step of the coherent search at a level of stride `h`: exact (1) at the two finest
@@ -83,14 +78,14 @@ pub fn grid_step(h: usize) -> usize {
     }
 }
 
-/// Compute `[C_1(u), C_2(u)]` for every texel, searching exactly only the texels of a grid of
+/// Compute `[C_1(u), C_2(u)]` (texel indices `y·m + x`) for every texel, searching exactly only the texels of a grid of
 /// the given `step` (their `C_1`, and their [`GRID_MATCHES`] nearest matches far enough from it,
 /// the first of which is `C_2`) and taking every other texel's candidates from the four grid
 /// texels around it: each of their matches shifted by the texel's offset from the grid texel
 /// (the coherence of a smooth level) and every texel within one of those, the best by the same
 /// rules (border, separation); an exact search where no proposal qualifies. `step = 1` is the
 /// exact search of every texel.
-pub fn candidate_sets_on_grid(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, step: usize) -> Vec<[u32; 2]> {
+pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, step: usize) -> Vec<[u32; 2]> {
     let m = rules.m;
     let inner: Vec<([f64; SEARCH_DIMS], u32)> =
         (0..feats.len()).filter(|&i| !rules.is_border(i)).map(|i| (feats[i], i as u32)).collect();

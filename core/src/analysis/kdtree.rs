@@ -45,7 +45,8 @@ impl<const D: usize> KdTree<D> {
     }
 
     fn search(&self, node: usize, q: &[f64; D], k: usize, keep: &impl Fn(u32) -> bool, best: &mut Vec<(f64, u32)>) {
-        let bound = |best: &Vec<(f64, u32)>| if best.len() < k { f64::INFINITY } else { best[k - 1].0 };
+        // The k-th best so far: what a new item must beat.
+        let worst = |best: &Vec<(f64, u32)>| if best.len() < k { (f64::INFINITY, u32::MAX) } else { best[k - 1] };
         match self.nodes[node] {
             Node::Leaf { start, end } => {
                 for i in start..end {
@@ -56,8 +57,8 @@ impl<const D: usize> KdTree<D> {
                         d += e * e;
                     }
                     let item = self.items[i];
-                    let worst = if best.len() < k { (f64::INFINITY, u32::MAX) } else { best[k - 1] };
-                    if (d < worst.0 || (d == worst.0 && item < worst.1)) && keep(item) {
+                    let w = worst(best);
+                    if (d < w.0 || (d == w.0 && item < w.1)) && keep(item) {
                         let at = best.partition_point(|b| b.0 < d || (b.0 == d && b.1 < item));
                         best.insert(at, (d, item));
                         best.truncate(k);
@@ -68,7 +69,7 @@ impl<const D: usize> KdTree<D> {
                 let diff = q[dim] - value;
                 let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
                 self.search(near, q, k, keep, best);
-                if diff * diff <= bound(best) {
+                if diff * diff <= worst(best).0 {
                     self.search(far, q, k, keep, best);
                 }
             }

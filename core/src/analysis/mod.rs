@@ -10,7 +10,7 @@ pub mod stack;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::candidates::{candidate_sets_on_grid, grid_step, CandidateRules};
+use crate::analysis::candidates::{candidate_sets, grid_step, CandidateRules};
 use crate::analysis::features::{
     principal_directions, project_runtime, project_search, quantise_projection, LevelColours, RUNTIME_DIMS, SEARCH_DIMS,
 };
@@ -34,15 +34,26 @@ pub const FIRST_CORRECTED_LEVEL: u32 = 4;
 pub const COHERENT_FROM_SIDE: u32 = 256;
 
 /// How the candidate sets are searched (design note §1.2d).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SearchIndex {
     /// Exact nearest neighbours of every texel in a k-d tree.
+    #[default]
     Exact,
     /// Exact matches on a grid of texels, propagated to the texels between by coherence and
-    /// refined locally ([`candidates::candidate_sets_on_grid`]): several times faster on large
+    /// refined locally ([`candidates::candidate_sets`]): several times faster on large
     /// exemplars, most candidates identical or one texel off.
     Coherent,
+}
+
+impl SearchIndex {
+    /// The name `index` settings and reports use.
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchIndex::Exact => "exact",
+            SearchIndex::Coherent => "coherent",
+        }
+    }
 }
 
 /// The search asked for: one of [`SearchIndex`], or chosen by exemplar size.
@@ -59,9 +70,6 @@ pub enum IndexChoice {
 }
 
 impl IndexChoice {
-    /// Names accepted by [`IndexChoice::parse`].
-    pub const NAMES: [&'static str; 3] = ["auto", "exact", "coherent"];
-
     /// Parse `auto`, `exact` or `coherent`.
     pub fn parse(s: &str) -> Result<IndexChoice> {
         match s {
@@ -138,12 +146,8 @@ pub struct AnalysisHeader {
     /// How the input image was prepared.
     pub preparation: Preparation,
     /// How the candidate sets were searched (files from before the choice existed: exact).
-    #[serde(default = "exact_index")]
+    #[serde(default)]
     pub index: SearchIndex,
-}
-
-fn exact_index() -> SearchIndex {
-    SearchIndex::Exact
 }
 
 /// A complete exemplar analysis.
@@ -294,7 +298,7 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_inde
         })
         .unzip();
     let step = if search_index == SearchIndex::Coherent { grid_step(h) } else { 1 };
-    let sets = candidate_sets_on_grid(&search, &CandidateRules::for_level(m, toroidal, h), step);
+    let sets = candidate_sets(&search, &CandidateRules::for_level(m, toroidal, h), step);
     let cand = |i: u32| {
         let i = i as usize;
         Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }

@@ -45,25 +45,21 @@ impl Schedules {
     /// Schedules for `passes` passes of `subpasses` subpasses (one more at `L − 2`) in a
     /// pyramid whose finest level is `levels`.
     pub fn new(passes: u32, subpasses: u32, levels: u32) -> Self {
-        Schedules(
-            (0..=levels)
-                .map(|l| {
-                    if passes == 0 || l < FIRST_CORRECTED_LEVEL {
-                        Vec::new()
-                    } else if l + 2 == levels {
-                        schedule(passes + 1, subpasses)
-                    } else {
-                        schedule(passes, subpasses)
-                    }
-                })
-                .collect(),
-        )
+        Self::with_extra(passes, subpasses, levels, 1)
     }
 
     /// The same schedule at every corrected level (the design note's worked example).
     #[cfg(test)]
     fn uniform(passes: u32, subpasses: u32, levels: u32) -> Self {
-        let at = |l: u32| if passes == 0 || l < FIRST_CORRECTED_LEVEL { Vec::new() } else { schedule(passes, subpasses) };
+        Self::with_extra(passes, subpasses, levels, 0)
+    }
+
+    fn with_extra(passes: u32, subpasses: u32, levels: u32, extra_at_l_minus_2: u32) -> Self {
+        let at = |l: u32| match l {
+            _ if passes == 0 || l < FIRST_CORRECTED_LEVEL => Vec::new(),
+            _ if l + 2 == levels => schedule(passes + extra_at_l_minus_2, subpasses),
+            _ => schedule(passes, subpasses),
+        };
         Schedules((0..=levels).map(at).collect())
     }
 
