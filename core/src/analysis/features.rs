@@ -45,6 +45,61 @@ impl LevelColours<'_> {
     }
 }
 
+/// The taps of a 5×5 neighbourhood that lie inside a non-toroidal exemplar: rows `r0..r1` and
+/// columns `c0..c1` of the 5×5 grid (design note §1.2b: near an edge only real texels are
+/// compared, never the mirror image the stack's addressing would supply).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct InnerTaps {
+    /// First row inside.
+    pub r0: u8,
+    /// One past the last row inside.
+    pub r1: u8,
+    /// First column inside.
+    pub c0: u8,
+    /// One past the last column inside.
+    pub c1: u8,
+}
+
+impl InnerTaps {
+    /// The taps inside an `m × m` exemplar of the 5×5 neighbourhood at stride `h` around
+    /// `(x, y)`, or `None` when all are (the usual case: `2h ≤ x, y < m − 2h`).
+    #[inline]
+    pub fn at(x: i64, y: i64, h: i64, m: i64) -> Option<InnerTaps> {
+        let span = |v: i64| -> (u8, u8) {
+            let lo = if v >= 2 * h {
+                0
+            } else if v >= h {
+                1
+            } else {
+                2
+            };
+            let hi = if v + 2 * h < m {
+                5
+            } else if v + h < m {
+                4
+            } else {
+                3
+            };
+            (lo, hi)
+        };
+        let ((c0, c1), (r0, r1)) = (span(x), span(y));
+        (c0 != 0 || r0 != 0 || c1 != 5 || r1 != 5).then_some(InnerTaps { r0, r1, c0, c1 })
+    }
+
+    /// Number of taps inside.
+    #[inline]
+    pub fn count(&self) -> u32 {
+        (self.r1 - self.r0) as u32 * (self.c1 - self.c0) as u32
+    }
+
+    /// Whether tap `t` (raster order) is inside.
+    #[inline]
+    pub fn contains(&self, t: usize) -> bool {
+        let (r, c) = ((t / 5) as u8, (t % 5) as u8);
+        r >= self.r0 && r < self.r1 && c >= self.c0 && c < self.c1
+    }
+}
+
 /// The top `k` principal directions of the `(2r+1)²·3`-dimensional neighbourhoods of a level,
 /// estimated from a regular grid of at most 64×64 texels (exact integer sums, f64 eigen-solve).
 /// Each vector has its largest-magnitude component positive.

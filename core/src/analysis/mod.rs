@@ -12,7 +12,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::candidates::{candidate_sets, grid_step, CandidateRules};
 use crate::analysis::features::{
-    principal_directions, project_runtime, project_search, quantise_projection, LevelColours, RUNTIME_DIMS, SEARCH_DIMS,
+    principal_directions, project_runtime, project_search, quantise_projection, InnerTaps, LevelColours, RUNTIME_DIMS,
+    SEARCH_DIMS,
 };
 use crate::analysis::stack::{build_stack, to_u8};
 use crate::error::{CoreError, Result};
@@ -20,7 +21,7 @@ use crate::exemplar::{Exemplar, Preparation};
 
 /// Version of the analysis (its content and file layout; part of the analysis id, so a change
 /// recomputes stored analyses). Each mode's output has its own version (`Mode::VERSION`).
-pub const ALGORITHM_VERSION: u32 = 2;
+pub const ALGORITHM_VERSION: u32 = 3;
 /// First pyramid level that is corrected. LH05 leaves levels 0–2 uncorrected; we also leave
 /// level 3, whose 5×5 neighbourhood at stride `h_3 = m/8` spans over half the exemplar: there,
 /// correction grows coherent runs that can only repeat the few positions the exemplar offers
@@ -292,13 +293,21 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_inde
         .map_init(Vec::new, |buf, i| {
             let (x, y) = ((i % m) as i64, (i / m) as i64);
             cols.neighbourhood(x, y, 2, buf);
+            // Near a non-toroidal edge, the feature of the real texels only (outside: zero).
+            if let Some(inner) = InnerTaps::at(x, y, h as i64, m as i64).filter(|_| !toroidal) {
+                for (t, rgb) in buf.chunks_mut(3).enumerate() {
+                    if !inner.contains(t) {
+                        rgb.fill(0);
+                    }
+                }
+            }
             let r = project_runtime(&proj, buf);
             cols.neighbourhood(x, y, 3, buf);
             (r, project_search(&dirs7, buf))
         })
         .unzip();
     let step = if search_index == SearchIndex::Coherent { grid_step(h) } else { 1 };
-    let sets = candidate_sets(&search, &CandidateRules::for_level(m, toroidal, h), step);
+    let sets = candidate_sets(&search, &CandidateRules::new(m, toroidal), step);
     let cand = |i: u32| {
         let i = i as usize;
         Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }

@@ -5,7 +5,79 @@
 //! both give identical results.
 
 use crate::analysis::Candidate;
-use crate::analysis::features::{FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
+use crate::analysis::features::{InnerTaps, FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
+
+/// Distances are scaled by `WEIGHT_ONE / taps compared`, so a candidate near an exemplar edge,
+/// compared over fewer taps, competes on its mean squared tap difference (the least common
+/// multiple of every possible count: 9, 12, 15, 16, 20, 25) ...
+const WEIGHT_ONE: u64 = 3600;
+/// ... times this factor: a match over part of the neighbourhood is weaker evidence than one
+/// over all of it. 2 keeps exemplar-likeness (texq `nn_err`) better than excluding edge texels
+/// did while a band along an edge still reaches the output (1: more edge content, worse
+/// `nn_err`; 3: less; bench/README.md).
+const PARTIAL_FACTOR: u64 = 2;
+/// The distance scale of a candidate compared over all taps.
+const FULL_WEIGHT: u64 = WEIGHT_ONE / TAPS5 as u64;
+
+/// The distance scale of a candidate compared over `inner` only.
+#[inline(always)]
+fn partial_weight(inner: &InnerTaps) -> u64 {
+    const BY_COUNT: [u64; TAPS5 + 1] = {
+        let mut t = [0; TAPS5 + 1];
+        let mut n = 1;
+        while n <= TAPS5 {
+            t[n] = PARTIAL_FACTOR * WEIGHT_ONE / n as u64;
+            n += 1;
+        }
+        t
+    };
+    BY_COUNT[inner.count() as usize]
+}
+
+/// The projection as `vpmaddwd` operands: the weight rows of [`Kernel::pairs`] and the byte
+/// shuffles that turn a colour `0x00BBGGRR`, broadcast to every 32-bit lane, into `(R, G)` and
+/// `(B, 0)` i16 pairs.
+#[cfg(target_arch = "x86_64")]
+struct Avx2Projection {
+    w: [std::arch::x86_64::__m256i; 2 * TAPS5],
+    rg: std::arch::x86_64::__m256i,
+    b0: std::arch::x86_64::__m256i,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Avx2Projection {
+    #[target_feature(enable = "avx2")]
+    fn new(k: &Kernel) -> Self {
+        use std::arch::x86_64::*;
+        Avx2Projection {
+            // SAFETY: `[i16; 16]` and `__m256i` have the same size; unaligned loads are used.
+            w: k.pairs.map(|row| unsafe { _mm256_loadu_si256(row.as_ptr() as *const __m256i) }),
+            rg: _mm256_set1_epi32(0x8001_8000u32 as i32),
+            b0: _mm256_set1_epi32(0x8080_8002u32 as i32),
+        }
+    }
+
+    /// Hand each tap's term of the projection of the neighbourhood around buffer index `idx`
+    /// (eight i32 dimensions, before the shift) to `f` with its row and column, in raster order.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn taps(&self, k: &Kernel, idx: usize, col: &[u32], mut f: impl FnMut(usize, usize, std::arch::x86_64::__m256i)) {
+        use std::arch::x86_64::*;
+        // The 5×5 taps are five runs of five adjacent pixels: one bounds check per run.
+        for (r, wr) in self.w.chunks_exact(10).enumerate() {
+            let at = (idx as isize + k.taps[5 * r]) as usize;
+            let run: &[u32; 5] = col[at..at + 5].try_into().unwrap_or(&[0; 5]);
+            for (i, (&c, wt)) in run.iter().zip(wr.chunks_exact(2)).enumerate() {
+                let c = _mm256_set1_epi32(c as i32);
+                let t = _mm256_add_epi32(
+                    _mm256_madd_epi16(_mm256_shuffle_epi8(c, self.rg), wt[0]),
+                    _mm256_madd_epi16(_mm256_shuffle_epi8(c, self.b0), wt[1]),
+                );
+                f(r, i, t);
+            }
+        }
+    }
+}
 
 /// The correction kernel of one level: everything a pixel's correction reads besides the
 /// snapshot buffers.
@@ -23,6 +95,11 @@ pub(crate) struct Kernel<'a> {
     pub m: usize,
     pub mask: u32,
     pub phi: [u64; 2],
+    /// Stride `h` of the level.
+    pub h: u32,
+    /// Whether the exemplar has edges (not toroidal): candidates within `2h` of one are
+    /// compared over their real texels only.
+    pub edged: bool,
 }
 
 impl Kernel<'_> {
@@ -48,12 +125,8 @@ impl Kernel<'_> {
     #[target_feature(enable = "avx2")]
     fn row_avx2(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
         use std::arch::x86_64::*;
-        // SAFETY: `[i16; 16]` and `__m256i` have the same size; unaligned loads are used.
-        let w: [__m256i; 2 * TAPS5] =
-            self.pairs.map(|row| unsafe { _mm256_loadu_si256(row.as_ptr() as *const __m256i) });
-        // From a colour 0x00BBGGRR broadcast to every 32-bit lane: (R, G) and (B, 0) as i16 pairs.
-        let rg = _mm256_set1_epi32(0x8001_8000u32 as i32);
-        let b0 = _mm256_set1_epi32(0x8080_8002u32 as i32);
+        let simd = Avx2Projection::new(self);
+        let (w, rg, b0) = (&simd.w, simd.rg, simd.b0);
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
             let mut acc = _mm256_setzero_si256();
@@ -67,25 +140,35 @@ impl Kernel<'_> {
                     acc = _mm256_add_epi32(acc, _mm256_madd_epi16(_mm256_shuffle_epi8(c, b0), wt[1]));
                 }
             }
-            *o = self.best_avx2(idx, s, _mm256_srai_epi32(acc, FEAT_SHIFT as i32));
+            *o = self.best_avx2(idx, s, col, &simd, _mm256_srai_epi32(acc, FEAT_SHIFT as i32));
         }
     }
 
     /// [`Kernel::best`] for AVX2: the 18 squared distances as vectors, summed eight at a time
     /// by a horizontal-add tree (wrapping, like the scalar sum), then compared in the same
-    /// order with the same tie rule.
+    /// order with the same tie rule. The few candidates near an exemplar edge are compared
+    /// again by [`Kernel::edge_distances_avx2`], and then every distance is scaled by its share
+    /// of taps, as [`Kernel::best`] does.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn best_avx2(&self, idx: usize, s: &[u32], ns: std::arch::x86_64::__m256i) -> u32 {
+    fn best_avx2(
+        &self,
+        idx: usize,
+        s: &[u32],
+        col: &[u32],
+        simd: &Avx2Projection,
+        ns: std::arch::x86_64::__m256i,
+    ) -> u32 {
         use std::arch::x86_64::*;
         const N: usize = 18;
-        let (mut sq, mut coord) = ([_mm256_setzero_si256(); N + 6], [0u32; N]);
+        let (mut sq, mut coord, mut texel) = ([_mm256_setzero_si256(); N + 6], [0u32; N + 6], [0u32; 9]);
         for (n, &(off, subx, suby)) in self.nb_off.iter().enumerate() {
             let v = s[(idx as isize + off) as usize];
             let vx = ((v & 0xFFFF) + subx) & self.mask;
             let vy = ((v >> 16) + suby) & self.mask;
-            let pair = &self.cands[vy as usize * self.m + vx as usize];
+            texel[n] = vy * self.m as u32 + vx;
+            let pair = &self.cands[texel[n] as usize];
             for (k, cand) in pair.iter().enumerate() {
                 // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
                 let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
@@ -94,18 +177,24 @@ impl Kernel<'_> {
                 coord[k * 9 + n] = cand.coord;
             }
         }
-        let mut d = [0u32; N + 6];
-        for (group, out) in sq.chunks(8).zip(d.chunks_mut(8)) {
-            let h = |a: usize, b: usize| _mm256_hadd_epi32(group[a], group[b]);
-            let (u0, u1) = (_mm256_hadd_epi32(h(0, 1), h(2, 3)), _mm256_hadd_epi32(h(4, 5), h(6, 7)));
-            let sums =
-                _mm256_add_epi32(_mm256_permute2x128_si256(u0, u1, 0x20), _mm256_permute2x128_si256(u0, u1, 0x31));
-            // SAFETY: `out` is 8 u32 = 256 bits; unaligned store.
-            unsafe { _mm256_storeu_si256(out.as_mut_ptr() as *mut __m256i, sums) };
-        }
+        // Bit `i`: candidate `i` lies near an edge ([`Kernel::near_edge`], eight at a time).
+        let edge = if self.edged { self.near_edge_avx2(&coord) } else { 0 };
         let mut best = (u64::MAX, s[idx]);
-        for (i, (&d, &c)) in d.iter().zip(&coord).enumerate() {
-            let dd = d as u64 * self.phi[i / 9];
+        if edge == 0 {
+            // All compared over every tap: the common scale can be left out.
+            for (i, (&d, &c)) in hsum18(&sq).iter().zip(&coord[..N]).enumerate() {
+                let dd = d as u64 * self.phi[i / 9];
+                if dd < best.0 {
+                    best = (dd, c);
+                }
+            }
+            return best.1;
+        }
+        let mut weight = [FULL_WEIGHT; N];
+        self.edge_distances_avx2(idx, col, simd, edge, &texel, &mut sq, &mut weight);
+        let d = hsum18(&sq);
+        for (i, ((&d, &c), &w)) in d.iter().zip(&coord[..N]).zip(&weight).enumerate() {
+            let dd = d as u64 * self.phi[i / 9] * w;
             if dd < best.0 {
                 best = (dd, c);
             }
@@ -113,11 +202,83 @@ impl Kernel<'_> {
         best.1
     }
 
+    /// [`Kernel::near_edge`] of the first 18 of `coord`, as bits.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn near_edge_avx2(&self, coord: &[u32; 24]) -> u32 {
+        use std::arch::x86_64::*;
+        let b = _mm256_set1_epi32((2 * self.h) as i32);
+        // `v − 2h < m − 4h` (unsigned) ⇔ `min(v − 2h, m − 4h − 1) = v − 2h`.
+        let last = _mm256_set1_epi32((self.m as u32 - 4 * self.h - 1) as i32);
+        let low = _mm256_set1_epi32(0xFFFF);
+        let mut bits = 0u32;
+        for (g, c) in coord.chunks_exact(8).enumerate() {
+            // SAFETY: `c` is 8 u32 = 256 bits; unaligned load.
+            let v = unsafe { _mm256_loadu_si256(c.as_ptr() as *const __m256i) };
+            let x = _mm256_sub_epi32(_mm256_and_si256(v, low), b);
+            let y = _mm256_sub_epi32(_mm256_srli_epi32(v, 16), b);
+            let inside = _mm256_and_si256(
+                _mm256_cmpeq_epi32(_mm256_min_epu32(x, last), x),
+                _mm256_cmpeq_epi32(_mm256_min_epu32(y, last), y),
+            );
+            let out = !(_mm256_movemask_ps(_mm256_castsi256_ps(inside)) as u32) & 0xFF;
+            bits |= out << (8 * g);
+        }
+        bits & ((1 << 18) - 1)
+    }
+
+    /// The squared feature differences and distance scales of the candidates flagged in
+    /// `edge` (bit `k·9 + n`: candidate `k` of neighbour `n`, whose texel is `texel[n]`),
+    /// compared over their real texels only: the per-tap terms of the pixel's projection are
+    /// summed over the taps inside the exemplar (2-D prefix sums: any rectangle of taps in
+    /// three operations).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
+    fn edge_distances_avx2(
+        &self,
+        idx: usize,
+        col: &[u32],
+        simd: &Avx2Projection,
+        mut edge: u32,
+        texel: &[u32; 9],
+        sq: &mut [std::arch::x86_64::__m256i; 24],
+        weight: &mut [u64; 18],
+    ) {
+        use std::arch::x86_64::*;
+        let mut pre = [[_mm256_setzero_si256(); 6]; 6];
+        simd.taps(self, idx, col, |r, c, v| pre[r + 1][c + 1] = v);
+        for r in 1..6 {
+            for c in 1..6 {
+                let up = _mm256_sub_epi32(pre[r - 1][c], pre[r - 1][c - 1]);
+                pre[r][c] = _mm256_add_epi32(_mm256_add_epi32(pre[r][c], pre[r][c - 1]), up);
+            }
+        }
+        while edge != 0 {
+            let i = edge.trailing_zeros() as usize;
+            edge &= edge - 1;
+            let cand = &self.cands[texel[i % 9] as usize][i / 9];
+            let Some(t) = self.inner_taps(cand.coord) else { continue };
+            weight[i] = partial_weight(&t);
+            let (r0, r1, c0, c1) = (t.r0 as usize, t.r1 as usize, t.c0 as usize, t.c1 as usize);
+            let q = _mm256_sub_epi32(
+                _mm256_add_epi32(pre[r1][c1], pre[r0][c0]),
+                _mm256_add_epi32(pre[r0][c1], pre[r1][c0]),
+            );
+            // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
+            let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
+            let e = _mm256_sub_epi32(_mm256_srai_epi32(q, FEAT_SHIFT as i32), _mm256_cvtepi16_epi32(f));
+            sq[i] = _mm256_mullo_epi32(e, e);
+        }
+    }
+
     #[inline(always)]
     fn row_portable(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
-            *o = self.best(idx, s, self.project(idx, col));
+            *o = self.best(idx, s, col, self.project(idx, col));
         }
     }
 
@@ -138,10 +299,46 @@ impl Kernel<'_> {
         acc.map(|a| a >> FEAT_SHIFT)
     }
 
-    /// The best of the 18 k-coherence candidates for the pixel at buffer index `idx`, whose
-    /// neighbourhood feature is `ns`.
+    /// The per-tap terms of [`Kernel::project`] (before the shift), for comparisons over part
+    /// of the neighbourhood.
+    fn tap_projections(&self, idx: usize, col: &[u32]) -> [[i32; RUNTIME_DIMS]; TAPS5] {
+        let mut tp = [[0i32; RUNTIME_DIMS]; TAPS5];
+        for ((&off, pr), acc) in self.taps.iter().zip(self.proj.chunks_exact(3 * RUNTIME_DIMS)).zip(tp.iter_mut()) {
+            let c = col[(idx as isize + off) as usize];
+            let (r, g, b) = ((c & 255) as i32, ((c >> 8) & 255) as i32, ((c >> 16) & 255) as i32);
+            for d in 0..RUNTIME_DIMS {
+                acc[d] = pr[d] * r + pr[RUNTIME_DIMS + d] * g + pr[2 * RUNTIME_DIMS + d] * b;
+            }
+        }
+        tp
+    }
+
+    /// Whether a candidate at packed exemplar coordinate `coord` lies within `2h` of an edge of
+    /// a non-toroidal exemplar (branch-free: the common case is a no).
     #[inline(always)]
-    fn best(&self, idx: usize, s: &[u32], ns: [i32; RUNTIME_DIMS]) -> u32 {
+    fn near_edge(&self, coord: u32) -> bool {
+        let (x, y) = (coord & 0xFFFF, coord >> 16);
+        let (b, inner) = (2 * self.h, self.m as u32 - 4 * self.h);
+        self.edged & ((x.wrapping_sub(b) >= inner) | (y.wrapping_sub(b) >= inner))
+    }
+
+    /// Which taps a candidate at packed exemplar coordinate `coord` is compared over: `None`
+    /// for all of them (toroidal exemplars, and texels at least `2h` from every edge).
+    #[inline(always)]
+    fn inner_taps(&self, coord: u32) -> Option<InnerTaps> {
+        if !self.near_edge(coord) {
+            return None;
+        }
+        let (x, y) = (coord & 0xFFFF, coord >> 16);
+        InnerTaps::at(x as i64, y as i64, self.h as i64, self.m as i64)
+    }
+
+    /// The best of the 18 k-coherence candidates for the pixel at buffer index `idx`, whose
+    /// neighbourhood feature is `ns`: the smallest squared feature distance, scaled by `φ` of
+    /// the candidate's rank and by the share of taps compared.
+    #[inline(always)]
+    fn best(&self, idx: usize, s: &[u32], col: &[u32], ns: [i32; RUNTIME_DIMS]) -> u32 {
+        let mut tp = None;
         let mut best = (u64::MAX, s[idx]);
         for (k, &phi_k) in self.phi.iter().enumerate() {
             for &(off, subx, suby) in &self.nb_off {
@@ -149,12 +346,27 @@ impl Kernel<'_> {
                 let vx = ((v & 0xFFFF) + subx) & self.mask;
                 let vy = ((v >> 16) + suby) & self.mask;
                 let cand = &self.cands[vy as usize * self.m + vx as usize][k];
+                let (q, weight) = match self.inner_taps(cand.coord) {
+                    None => (ns, FULL_WEIGHT),
+                    Some(inner) => {
+                        let tp = tp.get_or_insert_with(|| self.tap_projections(idx, col));
+                        let mut q = [0i32; RUNTIME_DIMS];
+                        for row in tp.chunks_exact(5).take(inner.r1 as usize).skip(inner.r0 as usize) {
+                            for t in &row[inner.c0 as usize..inner.c1 as usize] {
+                                for d in 0..RUNTIME_DIMS {
+                                    q[d] += t[d];
+                                }
+                            }
+                        }
+                        (q.map(|a| a >> FEAT_SHIFT), partial_weight(&inner))
+                    }
+                };
                 let mut d = 0u32;
-                for (a, &b) in ns.iter().zip(&cand.feat) {
+                for (a, &b) in q.iter().zip(&cand.feat) {
                     let e = a - b as i32;
                     d = d.wrapping_add((e * e) as u32);
                 }
-                let dd = d as u64 * phi_k;
+                let dd = d as u64 * phi_k * weight;
                 if dd < best.0 {
                     best = (dd, cand.coord);
                 }
@@ -162,6 +374,24 @@ impl Kernel<'_> {
         }
         best.1
     }
+}
+
+/// The 18 sums of eight lanes of `sq` (its last six vectors are padding), by a horizontal-add
+/// tree with wrapping adds, like the scalar sum.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn hsum18(sq: &[std::arch::x86_64::__m256i; 24]) -> [u32; 24] {
+    use std::arch::x86_64::*;
+    let mut d = [0u32; 24];
+    for (group, out) in sq.chunks(8).zip(d.chunks_mut(8)) {
+        let h = |a: usize, b: usize| _mm256_hadd_epi32(group[a], group[b]);
+        let (u0, u1) = (_mm256_hadd_epi32(h(0, 1), h(2, 3)), _mm256_hadd_epi32(h(4, 5), h(6, 7)));
+        let sums = _mm256_add_epi32(_mm256_permute2x128_si256(u0, u1, 0x20), _mm256_permute2x128_si256(u0, u1, 0x31));
+        // SAFETY: `out` is 8 u32 = 256 bits; unaligned store.
+        unsafe { _mm256_storeu_si256(out.as_mut_ptr() as *mut __m256i, sums) };
+    }
+    d
 }
 
 /// The multiply-add layout of a `[tap][channel][dim]` projection (see [`Kernel::pairs`]).

@@ -355,6 +355,8 @@ impl<'a> Ctx<'a> {
             m,
             mask: (m - 1) as u32,
             phi: self.phi,
+            h: h as u32,
+            edged: !self.an.header.toroidal,
         }
     }
 }
