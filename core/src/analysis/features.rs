@@ -65,25 +65,16 @@ impl InnerTaps {
     /// `(x, y)`, or `None` when all are (the usual case: `2h ≤ x, y < m − 2h`).
     #[inline]
     pub fn at(x: i64, y: i64, h: i64, m: i64) -> Option<InnerTaps> {
-        let span = |v: i64| -> (u8, u8) {
-            let lo = if v >= 2 * h {
-                0
-            } else if v >= h {
-                1
-            } else {
-                2
-            };
-            let hi = if v + 2 * h < m {
-                5
-            } else if v + h < m {
-                4
-            } else {
-                3
-            };
-            (lo, hi)
-        };
-        let ((c0, c1), (r0, r1)) = (span(x), span(y));
-        (c0 != 0 || r0 != 0 || c1 != 5 || r1 != 5).then_some(InnerTaps { r0, r1, c0, c1 })
+        let t = Self::around(x as u32, y as u32, h as u32, m as u32);
+        (t != InnerTaps { r0: 0, r1: 5, c0: 0, c1: 5 }).then_some(t)
+    }
+
+    /// [`InnerTaps::at`] without the test for the usual case (branch-free).
+    #[inline(always)]
+    pub fn around(x: u32, y: u32, h: u32, m: u32) -> InnerTaps {
+        let lo = |v: u32| (v < 2 * h) as u8 + (v < h) as u8;
+        let hi = |v: u32| 5 - (v + 2 * h >= m) as u8 - (v + h >= m) as u8;
+        InnerTaps { r0: lo(y), r1: hi(y), c0: lo(x), c1: hi(x) }
     }
 
     /// Number of taps inside.

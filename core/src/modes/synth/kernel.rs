@@ -260,7 +260,7 @@ impl Kernel<'_> {
             let i = edge.trailing_zeros() as usize;
             edge &= edge - 1;
             let cand = &self.cands[texel[i % 9] as usize][i / 9];
-            let Some(t) = self.inner_taps(cand.coord) else { continue };
+            let t = InnerTaps::around(cand.coord & 0xFFFF, cand.coord >> 16, self.h, self.m as u32);
             weight[i] = partial_weight(&t);
             let (r0, r1, c0, c1) = (t.r0 as usize, t.r1 as usize, t.c0 as usize, t.c1 as usize);
             let q = _mm256_sub_epi32(
