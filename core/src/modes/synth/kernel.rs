@@ -1,6 +1,7 @@
 //! The correction kernel (design note §1.3): for one pixel, its 5×5 neighbourhood projected to
-//! the runtime feature space, compared with the 18 k-coherence candidates of its 3×3 neighbours;
-//! written twice — portable, and with AVX2 intrinsics (16-bit multiply-add projection, a
+//! the runtime feature space, compared with the 18 k-coherence candidates of its 3×3 neighbours
+//! — a candidate within `2h` of a non-toroidal exemplar's edge over the taps inside the exemplar
+//! only; written twice — portable, and with AVX2 intrinsics (16-bit multiply-add projection, a
 //! horizontal-add tree for the 18 distances), chosen at run time — in integer arithmetic, so
 //! both give identical results.
 
@@ -32,51 +33,6 @@ fn partial_weight(inner: &InnerTaps) -> u64 {
         t
     };
     BY_COUNT[inner.count() as usize]
-}
-
-/// The projection as `vpmaddwd` operands: the weight rows of [`Kernel::pairs`] and the byte
-/// shuffles that turn a colour `0x00BBGGRR`, broadcast to every 32-bit lane, into `(R, G)` and
-/// `(B, 0)` i16 pairs.
-#[cfg(target_arch = "x86_64")]
-struct Avx2Projection {
-    w: [std::arch::x86_64::__m256i; 2 * TAPS5],
-    rg: std::arch::x86_64::__m256i,
-    b0: std::arch::x86_64::__m256i,
-}
-
-#[cfg(target_arch = "x86_64")]
-impl Avx2Projection {
-    #[target_feature(enable = "avx2")]
-    fn new(k: &Kernel) -> Self {
-        use std::arch::x86_64::*;
-        Avx2Projection {
-            // SAFETY: `[i16; 16]` and `__m256i` have the same size; unaligned loads are used.
-            w: k.pairs.map(|row| unsafe { _mm256_loadu_si256(row.as_ptr() as *const __m256i) }),
-            rg: _mm256_set1_epi32(0x8001_8000u32 as i32),
-            b0: _mm256_set1_epi32(0x8080_8002u32 as i32),
-        }
-    }
-
-    /// Hand each tap's term of the projection of the neighbourhood around buffer index `idx`
-    /// (eight i32 dimensions, before the shift) to `f` with its row and column, in raster order.
-    #[target_feature(enable = "avx2")]
-    #[inline]
-    fn taps(&self, k: &Kernel, idx: usize, col: &[u32], mut f: impl FnMut(usize, usize, std::arch::x86_64::__m256i)) {
-        use std::arch::x86_64::*;
-        // The 5×5 taps are five runs of five adjacent pixels: one bounds check per run.
-        for (r, wr) in self.w.chunks_exact(10).enumerate() {
-            let at = (idx as isize + k.taps[5 * r]) as usize;
-            let run: &[u32; 5] = col[at..at + 5].try_into().unwrap_or(&[0; 5]);
-            for (i, (&c, wt)) in run.iter().zip(wr.chunks_exact(2)).enumerate() {
-                let c = _mm256_set1_epi32(c as i32);
-                let t = _mm256_add_epi32(
-                    _mm256_madd_epi16(_mm256_shuffle_epi8(c, self.rg), wt[0]),
-                    _mm256_madd_epi16(_mm256_shuffle_epi8(c, self.b0), wt[1]),
-                );
-                f(r, i, t);
-            }
-        }
-    }
 }
 
 /// The correction kernel of one level: everything a pixel's correction reads besides the
@@ -125,8 +81,15 @@ impl Kernel<'_> {
     #[target_feature(enable = "avx2")]
     fn row_avx2(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
         use std::arch::x86_64::*;
-        let simd = Avx2Projection::new(self);
-        let (w, rg, b0) = (&simd.w, simd.rg, simd.b0);
+        // SAFETY: `[i16; 16]` and `__m256i` have the same size; unaligned loads are used.
+        let w: [__m256i; 2 * TAPS5] =
+            self.pairs.map(|row| unsafe { _mm256_loadu_si256(row.as_ptr() as *const __m256i) });
+        // From a colour 0x00BBGGRR broadcast to every 32-bit lane: (R, G) and (B, 0) as i16 pairs.
+        let rg = _mm256_set1_epi32(0x8001_8000u32 as i32);
+        let b0 = _mm256_set1_epi32(0x8080_8002u32 as i32);
+        // Each tap's term of the projection at `[row + 1][column + 1]` (row and column 0 stay
+        // zero), for the comparisons near an exemplar edge.
+        let mut terms = [[_mm256_setzero_si256(); 6]; 6];
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
             let mut acc = _mm256_setzero_si256();
@@ -134,13 +97,17 @@ impl Kernel<'_> {
             for (r, wr) in w.chunks_exact(10).enumerate() {
                 let at = (idx as isize + self.taps[5 * r]) as usize;
                 let run: &[u32; 5] = col[at..at + 5].try_into().unwrap_or(&[0; 5]);
-                for (&c, wt) in run.iter().zip(wr.chunks_exact(2)) {
-                    let c = _mm256_set1_epi32(c as i32);
-                    acc = _mm256_add_epi32(acc, _mm256_madd_epi16(_mm256_shuffle_epi8(c, rg), wt[0]));
-                    acc = _mm256_add_epi32(acc, _mm256_madd_epi16(_mm256_shuffle_epi8(c, b0), wt[1]));
+                for (c, (&v, wt)) in run.iter().zip(wr.chunks_exact(2)).enumerate() {
+                    let v = _mm256_set1_epi32(v as i32);
+                    let t = _mm256_add_epi32(
+                        _mm256_madd_epi16(_mm256_shuffle_epi8(v, rg), wt[0]),
+                        _mm256_madd_epi16(_mm256_shuffle_epi8(v, b0), wt[1]),
+                    );
+                    terms[r + 1][c + 1] = t;
+                    acc = _mm256_add_epi32(acc, t);
                 }
             }
-            *o = self.best_avx2(idx, s, col, &simd, _mm256_srai_epi32(acc, FEAT_SHIFT as i32));
+            *o = self.best_avx2(idx, s, &mut terms, _mm256_srai_epi32(acc, FEAT_SHIFT as i32));
         }
     }
 
@@ -156,8 +123,7 @@ impl Kernel<'_> {
         &self,
         idx: usize,
         s: &[u32],
-        col: &[u32],
-        simd: &Avx2Projection,
+        terms: &mut [[std::arch::x86_64::__m256i; 6]; 6],
         ns: std::arch::x86_64::__m256i,
     ) -> u32 {
         use std::arch::x86_64::*;
@@ -191,7 +157,7 @@ impl Kernel<'_> {
             return best.1;
         }
         let mut weight = [FULL_WEIGHT; N];
-        self.edge_distances_avx2(idx, col, simd, edge, &texel, &mut sq, &mut weight);
+        self.edge_distances_avx2(terms, edge, &texel, &mut sq, &mut weight);
         let d = hsum18(&sq);
         for (i, ((&d, &c), &w)) in d.iter().zip(&coord[..N]).zip(&weight).enumerate() {
             let dd = d as u64 * self.phi[i / 9] * w;
@@ -230,26 +196,22 @@ impl Kernel<'_> {
 
     /// The squared feature differences and distance scales of the candidates flagged in
     /// `edge` (bit `k·9 + n`: candidate `k` of neighbour `n`, whose texel is `texel[n]`),
-    /// compared over their real texels only: the per-tap terms of the pixel's projection are
-    /// summed over the taps inside the exemplar (2-D prefix sums: any rectangle of taps in
-    /// three operations).
+    /// compared over their real texels only: the per-tap terms of the pixel's projection
+    /// (`terms`, made 2-D prefix sums here: any rectangle of taps in three operations) summed
+    /// over the taps inside the exemplar.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline(never)]
-    #[allow(clippy::too_many_arguments)]
     fn edge_distances_avx2(
         &self,
-        idx: usize,
-        col: &[u32],
-        simd: &Avx2Projection,
+        terms: &mut [[std::arch::x86_64::__m256i; 6]; 6],
         mut edge: u32,
         texel: &[u32; 9],
         sq: &mut [std::arch::x86_64::__m256i; 24],
         weight: &mut [u64; 18],
     ) {
         use std::arch::x86_64::*;
-        let mut pre = [[_mm256_setzero_si256(); 6]; 6];
-        simd.taps(self, idx, col, |r, c, v| pre[r + 1][c + 1] = v);
+        let pre = terms;
         for r in 1..6 {
             for c in 1..6 {
                 let up = _mm256_sub_epi32(pre[r - 1][c], pre[r - 1][c - 1]);
