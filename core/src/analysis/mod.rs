@@ -294,7 +294,7 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_inde
             let (x, y) = ((i % m) as i64, (i / m) as i64);
             cols.neighbourhood(x, y, 2, buf);
             // Near a non-toroidal edge, the feature of the real texels only (outside: zero).
-            if let Some(inner) = InnerTaps::at(x, y, h as i64, m as i64).filter(|_| !toroidal) {
+            if let Some(inner) = (!toroidal).then(|| InnerTaps::at(x, y, h as i64, m as i64)).flatten() {
                 for (t, rgb) in buf.chunks_mut(3).enumerate() {
                     if !inner.contains(t) {
                         rgb.fill(0);

@@ -240,30 +240,15 @@ impl Kernel<'_> {
     fn row_portable(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
-            *o = self.best(idx, s, col, self.project(idx, col));
+            let terms = self.tap_terms(idx, col);
+            *o = self.best(idx, s, &terms, sum_taps(&terms, 0..5, 0..5));
         }
     }
 
-    /// The runtime feature of the synthesized 5×5 neighbourhood around buffer index `idx`.
+    /// Each tap's term of the projection of the synthesized 5×5 neighbourhood around buffer
+    /// index `idx` (before the shift), raster order.
     #[inline(always)]
-    fn project(&self, idx: usize, col: &[u32]) -> [i32; RUNTIME_DIMS] {
-        let mut acc = [0i32; RUNTIME_DIMS];
-        for (t, &off) in self.taps.iter().enumerate() {
-            let c = col[(idx as isize + off) as usize];
-            let (r, g, b) = ((c & 255) as i32, ((c >> 8) & 255) as i32, ((c >> 16) & 255) as i32);
-            let pr: &[i32; 3 * RUNTIME_DIMS] = self.proj[t * 3 * RUNTIME_DIMS..(t + 1) * 3 * RUNTIME_DIMS]
-                .try_into()
-                .unwrap_or(&[0; 3 * RUNTIME_DIMS]);
-            for d in 0..RUNTIME_DIMS {
-                acc[d] += pr[d] * r + pr[RUNTIME_DIMS + d] * g + pr[2 * RUNTIME_DIMS + d] * b;
-            }
-        }
-        acc.map(|a| a >> FEAT_SHIFT)
-    }
-
-    /// The per-tap terms of [`Kernel::project`] (before the shift), for comparisons over part
-    /// of the neighbourhood.
-    fn tap_projections(&self, idx: usize, col: &[u32]) -> [[i32; RUNTIME_DIMS]; TAPS5] {
+    fn tap_terms(&self, idx: usize, col: &[u32]) -> [[i32; RUNTIME_DIMS]; TAPS5] {
         let mut tp = [[0i32; RUNTIME_DIMS]; TAPS5];
         for ((&off, pr), acc) in self.taps.iter().zip(self.proj.chunks_exact(3 * RUNTIME_DIMS)).zip(tp.iter_mut()) {
             let c = col[(idx as isize + off) as usize];
@@ -288,19 +273,15 @@ impl Kernel<'_> {
     /// for all of them (toroidal exemplars, and texels at least `2h` from every edge).
     #[inline(always)]
     fn inner_taps(&self, coord: u32) -> Option<InnerTaps> {
-        if !self.near_edge(coord) {
-            return None;
-        }
-        let (x, y) = (coord & 0xFFFF, coord >> 16);
-        InnerTaps::at(x as i64, y as i64, self.h as i64, self.m as i64)
+        self.near_edge(coord)
+            .then(|| InnerTaps::around(coord & 0xFFFF, coord >> 16, self.h, self.m as u32))
     }
 
     /// The best of the 18 k-coherence candidates for the pixel at buffer index `idx`, whose
-    /// neighbourhood feature is `ns`: the smallest squared feature distance, scaled by `φ` of
-    /// the candidate's rank and by the share of taps compared.
+    /// neighbourhood's per-tap terms are `terms` and feature `ns`: the smallest squared feature
+    /// distance, scaled by `φ` of the candidate's rank and by the share of taps compared.
     #[inline(always)]
-    fn best(&self, idx: usize, s: &[u32], col: &[u32], ns: [i32; RUNTIME_DIMS]) -> u32 {
-        let mut tp = None;
+    fn best(&self, idx: usize, s: &[u32], terms: &[[i32; RUNTIME_DIMS]; TAPS5], ns: [i32; RUNTIME_DIMS]) -> u32 {
         let mut best = (u64::MAX, s[idx]);
         for (k, &phi_k) in self.phi.iter().enumerate() {
             for &(off, subx, suby) in &self.nb_off {
@@ -310,18 +291,10 @@ impl Kernel<'_> {
                 let cand = &self.cands[vy as usize * self.m + vx as usize][k];
                 let (q, weight) = match self.inner_taps(cand.coord) {
                     None => (ns, FULL_WEIGHT),
-                    Some(inner) => {
-                        let tp = tp.get_or_insert_with(|| self.tap_projections(idx, col));
-                        let mut q = [0i32; RUNTIME_DIMS];
-                        for row in tp.chunks_exact(5).take(inner.r1 as usize).skip(inner.r0 as usize) {
-                            for t in &row[inner.c0 as usize..inner.c1 as usize] {
-                                for d in 0..RUNTIME_DIMS {
-                                    q[d] += t[d];
-                                }
-                            }
-                        }
-                        (q.map(|a| a >> FEAT_SHIFT), partial_weight(&inner))
-                    }
+                    Some(t) => (
+                        sum_taps(terms, t.r0 as usize..t.r1 as usize, t.c0 as usize..t.c1 as usize),
+                        partial_weight(&t),
+                    ),
                 };
                 let mut d = 0u32;
                 for (a, &b) in q.iter().zip(&cand.feat) {
@@ -336,6 +309,24 @@ impl Kernel<'_> {
         }
         best.1
     }
+}
+
+/// The feature of the taps in `rows × cols` of a neighbourhood's per-tap terms (raster order).
+#[inline(always)]
+fn sum_taps(
+    terms: &[[i32; RUNTIME_DIMS]; TAPS5],
+    rows: std::ops::Range<usize>,
+    cols: std::ops::Range<usize>,
+) -> [i32; RUNTIME_DIMS] {
+    let mut q = [0i32; RUNTIME_DIMS];
+    for r in rows {
+        for t in &terms[5 * r + cols.start..5 * r + cols.end] {
+            for d in 0..RUNTIME_DIMS {
+                q[d] += t[d];
+            }
+        }
+    }
+    q.map(|a| a >> FEAT_SHIFT)
 }
 
 /// The 18 sums of eight lanes of `sq` (its last six vectors are padding), by a horizontal-add
