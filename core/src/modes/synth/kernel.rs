@@ -1,9 +1,9 @@
 //! The correction kernel (design note §1.3): for one pixel, its 5×5 neighbourhood projected to
 //! the runtime feature space, compared with the 18 k-coherence candidates of its 3×3 neighbours
 //! — a candidate within `2h` of a non-toroidal exemplar's edge over the taps inside the exemplar
-//! only; written twice — portable, and with AVX2 intrinsics (16-bit multiply-add projection, a
-//! horizontal-add tree for the 18 distances), chosen at run time — in integer arithmetic, so
-//! both give identical results.
+//! only; written twice — portable, and with AVX2 intrinsics (candidates found by vector gathers,
+//! a 16-bit multiply-add projection, a horizontal-add tree for the 18 distances), chosen at run
+//! time — in integer arithmetic, so both give identical results.
 
 use crate::analysis::Candidate;
 use crate::analysis::features::{InnerTaps, FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
@@ -47,6 +47,9 @@ pub(crate) struct Kernel<'a> {
     /// The same projection as i16 pairs for multiply-add (`vpmaddwd`): per tap, one row of
     /// `(red, green)` weights per dimension and one of `(blue, 0)`.
     pub pairs: [[i16; 2 * RUNTIME_DIMS]; 2 * TAPS5],
+    /// The projection of two adjacent taps as i16 pairs: per row of taps, for columns (0, 1)
+    /// and then (2, 3), one row of `(left, right)` weights per dimension for each channel.
+    pub run_pairs: [[i16; 2 * RUNTIME_DIMS]; 30],
     pub cands: &'a [[Candidate; 2]],
     pub m: usize,
     pub mask: u32,
@@ -56,6 +59,16 @@ pub(crate) struct Kernel<'a> {
     /// Whether the exemplar has edges (not toroidal): candidates within `2h` of one are
     /// compared over their real texels only.
     pub edged: bool,
+    /// For a non-toroidal exemplar, per exemplar coordinate `v` along either axis, the first
+    /// and one past the last tap (of five, stride `h`) around `v` inside the exemplar (empty
+    /// for a toroidal one).
+    pub span: Vec<[u8; 2]>,
+}
+
+/// [`Kernel::span`] for an `m × m` exemplar at stride `h`, edged or not.
+pub(crate) fn tap_spans(m: u32, h: u32, edged: bool) -> Vec<[u8; 2]> {
+    let inner = |v: u32| InnerTaps::around(v, 0, h, m);
+    if edged { (0..m).map(|v| [inner(v).c0, inner(v).c1]).collect() } else { Vec::new() }
 }
 
 impl Kernel<'_> {
@@ -75,91 +88,166 @@ impl Kernel<'_> {
     }
 
     /// The AVX2 copy. The projection — most of the work — multiplies the 8-bit channels as
-    /// 16-bit pairs with `vpmaddwd` (two channels per instruction, every product and pair sum
-    /// exact in i32); the candidate comparison is the shared code, compiled for AVX2.
+    /// 16-bit pairs with `vpmaddwd` (every product and pair sum exact in i32): for a pixel
+    /// whose candidates are all away from an exemplar edge, one channel of two adjacent taps
+    /// per instruction, summing whole rows; otherwise two channels of one tap, keeping each
+    /// tap's term for [`Kernel::edge_distances_avx2`]. Both give the same sum.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn row_avx2(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
         use std::arch::x86_64::*;
-        // SAFETY: `[i16; 16]` and `__m256i` have the same size; unaligned loads are used.
+        // SAFETY (both): `[i16; 16]` and `__m256i` have the same size; unaligned loads.
         let w: [__m256i; 2 * TAPS5] =
             self.pairs.map(|row| unsafe { _mm256_loadu_si256(row.as_ptr() as *const __m256i) });
+        let wr: [__m256i; 30] =
+            self.run_pairs.map(|row| unsafe { _mm256_loadu_si256(row.as_ptr() as *const __m256i) });
         // From a colour 0x00BBGGRR broadcast to every 32-bit lane: (R, G) and (B, 0) as i16 pairs.
-        let rg = _mm256_set1_epi32(0x8001_8000u32 as i32);
-        let b0 = _mm256_set1_epi32(0x8080_8002u32 as i32);
+        let (rg, b0) = (_mm256_set1_epi32(0x8001_8000u32 as i32), _mm256_set1_epi32(0x8080_8002u32 as i32));
+        // From two colours broadcast to every 64-bit lane: one channel of both as an i16 pair.
+        let chan = [0x8004_8000u32, 0x8005_8001, 0x8006_8002].map(|m| _mm256_set1_epi32(m as i32));
+        let single = |v: u32, wt: &[__m256i]| {
+            let v = _mm256_set1_epi32(v as i32);
+            _mm256_add_epi32(
+                _mm256_madd_epi16(_mm256_shuffle_epi8(v, rg), wt[0]),
+                _mm256_madd_epi16(_mm256_shuffle_epi8(v, b0), wt[1]),
+            )
+        };
         // Each tap's term of the projection at `[row + 1][column + 1]` (row and column 0 stay
         // zero), for the comparisons near an exemplar edge.
         let mut terms = [[_mm256_setzero_si256(); 6]; 6];
+        let nb = Neighbours::new(self);
+        // The gathers below read `s[idx + offset]` unchecked and `cands` at texels below `m²`.
+        let last = start + out.len().saturating_sub(1) * step;
+        let (lo, hi) = self.nb_off[1..].iter().fold((0, 0), |(a, b), &(o, _, _)| (o.min(a), o.max(b)));
+        if out.is_empty()
+            || (start as isize + lo) < 0
+            || last as isize + hi >= s.len() as isize
+            || self.cands.len() < self.m * self.m
+            || self.m > crate::exemplar::MAX_SIDE as usize
+            || std::mem::size_of::<[Candidate; 2]>() != 40
+        {
+            return self.row_portable(s, col, start, step, out);
+        }
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
+            let (texel, coord, edge) = self.candidates_avx2(idx, s, &nb);
             let mut acc = _mm256_setzero_si256();
             // The 5×5 taps are five runs of five adjacent pixels: one bounds check per run.
-            for (r, wr) in w.chunks_exact(10).enumerate() {
+            for r in 0..5 {
                 let at = (idx as isize + self.taps[5 * r]) as usize;
                 let run: &[u32; 5] = col[at..at + 5].try_into().unwrap_or(&[0; 5]);
-                for (c, (&v, wt)) in run.iter().zip(wr.chunks_exact(2)).enumerate() {
-                    let v = _mm256_set1_epi32(v as i32);
-                    let t = _mm256_add_epi32(
-                        _mm256_madd_epi16(_mm256_shuffle_epi8(v, rg), wt[0]),
-                        _mm256_madd_epi16(_mm256_shuffle_epi8(v, b0), wt[1]),
-                    );
-                    terms[r + 1][c + 1] = t;
-                    acc = _mm256_add_epi32(acc, t);
+                if edge == 0 {
+                    for (p, wp) in wr[6 * r..6 * r + 6].chunks_exact(3).enumerate() {
+                        let v = _mm256_set1_epi64x((run[2 * p] as u64 | (run[2 * p + 1] as u64) << 32) as i64);
+                        let t = _mm256_add_epi32(
+                            _mm256_madd_epi16(_mm256_shuffle_epi8(v, chan[0]), wp[0]),
+                            _mm256_madd_epi16(_mm256_shuffle_epi8(v, chan[1]), wp[1]),
+                        );
+                        acc = _mm256_add_epi32(acc, _mm256_add_epi32(t, _mm256_madd_epi16(_mm256_shuffle_epi8(v, chan[2]), wp[2])));
+                    }
+                    acc = _mm256_add_epi32(acc, single(run[4], &w[10 * r + 8..10 * r + 10]));
+                } else {
+                    for (c, &v) in run.iter().enumerate() {
+                        let t = single(v, &w[10 * r + 2 * c..10 * r + 2 * c + 2]);
+                        terms[r + 1][c + 1] = t;
+                        acc = _mm256_add_epi32(acc, t);
+                    }
                 }
             }
-            *o = self.best_avx2(idx, s, &mut terms, _mm256_srai_epi32(acc, FEAT_SHIFT as i32));
+            let ns = _mm256_srai_epi32(acc, FEAT_SHIFT as i32);
+            *o = self.best_avx2(s[idx], &texel, &coord, edge, &mut terms, ns);
         }
     }
 
-    /// [`Kernel::best`] for AVX2: the 18 squared distances as vectors, summed eight at a time
-    /// by a horizontal-add tree (wrapping, like the scalar sum), then compared in the same
-    /// order with the same tie rule. The few candidates near an exemplar edge are compared
-    /// again by [`Kernel::edge_distances_avx2`], and then every distance is scaled by its share
-    /// of taps, as [`Kernel::best`] does.
+    /// The exemplar texels of the pixel at buffer index `idx`'s 3×3 neighbours shifted to it
+    /// (centre first, then raster order), and the coordinates of their candidates, rank-major:
+    /// candidate `i` is candidate `i / 9` of neighbour `i % 9`. The eight around the centre
+    /// are gathered as vectors; `nb` holds their buffer offsets and exemplar shifts.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn candidates_avx2(&self, idx: usize, s: &[u32], nb: &Neighbours) -> ([u32; 9], [[u32; 9]; 2], u32) {
+        use std::arch::x86_64::*;
+        let (mut texel, mut coord) = ([0u32; 9], [[0u32; 9]; 2]);
+        let v = s[idx];
+        texel[0] = (v >> 16) * self.m as u32 + (v & 0xFFFF);
+        // SAFETY: `row_avx2` checked that every `idx + offset` of its row lies inside `s`.
+        let v = unsafe { _mm256_i32gather_epi32::<4>(s.as_ptr().add(idx) as *const i32, nb.off) };
+        let vx = _mm256_and_si256(_mm256_add_epi32(_mm256_and_si256(v, nb.low), nb.subx), nb.mask);
+        let vy = _mm256_and_si256(_mm256_add_epi32(_mm256_srli_epi32(v, 16), nb.suby), nb.mask);
+        let t = _mm256_or_si256(_mm256_sll_epi32(vy, nb.log2m), vx);
+        // SAFETY (all four): 8 u32 = 256 bits at `texel[1..]`, `coord[k][1..]`; the gathered
+        // texels are below `m²` (both coordinates masked) and `row_avx2` checked that `cands`
+        // holds `m²` pairs of five-u32 candidates.
+        unsafe { _mm256_storeu_si256(texel[1..].as_mut_ptr() as *mut __m256i, t) };
+        // Candidate pairs are 40 bytes apart; `coord` lies at the same offset in each.
+        let base = unsafe { (self.cands.as_ptr() as *const u8).add(std::mem::offset_of!(Candidate, coord)) };
+        // Byte offsets of the pairs: below 40·512² < 2^31 (exemplars have at most 512² texels).
+        let at = _mm256_mullo_epi32(t, _mm256_set1_epi32(40));
+        // Bit `i`: candidate `i` lies near an edge ([`Kernel::near_edge`]), from the registers.
+        let mut edge = 0;
+        for (k, c) in coord.iter_mut().enumerate() {
+            c[0] = self.cands[texel[0] as usize][k].coord;
+            let g = unsafe { _mm256_i32gather_epi32::<1>(base.add(20 * k) as *const i32, at) };
+            unsafe { _mm256_storeu_si256(c[1..].as_mut_ptr() as *mut __m256i, g) };
+            if self.edged {
+                edge |= (self.near_edge(c[0]) as u32 | self.near_edge_avx2(g) << 1) << (9 * k);
+            }
+        }
+        (texel, coord, edge)
+    }
+
+    /// [`Kernel::best`] for AVX2, given the candidates: the 18 squared distances as vectors,
+    /// summed eight at a time by a horizontal-add tree (wrapping, like the scalar sum), then
+    /// compared in the same order with the same tie rule. The candidates flagged in `edge`
+    /// are compared again by [`Kernel::edge_distances_avx2`], and then every distance is
+    /// scaled by its share of taps, as [`Kernel::best`] does.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline]
     fn best_avx2(
         &self,
-        idx: usize,
-        s: &[u32],
+        own: u32,
+        texel: &[u32; 9],
+        coord: &[[u32; 9]; 2],
+        edge: u32,
         terms: &mut [[std::arch::x86_64::__m256i; 6]; 6],
         ns: std::arch::x86_64::__m256i,
     ) -> u32 {
         use std::arch::x86_64::*;
         const N: usize = 18;
-        let (mut sq, mut coord, mut texel) = ([_mm256_setzero_si256(); N + 6], [0u32; N + 6], [0u32; 9]);
-        for (n, &(off, subx, suby)) in self.nb_off.iter().enumerate() {
-            let v = s[(idx as isize + off) as usize];
-            let vx = ((v & 0xFFFF) + subx) & self.mask;
-            let vy = ((v >> 16) + suby) & self.mask;
-            texel[n] = vy * self.m as u32 + vx;
-            let pair = &self.cands[texel[n] as usize];
-            for (k, cand) in pair.iter().enumerate() {
+        let mut sq = [[_mm256_setzero_si256(); 9]; 2];
+        for (n, &t) in texel.iter().enumerate() {
+            for (k, cand) in self.cands[t as usize].iter().enumerate() {
                 // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
                 let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
                 let e = _mm256_sub_epi32(ns, _mm256_cvtepi16_epi32(f));
-                sq[k * 9 + n] = _mm256_mullo_epi32(e, e);
-                coord[k * 9 + n] = cand.coord;
+                sq[k][n] = _mm256_mullo_epi32(e, e);
             }
         }
-        // Bit `i`: candidate `i` lies near an edge ([`Kernel::near_edge`], eight at a time).
-        let edge = if self.edged { self.near_edge_avx2(&coord) } else { 0 };
-        let mut best = (u64::MAX, s[idx]);
+        let coord = coord.as_flattened();
         if edge == 0 {
-            // All compared over every tap: the common scale can be left out.
-            for (i, (&d, &c)) in hsum18(&sq).iter().zip(&coord[..N]).enumerate() {
-                let dd = d as u64 * self.phi[i / 9];
-                if dd < best.0 {
-                    best = (dd, c);
+            // All compared over every tap: the common scale can be left out, and within a rank
+            // the first smallest distance is the first smallest scaled one; the first rank wins
+            // a tie between the two, as in the scan of [`Kernel::best`].
+            let d = hsum18(&sq);
+            let first_min = |r: std::ops::Range<usize>| {
+                let mut b = r.start;
+                for i in r {
+                    if d[i] < d[b] {
+                        b = i;
+                    }
                 }
-            }
-            return best.1;
+                b
+            };
+            let (b0, b1) = (first_min(0..9), first_min(9..N));
+            let win = if d[b1] as u64 * self.phi[1] < d[b0] as u64 * self.phi[0] { b1 } else { b0 };
+            return coord[win];
         }
         let mut weight = [FULL_WEIGHT; N];
-        self.edge_distances_avx2(terms, edge, &texel, &mut sq, &mut weight);
-        let d = hsum18(&sq);
-        for (i, ((&d, &c), &w)) in d.iter().zip(&coord[..N]).zip(&weight).enumerate() {
+        self.edge_distances_avx2(terms, edge, texel, &mut sq, &mut weight);
+        let mut best = (u64::MAX, own);
+        for (i, ((&d, &c), &w)) in hsum18(&sq).iter().zip(coord).zip(&weight).enumerate() {
             let dd = d as u64 * self.phi[i / 9] * w;
             if dd < best.0 {
                 best = (dd, c);
@@ -168,30 +256,22 @@ impl Kernel<'_> {
         best.1
     }
 
-    /// [`Kernel::near_edge`] of the first 18 of `coord`, as bits.
+    /// [`Kernel::near_edge`] of eight packed coordinates, as bits.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn near_edge_avx2(&self, coord: &[u32; 24]) -> u32 {
+    fn near_edge_avx2(&self, v: std::arch::x86_64::__m256i) -> u32 {
         use std::arch::x86_64::*;
         let b = _mm256_set1_epi32((2 * self.h) as i32);
         // `v − 2h < m − 4h` (unsigned) ⇔ `min(v − 2h, m − 4h − 1) = v − 2h`.
         let last = _mm256_set1_epi32((self.m as u32 - 4 * self.h - 1) as i32);
-        let low = _mm256_set1_epi32(0xFFFF);
-        let mut bits = 0u32;
-        for (g, c) in coord.chunks_exact(8).enumerate() {
-            // SAFETY: `c` is 8 u32 = 256 bits; unaligned load.
-            let v = unsafe { _mm256_loadu_si256(c.as_ptr() as *const __m256i) };
-            let x = _mm256_sub_epi32(_mm256_and_si256(v, low), b);
-            let y = _mm256_sub_epi32(_mm256_srli_epi32(v, 16), b);
-            let inside = _mm256_and_si256(
-                _mm256_cmpeq_epi32(_mm256_min_epu32(x, last), x),
-                _mm256_cmpeq_epi32(_mm256_min_epu32(y, last), y),
-            );
-            let out = !(_mm256_movemask_ps(_mm256_castsi256_ps(inside)) as u32) & 0xFF;
-            bits |= out << (8 * g);
-        }
-        bits & ((1 << 18) - 1)
+        let x = _mm256_sub_epi32(_mm256_and_si256(v, _mm256_set1_epi32(0xFFFF)), b);
+        let y = _mm256_sub_epi32(_mm256_srli_epi32(v, 16), b);
+        let inside = _mm256_and_si256(
+            _mm256_cmpeq_epi32(_mm256_min_epu32(x, last), x),
+            _mm256_cmpeq_epi32(_mm256_min_epu32(y, last), y),
+        );
+        !(_mm256_movemask_ps(_mm256_castsi256_ps(inside)) as u32) & 0xFF
     }
 
     /// The squared feature differences and distance scales of the candidates flagged in
@@ -207,7 +287,7 @@ impl Kernel<'_> {
         terms: &mut [[std::arch::x86_64::__m256i; 6]; 6],
         mut edge: u32,
         texel: &[u32; 9],
-        sq: &mut [std::arch::x86_64::__m256i; 24],
+        sq: &mut [[std::arch::x86_64::__m256i; 9]; 2],
         weight: &mut [u64; 18],
     ) {
         use std::arch::x86_64::*;
@@ -222,7 +302,7 @@ impl Kernel<'_> {
             let i = edge.trailing_zeros() as usize;
             edge &= edge - 1;
             let cand = &self.cands[texel[i % 9] as usize][i / 9];
-            let t = InnerTaps::around(cand.coord & 0xFFFF, cand.coord >> 16, self.h, self.m as u32);
+            let t = self.inner_of(cand.coord);
             weight[i] = partial_weight(&t);
             let (r0, r1, c0, c1) = (t.r0 as usize, t.r1 as usize, t.c0 as usize, t.c1 as usize);
             let q = _mm256_sub_epi32(
@@ -232,7 +312,7 @@ impl Kernel<'_> {
             // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
             let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
             let e = _mm256_sub_epi32(_mm256_srai_epi32(q, FEAT_SHIFT as i32), _mm256_cvtepi16_epi32(f));
-            sq[i] = _mm256_mullo_epi32(e, e);
+            sq[i / 9][i % 9] = _mm256_mullo_epi32(e, e);
         }
     }
 
@@ -273,8 +353,15 @@ impl Kernel<'_> {
     /// for all of them (toroidal exemplars, and texels at least `2h` from every edge).
     #[inline(always)]
     fn inner_taps(&self, coord: u32) -> Option<InnerTaps> {
-        self.near_edge(coord)
-            .then(|| InnerTaps::around(coord & 0xFFFF, coord >> 16, self.h, self.m as u32))
+        self.near_edge(coord).then(|| self.inner_of(coord))
+    }
+
+    /// The taps inside the exemplar around the candidate at packed coordinate `coord` of a
+    /// non-toroidal exemplar ([`InnerTaps::around`], looked up per axis).
+    #[inline(always)]
+    fn inner_of(&self, coord: u32) -> InnerTaps {
+        let ([r0, r1], [c0, c1]) = (self.span[(coord >> 16) as usize], self.span[(coord & 0xFFFF) as usize]);
+        InnerTaps { r0, r1, c0, c1 }
     }
 
     /// The best of the 18 k-coherence candidates for the pixel at buffer index `idx`, whose
@@ -311,6 +398,39 @@ impl Kernel<'_> {
     }
 }
 
+/// The eight neighbours around the centre of [`Kernel::nb_off`] as vectors, for
+/// [`Kernel::candidates_avx2`].
+#[cfg(target_arch = "x86_64")]
+struct Neighbours {
+    off: std::arch::x86_64::__m256i,
+    subx: std::arch::x86_64::__m256i,
+    suby: std::arch::x86_64::__m256i,
+    mask: std::arch::x86_64::__m256i,
+    low: std::arch::x86_64::__m256i,
+    log2m: std::arch::x86_64::__m128i,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Neighbours {
+    #[target_feature(enable = "avx2")]
+    fn new(k: &Kernel) -> Self {
+        use std::arch::x86_64::*;
+        let lane = |f: &dyn Fn(&(isize, u32, u32)) -> i32| {
+            let v: [i32; 8] = std::array::from_fn(|n| f(&k.nb_off[n + 1]));
+            // SAFETY: 8 i32 = 256 bits; unaligned load.
+            unsafe { _mm256_loadu_si256(v.as_ptr() as *const __m256i) }
+        };
+        Neighbours {
+            off: lane(&|n| n.0 as i32),
+            subx: lane(&|n| n.1 as i32),
+            suby: lane(&|n| n.2 as i32),
+            mask: _mm256_set1_epi32(k.mask as i32),
+            low: _mm256_set1_epi32(0xFFFF),
+            log2m: _mm_cvtsi32_si128(k.m.trailing_zeros() as i32),
+        }
+    }
+}
+
 /// The feature of the taps in `rows × cols` of a neighbourhood's per-tap terms (raster order).
 #[inline(always)]
 fn sum_taps(
@@ -329,21 +449,27 @@ fn sum_taps(
     q.map(|a| a >> FEAT_SHIFT)
 }
 
-/// The 18 sums of eight lanes of `sq` (its last six vectors are padding), by a horizontal-add
-/// tree with wrapping adds, like the scalar sum.
+/// The 18 sums of eight lanes of `sq`, by a horizontal-add tree with wrapping adds, like the
+/// scalar sum.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn hsum18(sq: &[std::arch::x86_64::__m256i; 24]) -> [u32; 24] {
+fn hsum18(sq: &[[std::arch::x86_64::__m256i; 9]; 2]) -> [u32; 18] {
     use std::arch::x86_64::*;
-    let mut d = [0u32; 24];
-    for (group, out) in sq.chunks(8).zip(d.chunks_mut(8)) {
-        let h = |a: usize, b: usize| _mm256_hadd_epi32(group[a], group[b]);
-        let (u0, u1) = (_mm256_hadd_epi32(h(0, 1), h(2, 3)), _mm256_hadd_epi32(h(4, 5), h(6, 7)));
+    let sq = sq.as_flattened();
+    let mut d = [0u32; 18];
+    let h = |a: __m256i, b: __m256i| _mm256_hadd_epi32(a, b);
+    for (group, out) in sq.chunks_exact(8).zip(d.chunks_exact_mut(8)) {
+        let (u0, u1) = (h(h(group[0], group[1]), h(group[2], group[3])), h(h(group[4], group[5]), h(group[6], group[7])));
         let sums = _mm256_add_epi32(_mm256_permute2x128_si256(u0, u1, 0x20), _mm256_permute2x128_si256(u0, u1, 0x31));
         // SAFETY: `out` is 8 u32 = 256 bits; unaligned store.
         unsafe { _mm256_storeu_si256(out.as_mut_ptr() as *mut __m256i, sums) };
     }
+    // The last two: lanes `(a0+a1, a2+a3, b0+b1, b2+b3)` per half, twice more.
+    let u = h(h(sq[16], sq[17]), _mm256_setzero_si256());
+    let two = _mm_add_epi32(_mm256_castsi256_si128(u), _mm256_extracti128_si256(u, 1));
+    d[16] = _mm_cvtsi128_si32(two) as u32;
+    d[17] = _mm_extract_epi32(two, 1) as u32;
     d
 }
 
@@ -356,6 +482,23 @@ pub(crate) fn projection_pairs(proj: &[i16]) -> [[i16; 2 * RUNTIME_DIMS]; 2 * TA
             two[0][2 * d] = at(t, 0, d);
             two[0][2 * d + 1] = at(t, 1, d);
             two[1][2 * d] = at(t, 2, d);
+        }
+    }
+    pairs
+}
+
+/// The two-tap multiply-add layout of a `[tap][channel][dim]` projection (see
+/// [`Kernel::run_pairs`]).
+pub(crate) fn projection_run_pairs(proj: &[i16]) -> [[i16; 2 * RUNTIME_DIMS]; 30] {
+    let mut pairs = [[0i16; 2 * RUNTIME_DIMS]; 30];
+    let at = |t: usize, c: usize, d: usize| proj.get((t * 3 + c) * RUNTIME_DIMS + d).copied().unwrap_or(0);
+    for (i, row) in pairs.iter_mut().enumerate() {
+        // Row of taps `r`, first column `2p`, channel `c`.
+        let (r, p, c) = (i / 6, i % 6 / 3, i % 3);
+        let left = 5 * r + 2 * p;
+        for d in 0..RUNTIME_DIMS {
+            row[2 * d] = at(left, c, d);
+            row[2 * d + 1] = at(left + 1, c, d);
         }
     }
     pairs

@@ -16,7 +16,7 @@ use super::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash, TAG_JITTER};
 use super::history::{block_index, capture, for_rows, overlay, pending};
-use super::kernel::{projection_pairs, Kernel};
+use super::kernel::{projection_pairs, projection_run_pairs, tap_spans, Kernel};
 use super::params::SynthParams;
 use super::Synth;
 use crate::modes::Mode;
@@ -351,12 +351,14 @@ impl<'a> Ctx<'a> {
             nb_off: nb_off.try_into().unwrap_or([(0, 0, 0); 9]),
             proj,
             pairs: projection_pairs(&cl.proj),
+            run_pairs: projection_run_pairs(&cl.proj),
             cands: &cl.cands,
             m,
             mask: (m - 1) as u32,
             phi: self.phi,
             h: h as u32,
             edged: !self.an.header.toroidal,
+            span: tap_spans(m as u32, h as u32, !self.an.header.toroidal),
         }
     }
 }
