@@ -39,39 +39,60 @@ impl<const D: usize> KdTree<D> {
     pub fn nearest_k(&self, q: &[f64; D], k: usize, keep: impl Fn(u32) -> bool) -> Vec<(f64, u32)> {
         let mut best = Vec::with_capacity(k + 1);
         if !self.nodes.is_empty() && k > 0 {
-            self.search(0, q, k, &keep, &mut best);
+            let mut gap = [0.0; D];
+            self.search(0, q, k, &keep, &mut best, &mut gap);
         }
         best
     }
 
-    fn search(&self, node: usize, q: &[f64; D], k: usize, keep: &impl Fn(u32) -> bool, best: &mut Vec<(f64, u32)>) {
+    /// Search the subtree `node`; `gap` holds `q`'s distance to the subtree's cell along each
+    /// dimension (0 where `q` lies within its extent).
+    fn search(
+        &self,
+        node: usize,
+        q: &[f64; D],
+        k: usize,
+        keep: &impl Fn(u32) -> bool,
+        best: &mut Vec<(f64, u32)>,
+        gap: &mut [f64; D],
+    ) {
         // The k-th best so far: what a new item must beat.
         let worst = |best: &Vec<(f64, u32)>| if best.len() < k { (f64::INFINITY, u32::MAX) } else { best[k - 1] };
         match self.nodes[node] {
             Node::Leaf { start, end } => {
-                for i in start..end {
-                    let p = &self.points[i];
+                let mut w = worst(best);
+                for (p, &item) in self.points[start..end].iter().zip(&self.items[start..end]) {
                     let mut d = 0.0;
                     for j in 0..D {
                         let e = p[j] - q[j];
                         d += e * e;
                     }
-                    let item = self.items[i];
-                    let w = worst(best);
                     if (d < w.0 || (d == w.0 && item < w.1)) && keep(item) {
                         let at = best.partition_point(|b| b.0 < d || (b.0 == d && b.1 < item));
                         best.insert(at, (d, item));
                         best.truncate(k);
+                        w = worst(best);
                     }
                 }
             }
             Node::Split { dim, value, left, right } => {
                 let diff = q[dim] - value;
                 let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
-                self.search(near, q, k, keep, best);
-                if diff * diff <= worst(best).0 {
-                    self.search(far, q, k, keep, best);
+                self.search(near, q, k, keep, best, gap);
+                // Every point of the far cell is at least `gap` (with `diff` on this dimension)
+                // from `q` along each dimension, and its distance is summed in the same order
+                // from terms at least as large: in floating point too, it is at least `reach`.
+                // Beyond the k-th best, no point there could be accepted.
+                let old = gap[dim];
+                gap[dim] = diff;
+                let mut reach = 0.0;
+                for g in gap.iter() {
+                    reach += g * g;
                 }
+                if reach <= worst(best).0 {
+                    self.search(far, q, k, keep, best, gap);
+                }
+                gap[dim] = old;
             }
         }
     }
@@ -132,6 +153,45 @@ mod tests {
                 .collect();
             all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             assert_eq!(tree.nearest_k(&q, 7, keep), all[..7]);
+        }
+    }
+
+    #[test]
+    fn cell_pruning_keeps_the_exact_result_in_eight_dimensions() {
+        // Clustered points with repeated coordinates (many equal distances) and fractional
+        // ones (rounding), as blurred coarse levels give.
+        let mut z = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            z = z.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (z >> 33) as f64 / (1u64 << 31) as f64
+        };
+        let pts: Vec<[f64; 8]> = (0..3000)
+            .map(|i| {
+                std::array::from_fn(|j| {
+                    if (i + j) % 3 == 0 {
+                        (i % 5) as f64
+                    } else {
+                        (i % 7) as f64 * 0.1 + next() * 1e-3
+                    }
+                })
+            })
+            .collect();
+        let tree = KdTree::new(pts.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect());
+        let dist = |a: &[f64; 8], b: &[f64; 8]| {
+            let mut d = 0.0;
+            for j in 0..8 {
+                let e = a[j] - b[j];
+                d += e * e;
+            }
+            d
+        };
+        for qi in (0..3000).step_by(97) {
+            let q = pts[qi];
+            let keep = |i: u32| (i as usize).abs_diff(qi) > 40;
+            let mut all: Vec<(f64, u32)> =
+                pts.iter().enumerate().filter(|(i, _)| keep(*i as u32)).map(|(i, p)| (dist(p, &q), i as u32)).collect();
+            all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            assert_eq!(tree.nearest_k(&q, 8, keep), all[..8], "query {qi}");
         }
     }
 }
