@@ -59,17 +59,18 @@ pub(crate) struct Kernel<'a> {
     /// Whether the exemplar has edges (not toroidal): candidates within `2h` of one are
     /// compared over their real texels only.
     pub edged: bool,
-    /// For a non-toroidal exemplar, per exemplar coordinate `v` along either axis, the first
-    /// and one past the last tap (of five, stride `h`) around `v` inside the exemplar (empty
-    /// for a toroidal one).
+    /// Per exemplar coordinate `v` along either axis, the first and one past the last tap (of
+    /// five, stride `h`) around `v` inside the exemplar (read only when `edged`).
     pub span: Vec<[u8; 2]>,
 }
 
-/// [`Kernel::span`] for an `m × m` exemplar at stride `h`, edged or not.
-pub(crate) fn tap_spans(m: u32, h: u32, edged: bool) -> Vec<[u8; 2]> {
-    let inner = |v: u32| InnerTaps::around(v, 0, h, m);
-    if edged { (0..m).map(|v| [inner(v).c0, inner(v).c1]).collect() } else { Vec::new() }
+/// [`Kernel::span`] for an `m × m` exemplar at stride `h`.
+pub(crate) fn tap_spans(m: u32, h: u32) -> Vec<[u8; 2]> {
+    (0..m).map(|v| InnerTaps::around(v, 0, h, m)).map(|t| [t.c0, t.c1]).collect()
 }
+
+// The gathers of `Kernel::candidates_avx2` address candidate pairs 40 bytes apart.
+const _: () = assert!(std::mem::size_of::<[Candidate; 2]>() == 40);
 
 impl Kernel<'_> {
     /// Correct the pixels `start, start + step, …` of one row (one per `out` entry). Runs a copy
@@ -124,7 +125,6 @@ impl Kernel<'_> {
             || last as isize + hi >= s.len() as isize
             || self.cands.len() < self.m * self.m
             || self.m > crate::exemplar::MAX_SIDE as usize
-            || std::mem::size_of::<[Candidate; 2]>() != 40
         {
             return self.row_portable(s, col, start, step, out);
         }

@@ -358,7 +358,7 @@ impl<'a> Ctx<'a> {
             phi: self.phi,
             h: h as u32,
             edged: !self.an.header.toroidal,
-            span: tap_spans(m as u32, h as u32, !self.an.header.toroidal),
+            span: tap_spans(m as u32, h as u32),
         }
     }
 }
