@@ -93,8 +93,8 @@ pub struct AnalyzeArgs {
     /// Toroidal (wrap-around) exemplar: auto, true or false.
     #[arg(long, default_value = "auto", value_parser = ["auto", "true", "false"])]
     pub toroidal: String,
-    /// Candidate search: exact (k-d tree, every texel), coherent (exact on a grid, propagated;
-    /// several times faster on large exemplars) or auto (coherent from 256² up).
+    /// Candidate search: exact (k-d tree, every texel), coherent (approximate, on a grid at the
+    /// coarse levels; several times faster on large exemplars) or auto (coherent from 256² up).
     #[arg(long, default_value = "auto", value_parser = index_choice)]
     pub index: IndexChoice,
     /// Largest accepted exemplar side.

@@ -1,6 +1,6 @@
 //! k-coherence candidate sets, k = 2 (design note §1.2d): for every exemplar texel, itself and its
-//! best match at least 5 % of the exemplar away. Exact nearest neighbours in the 7×7 PCA space
-//! with a k-d tree. Every texel is a candidate, those along a non-toroidal edge too: synthesis
+//! best match at least 5 % of the exemplar away. Nearest neighbours in the 7×7 PCA space with a
+//! k-d tree: exact, or (the coherent search) on a grid of texels with approximate queries. Every texel is a candidate, those along a non-toroidal edge too: synthesis
 //! compares them over their real texels only (`modes::synth::kernel`), so content along an edge
 //! is not lost, where the design note's border zone excluded it.
 
@@ -56,34 +56,62 @@ const AROUND: [(i64, i64); 9] = [(-1, -1), (0, -1), (1, -1), (-1, 0), (0, 0), (1
 /// Nearest matches kept per grid texel by [`candidate_sets`].
 pub const GRID_MATCHES: usize = 8;
 
-/// The grid step of the coherent search at a level of stride `h`: exact (1) at the two finest
-/// levels, whose exact search is cheap, 2 for `h = 4, 8`, 4 above, where blurred features make
-/// the exact search slow and the coherence strong (recall per level in bench/README.md).
-pub fn grid_step(h: usize) -> usize {
-    match h {
-        0..=2 => 1,
-        3..=8 => 2,
-        _ => 4,
+/// Slack of the coherent search's k-d tree queries on the grid levels (`(1 + ε)²`, ε ≈ 0.32;
+/// see [`SearchPlan::slack`]).
+pub const GRID_SLACK: f64 = 1.75;
+
+/// Slack of the coherent search's queries on the levels searched at every texel (ε = 0.5).
+pub const FINE_SLACK: f64 = 2.25;
+
+/// How one level's candidates are searched.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchPlan {
+    /// Grid step: texels searched in the k-d tree on a grid of this step, the others from
+    /// their grid neighbours' matches; 1 searches every texel.
+    pub step: usize,
+    /// A k-d tree cell is searched only if `slack` times its squared distance to the query is
+    /// within the best match so far: 1 is exact; `(1 + ε)²` returns matches within `1 + ε` of
+    /// the exact distance, far faster in these eight dimensions and mostly the same texels.
+    pub slack: f64,
+}
+
+impl SearchPlan {
+    /// Every texel, exactly.
+    pub const EXACT: SearchPlan = SearchPlan { step: 1, slack: 1.0 };
+
+    /// The coherent search at a level of stride `h`: every texel at the two finest levels
+    /// (`h ≤ 2`), a grid of step 2 for `h = 4, 8` and 4 above, where blurred features make the
+    /// search slow and the coherence strong; approximate queries (recall per level in
+    /// bench/README.md).
+    pub fn coherent(h: usize) -> SearchPlan {
+        match h {
+            0..=2 => SearchPlan { step: 1, slack: FINE_SLACK },
+            3..=8 => SearchPlan { step: 2, slack: GRID_SLACK },
+            _ => SearchPlan { step: 4, slack: GRID_SLACK },
+        }
     }
 }
 
-/// Compute `[C_1(u), C_2(u)] = [u, C_2(u)]` (texel indices `y·m + x`) for every texel,
-/// searching exactly only the texels of a grid of the given `step` (their [`GRID_MATCHES`]
-/// nearest matches far enough from them, the first of which is `C_2`) and taking every other
-/// texel's `C_2` from the four grid texels around it: each of their matches shifted by the
-/// texel's offset from the grid texel (the coherence of a smooth level) and every texel within
-/// one of those, the best far enough; an exact search where no proposal qualifies. `step = 1` is
-/// the exact search of every texel.
-pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, step: usize) -> Vec<[u32; 2]> {
+/// Compute `[C_1(u), C_2(u)] = [u, C_2(u)]` (texel indices `y·m + x`) for every texel as
+/// `plan` says: searching only the texels of a grid of step `plan.step` in the k-d tree (their
+/// [`GRID_MATCHES`] nearest matches far enough from them, the first of which is `C_2`) and
+/// taking every other texel's `C_2` from the four grid texels around it: each of their matches
+/// shifted by the texel's offset from the grid texel (the coherence of a smooth level) and
+/// every texel within one of those, the best far enough; a tree search where no proposal
+/// qualifies. Step 1 searches every texel.
+pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, plan: SearchPlan) -> Vec<[u32; 2]> {
     let m = rules.m;
     let tree = KdTree::new((0..feats.len()).map(|i| (feats[i], i as u32)).collect());
-    let exact = |u: usize| {
-        let c2 = tree.nearest(&feats[u], |v| rules.far_enough(v as usize, u)).map(|b| b.1).unwrap_or(u as u32);
+    let search = |u: usize| {
+        let c2 = tree
+            .nearest_k_approx(&feats[u], 1, plan.slack, |v| rules.far_enough(v as usize, u))
+            .first()
+            .map_or(u as u32, |b| b.1);
         [u as u32, c2]
     };
-    let step = step.clamp(1, m.max(1));
+    let step = plan.step.clamp(1, m.max(1));
     if step == 1 {
-        return (0..feats.len()).into_par_iter().map(exact).collect();
+        return (0..feats.len()).into_par_iter().map(search).collect();
     }
     // Per grid texel: its nearest matches far enough from it (C_2 first).
     let gm = m.div_ceil(step);
@@ -91,7 +119,7 @@ pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, step
         .into_par_iter()
         .map(|g| {
             let u = (g / gm) * step * m + (g % gm) * step;
-            tree.nearest_k(&feats[u], GRID_MATCHES, |x| rules.far_enough(x as usize, u))
+            tree.nearest_k_approx(&feats[u], GRID_MATCHES, plan.slack, |x| rules.far_enough(x as usize, u))
                 .into_iter()
                 .map(|b| b.1)
                 .collect()
@@ -114,7 +142,7 @@ pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, step
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             match best {
                 Some((_, c2)) => [u as u32, c2],
-                None => exact(u),
+                None => search(u),
             }
         })
         .collect()

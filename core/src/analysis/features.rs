@@ -3,6 +3,7 @@
 //! neighbourhood projected to [`SEARCH_DIMS`] for the candidate search.
 
 use nalgebra::{DMatrix, SymmetricEigen};
+use rayon::prelude::*;
 
 use crate::analysis::stack::addr;
 
@@ -97,24 +98,37 @@ impl InnerTaps {
 pub fn principal_directions(cols: &LevelColours, r: i64, k: usize) -> Vec<Vec<f64>> {
     let dim = ((2 * r + 1) * (2 * r + 1) * 3) as usize;
     let step = (cols.m / 64).max(1);
-    let mut sum = vec![0i64; dim];
-    let mut cross = vec![0i64; dim * dim];
-    let mut n = 0i64;
-    let mut v = Vec::with_capacity(dim);
-    for y in (0..cols.m).step_by(step as usize) {
-        for x in (0..cols.m).step_by(step as usize) {
-            cols.neighbourhood(x, y, r, &mut v);
-            for i in 0..dim {
-                let vi = v[i] as i64;
-                sum[i] += vi;
-                let row = &mut cross[i * dim..i * dim + i + 1];
-                for (j, c) in row.iter_mut().enumerate() {
-                    *c += vi * v[j] as i64;
+    // Integer sums per sampled row, added up: exact, so the same whatever the thread count.
+    let rows: Vec<i64> = (0..cols.m).step_by(step as usize).collect();
+    let (sum, cross, n) = rows
+        .par_iter()
+        .map(|&y| {
+            let mut sum = vec![0i64; dim];
+            let mut cross = vec![0i64; dim * dim];
+            let mut n = 0i64;
+            let mut v = Vec::with_capacity(dim);
+            for x in (0..cols.m).step_by(step as usize) {
+                cols.neighbourhood(x, y, r, &mut v);
+                for i in 0..dim {
+                    let vi = v[i] as i64;
+                    sum[i] += vi;
+                    let row = &mut cross[i * dim..i * dim + i + 1];
+                    for (j, c) in row.iter_mut().enumerate() {
+                        *c += vi * v[j] as i64;
+                    }
                 }
+                n += 1;
             }
-            n += 1;
-        }
-    }
+            (sum, cross, n)
+        })
+        .reduce(
+            || (vec![0i64; dim], vec![0i64; dim * dim], 0),
+            |mut a, b| {
+                a.0.iter_mut().zip(&b.0).for_each(|(x, y)| *x += y);
+                a.1.iter_mut().zip(&b.1).for_each(|(x, y)| *x += y);
+                (a.0, a.1, a.2 + b.2)
+            },
+        );
     let nf = n as f64;
     let cov = DMatrix::from_fn(dim, dim, |i, j| {
         let (a, b) = if j <= i { (i, j) } else { (j, i) };
@@ -168,15 +182,32 @@ pub fn project_runtime(proj: &[i16], n: &[i32]) -> [i16; RUNTIME_DIMS] {
     acc.map(|a| (a >> FEAT_SHIFT) as i16)
 }
 
-/// Project a neighbourhood onto f64 directions (candidate search features).
-pub fn project_search(dirs: &[Vec<f64>], n: &[i32]) -> [f64; SEARCH_DIMS] {
-    let mut out = [0.0; SEARCH_DIMS];
-    for (d, dir) in dirs.iter().enumerate().take(SEARCH_DIMS) {
-        let mut s = 0.0;
-        for (a, &b) in dir.iter().zip(n) {
-            s += a * b as f64;
-        }
-        out[d] = s;
+/// The candidate search's projection: directions stored tap-major (`[component][direction]`),
+/// so one neighbourhood value feeds every direction at once.
+pub struct SearchProjection {
+    rows: Vec<[f64; SEARCH_DIMS]>,
+}
+
+impl SearchProjection {
+    /// The projection onto (up to [`SEARCH_DIMS`]) `dirs`, all of one length.
+    pub fn new(dirs: &[Vec<f64>]) -> SearchProjection {
+        let len = dirs.first().map_or(0, Vec::len);
+        let rows = (0..len)
+            .map(|i| std::array::from_fn(|d| dirs.get(d).and_then(|v| v.get(i)).copied().unwrap_or(0.0)))
+            .collect();
+        SearchProjection { rows }
     }
-    out
+
+    /// Project a neighbourhood: each output the sum, in component order, of direction ×
+    /// value (no fused multiply-add: the same bits on every machine).
+    pub fn project(&self, n: &[i32]) -> [f64; SEARCH_DIMS] {
+        let mut out = [0.0; SEARCH_DIMS];
+        for (row, &v) in self.rows.iter().zip(n) {
+            let v = v as f64;
+            for d in 0..SEARCH_DIMS {
+                out[d] += row[d] * v;
+            }
+        }
+        out
+    }
 }

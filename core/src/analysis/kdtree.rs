@@ -1,31 +1,52 @@
-//! An exact k-d tree for the candidate search (design note §1.2d, §3): nearest neighbour under a
-//! predicate, so the 5 % separation rule is applied during the search instead of by retrying
+//! A k-d tree for the candidate search (design note §1.2d, §3): nearest neighbours under a
+//! predicate, exact or within a factor `1 + ε` (a cell is skipped when it cannot hold a match
+//! much nearer than the one found), so the 5 % separation rule is applied during the search instead of by retrying
 //! ever larger k-nearest queries (which degrades to brute force on blurred coarse levels, where
 //! every near match is a spatial neighbour). Deterministic: ties go to the smallest item.
+//!
+//! A leaf's points are stored in groups of [`LANES`], dimension by dimension, so that their
+//! distances to a query are computed [`LANES`] at a time (with AVX where the processor has it);
+//! each distance is still summed in dimension order, so the results are the same bits as one
+//! point at a time.
 
-/// Points per leaf.
+/// Most points per leaf.
 const LEAF: usize = 16;
+/// Points whose distances are computed together.
+const LANES: usize = 4;
 
+/// A node; the left child of a split is the next node.
+#[derive(Clone, Copy)]
 enum Node {
-    Leaf { start: usize, end: usize },
-    Split { dim: usize, value: f64, left: usize, right: usize },
+    /// Points `slot..slot + len` (`slot` a multiple of [`LANES`]).
+    Leaf { slot: u32, len: u32 },
+    /// Points with coordinate `dim` below `value` on the left, above it on the right.
+    Split { value: f64, dim: u32, right: u32 },
 }
 
 /// A static k-d tree over `D`-dimensional points, each tagged with an item number.
 pub struct KdTree<const D: usize> {
-    points: Vec<[f64; D]>,
+    /// Per group of [`LANES`] slots, `D` lane vectors (one per dimension); padding slots are
+    /// at infinity.
+    lanes: Vec<[f64; LANES]>,
+    /// Item of every slot (padding: `u32::MAX`).
     items: Vec<u32>,
     nodes: Vec<Node>,
+    /// Whether the processor runs AVX (the leaf distances use it).
+    avx: bool,
 }
 
 impl<const D: usize> KdTree<D> {
     /// Build over `(point, item)` pairs. Median splits on the widest dimension.
     pub fn new(mut entries: Vec<([f64; D], u32)>) -> Self {
-        let mut nodes = Vec::new();
-        let n = entries.len();
-        build(&mut entries, 0, n, &mut nodes);
-        let (points, items) = entries.into_iter().unzip();
-        KdTree { points, items, nodes }
+        #[cfg(target_arch = "x86_64")]
+        let avx = std::arch::is_x86_feature_detected!("avx");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx = false;
+        let mut tree = KdTree { lanes: Vec::new(), items: Vec::new(), nodes: Vec::new(), avx };
+        if !entries.is_empty() {
+            tree.build(&mut entries);
+        }
+        tree
     }
 
     /// The item nearest to `q` (squared Euclidean distance) among those `keep` accepts, with its
@@ -37,10 +58,17 @@ impl<const D: usize> KdTree<D> {
     /// The `k` items nearest to `q` among those `keep` accepts, nearest first (ties to the
     /// smallest item).
     pub fn nearest_k(&self, q: &[f64; D], k: usize, keep: impl Fn(u32) -> bool) -> Vec<(f64, u32)> {
-        let mut best = Vec::with_capacity(k + 1);
-        if !self.nodes.is_empty() && k > 0 {
+        self.nearest_k_approx(q, k, 1.0, keep)
+    }
+
+    /// [`KdTree::nearest_k`], approximate: a cell is skipped unless `slack` times its squared
+    /// distance to `q` is within the k-th best so far (`slack = (1 + ε)²`: every match returned
+    /// is within `1 + ε` of the true one of its rank; `slack = 1`: exact). Deterministic.
+    pub fn nearest_k_approx(&self, q: &[f64; D], k: usize, slack: f64, keep: impl Fn(u32) -> bool) -> Vec<(f64, u32)> {
+        let mut best: Vec<(f64, u32)> = Vec::with_capacity(k + 1);
+        if k > 0 && !self.nodes.is_empty() {
             let mut gap = [0.0; D];
-            self.search(0, q, k, &keep, &mut best, &mut gap);
+            self.search(0, q, &Query { k, slack, keep }, &mut best, &mut gap);
         }
         best
     }
@@ -51,79 +79,188 @@ impl<const D: usize> KdTree<D> {
         &self,
         node: usize,
         q: &[f64; D],
-        k: usize,
-        keep: &impl Fn(u32) -> bool,
+        query: &Query<impl Fn(u32) -> bool>,
         best: &mut Vec<(f64, u32)>,
         gap: &mut [f64; D],
     ) {
+        let (k, keep) = (query.k, &query.keep);
         // The k-th best so far: what a new item must beat.
         let worst = |best: &Vec<(f64, u32)>| if best.len() < k { (f64::INFINITY, u32::MAX) } else { best[k - 1] };
         match self.nodes[node] {
-            Node::Leaf { start, end } => {
+            Node::Leaf { slot, len } => {
+                let (slot, len) = (slot as usize, len as usize);
+                let mut dist = [[0.0; LANES]; LEAF / LANES];
                 let mut w = worst(best);
-                for (p, &item) in self.points[start..end].iter().zip(&self.items[start..end]) {
-                    let mut d = 0.0;
-                    for j in 0..D {
-                        let e = p[j] - q[j];
-                        d += e * e;
-                    }
+                // Only points within the k-th best distance can enter (it only shrinks below).
+                let mut hits = self.leaf_distances(slot, len, q, w.0, &mut dist);
+                let dist = dist.as_flattened();
+                while hits != 0 {
+                    let i = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    let (d, item) = (dist[i], self.items[slot + i]);
                     if (d < w.0 || (d == w.0 && item < w.1)) && keep(item) {
-                        let at = best.partition_point(|b| b.0 < d || (b.0 == d && b.1 < item));
-                        best.insert(at, (d, item));
-                        best.truncate(k);
+                        offer(best, k, d, item);
                         w = worst(best);
                     }
                 }
             }
-            Node::Split { dim, value, left, right } => {
+            Node::Split { value, dim, right } => {
+                let dim = dim as usize;
                 let diff = q[dim] - value;
-                let (near, far) = if diff < 0.0 { (left, right) } else { (right, left) };
-                self.search(near, q, k, keep, best, gap);
+                let (near, far) = if diff < 0.0 { (node + 1, right as usize) } else { (right as usize, node + 1) };
+                self.search(near, q, query, best, gap);
                 // Every point of the far cell is at least `gap` (with `diff` on this dimension)
                 // from `q` along each dimension, and its distance is summed in the same order
                 // from terms at least as large: in floating point too, it is at least `reach`.
-                // Beyond the k-th best, no point there could be accepted.
+                // Beyond the k-th best, no point there could be accepted (with `slack` > 1,
+                // none much nearer than the k-th best).
                 let old = gap[dim];
                 gap[dim] = diff;
                 let mut reach = 0.0;
                 for g in gap.iter() {
                     reach += g * g;
                 }
-                if reach <= worst(best).0 {
-                    self.search(far, q, k, keep, best, gap);
+                if reach * query.slack <= worst(best).0 {
+                    self.search(far, q, query, best, gap);
                 }
                 gap[dim] = old;
             }
         }
     }
+
+    /// Distances from `q` of the `len` points from `slot`, into `out` (flattened order); returns
+    /// the mask of those at most `bound` (bit `i`: point `i`).
+    #[inline]
+    fn leaf_distances(
+        &self,
+        slot: usize,
+        len: usize,
+        q: &[f64; D],
+        bound: f64,
+        out: &mut [[f64; LANES]; LEAF / LANES],
+    ) -> u32 {
+        let groups = len.div_ceil(LANES);
+        let lanes = &self.lanes[slot / LANES * D..(slot / LANES + groups) * D];
+        #[cfg(target_arch = "x86_64")]
+        let within = if self.avx {
+            // SAFETY: the processor runs AVX (checked when the tree was built).
+            unsafe { group_distances_avx(lanes, q, bound, out) }
+        } else {
+            group_distances(lanes, q, bound, out)
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let within = group_distances(lanes, q, bound, out);
+        within & ((1u32 << len) - 1)
+    }
+
+    /// Build the subtree of `e` at the end of the node list; returns its node.
+    fn build(&mut self, e: &mut [([f64; D], u32)]) -> usize {
+        let id = self.nodes.len();
+        if e.len() <= LEAF {
+            let slot = self.items.len();
+            self.nodes.push(Node::Leaf { slot: slot as u32, len: e.len() as u32 });
+            for group in e.chunks(LANES) {
+                let mut lanes = [[f64::INFINITY; LANES]; D];
+                for (l, (p, item)) in group.iter().enumerate() {
+                    for j in 0..D {
+                        lanes[j][l] = p[j];
+                    }
+                    self.items.push(*item);
+                }
+                self.items.resize(self.items.len().next_multiple_of(LANES), u32::MAX);
+                self.lanes.extend_from_slice(&lanes);
+            }
+            return id;
+        }
+        let mut dim = 0;
+        let mut widest = -1.0;
+        for k in 0..D {
+            let (lo, hi) =
+                e.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.0[k]), hi.max(p.0[k])));
+            if hi - lo > widest {
+                widest = hi - lo;
+                dim = k;
+            }
+        }
+        let mid = e.len() / 2;
+        e.select_nth_unstable_by(mid, |a, b| a.0[dim].total_cmp(&b.0[dim]).then(a.1.cmp(&b.1)));
+        let value = e[mid].0[dim];
+        self.nodes.push(Node::Split { value, dim: dim as u32, right: 0 });
+        // Left: points ordered before the median (coordinate ≤ value); right: the rest (≥ value).
+        let (left, rest) = e.split_at_mut(mid);
+        self.build(left);
+        let right = self.build(rest);
+        self.nodes[id] = Node::Split { value, dim: dim as u32, right: right as u32 };
+        id
+    }
 }
 
-fn build<const D: usize>(e: &mut [([f64; D], u32)], start: usize, end: usize, nodes: &mut Vec<Node>) -> usize {
-    let id = nodes.len();
-    if end - start <= LEAF {
-        nodes.push(Node::Leaf { start, end });
-        return id;
-    }
-    let slice = &mut e[start..end];
-    let mut dim = 0;
-    let mut widest = -1.0;
-    for k in 0..D {
-        let (lo, hi) =
-            slice.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.0[k]), hi.max(p.0[k])));
-        if hi - lo > widest {
-            widest = hi - lo;
-            dim = k;
+/// What a search looks for.
+struct Query<F> {
+    k: usize,
+    slack: f64,
+    keep: F,
+}
+
+/// Insert `(d, item)` into the sorted `best` (ties by item), keeping at most `k`.
+fn offer(best: &mut Vec<(f64, u32)>, k: usize, d: f64, item: u32) {
+    let at = best.partition_point(|b| b.0 < d || (b.0 == d && b.1 < item));
+    best.insert(at, (d, item));
+    best.truncate(k);
+}
+
+/// The squared Euclidean distance from `q` of every point of consecutive lane groups (`D` lane
+/// vectors each), summed in dimension order; returns the mask of those at most `bound`.
+#[inline]
+fn group_distances<const D: usize>(
+    lanes: &[[f64; LANES]],
+    q: &[f64; D],
+    bound: f64,
+    out: &mut [[f64; LANES]; LEAF / LANES],
+) -> u32 {
+    let mut within = 0;
+    for (g, (group, o)) in lanes.chunks_exact(D).zip(out.iter_mut()).enumerate() {
+        let mut d = [0.0; LANES];
+        for (p, &qj) in group.iter().zip(q) {
+            for l in 0..LANES {
+                let e = p[l] - qj;
+                d[l] += e * e;
+            }
         }
+        for (l, &dl) in d.iter().enumerate() {
+            within |= ((dl <= bound) as u32) << (g * LANES + l);
+        }
+        *o = d;
     }
-    let mid = slice.len() / 2;
-    slice.select_nth_unstable_by(mid, |a, b| a.0[dim].total_cmp(&b.0[dim]).then(a.1.cmp(&b.1)));
-    let value = slice[mid].0[dim];
-    nodes.push(Node::Split { dim, value, left: 0, right: 0 });
-    // Left: points ordered before the median (coordinate ≤ value); right: the rest (≥ value).
-    let left = build(e, start, start + mid, nodes);
-    let right = build(e, start + mid, end, nodes);
-    nodes[id] = Node::Split { dim, value, left, right };
-    id
+    within
+}
+
+/// [`group_distances`] with AVX: one group's four points per instruction, each distance still
+/// summed in dimension order with separate multiplies and adds, so the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn group_distances_avx<const D: usize>(
+    lanes: &[[f64; LANES]],
+    q: &[f64; D],
+    bound: f64,
+    out: &mut [[f64; LANES]; LEAF / LANES],
+) -> u32 {
+    use std::arch::x86_64::*;
+    let qv: [__m256d; D] = std::array::from_fn(|j| _mm256_set1_pd(q[j]));
+    let limit = _mm256_set1_pd(bound);
+    let mut within = 0;
+    for (g, (group, o)) in lanes.chunks_exact(D).zip(out.iter_mut()).enumerate() {
+        let mut d = _mm256_setzero_pd();
+        for (p, &qj) in group.iter().zip(&qv) {
+            // SAFETY: `p` is four f64 (unaligned load).
+            let e = _mm256_sub_pd(unsafe { _mm256_loadu_pd(p.as_ptr()) }, qj);
+            d = _mm256_add_pd(d, _mm256_mul_pd(e, e));
+        }
+        // SAFETY: `o` is four f64 (unaligned store).
+        unsafe { _mm256_storeu_pd(o.as_mut_ptr(), d) };
+        within |= (_mm256_movemask_pd(_mm256_cmp_pd::<_CMP_LE_OQ>(d, limit)) as u32) << (g * LANES);
+    }
+    within
 }
 
 #[cfg(test)]
@@ -192,6 +329,48 @@ mod tests {
                 pts.iter().enumerate().filter(|(i, _)| keep(*i as u32)).map(|(i, p)| (dist(p, &q), i as u32)).collect();
             all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             assert_eq!(tree.nearest_k(&q, 8, keep), all[..8], "query {qi}");
+            // Approximate: each match of rank i within (1 + ε)² of the exact one's distance,
+            // all accepted, nearest first.
+            for slack in [1.5, 2.25, 4.0] {
+                let approx = tree.nearest_k_approx(&q, 8, slack, keep);
+                assert_eq!(approx.len(), 8);
+                for (i, (a, e)) in approx.iter().zip(&all).enumerate() {
+                    assert!(a.0 <= slack * e.0, "query {qi}, slack {slack}, rank {i}: {} > {slack}·{}", a.0, e.0);
+                    assert!(keep(a.1) && a.0 == dist(&pts[a.1 as usize], &q));
+                }
+                assert!(approx.windows(2).all(|w| w[0].0 <= w[1].0));
+            }
+        }
+    }
+
+    #[test]
+    fn leaf_distances_are_the_same_bits_with_and_without_avx() {
+        let mut z = 7u64;
+        let mut next = || {
+            z = z.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (z >> 11) as f64 / (1u64 << 40) as f64 - 2000.0
+        };
+        let lanes: Vec<[f64; LANES]> = (0..8 * LEAF / LANES).map(|_| std::array::from_fn(|_| next())).collect();
+        let q: [f64; 8] = std::array::from_fn(|_| next());
+        let (mut a, mut b) = ([[0.0; LANES]; LEAF / LANES], [[0.0; LANES]; LEAF / LANES]);
+        let bound = 3.0e7;
+        let ma = group_distances(&lanes, &q, bound, &mut a);
+        for (g, group) in lanes.chunks_exact(8).enumerate() {
+            for l in 0..LANES {
+                let p: [f64; 8] = std::array::from_fn(|j| group[j][l]);
+                let mut d = 0.0;
+                for j in 0..8 {
+                    d += (p[j] - q[j]) * (p[j] - q[j]);
+                }
+                assert_eq!(a[g][l].to_bits(), d.to_bits());
+                assert_eq!(ma >> (g * LANES + l) & 1 == 1, d <= bound);
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx") {
+            // SAFETY: AVX is present.
+            let mb = unsafe { group_distances_avx(&lanes, &q, bound, &mut b) };
+            assert_eq!((ma, a.map(|g| g.map(f64::to_bits))), (mb, b.map(|g| g.map(f64::to_bits))));
         }
     }
 }

@@ -10,10 +10,10 @@ pub mod stack;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::candidates::{candidate_sets, grid_step, CandidateRules};
+use crate::analysis::candidates::{candidate_sets, CandidateRules, SearchPlan};
 use crate::analysis::features::{
-    principal_directions, project_runtime, project_search, quantise_projection, InnerTaps, LevelColours, RUNTIME_DIMS,
-    SEARCH_DIMS,
+    principal_directions, project_runtime, quantise_projection, InnerTaps, LevelColours, SearchProjection,
+    RUNTIME_DIMS, SEARCH_DIMS,
 };
 use crate::analysis::stack::{build_stack, to_u8};
 use crate::error::{CoreError, Result};
@@ -34,6 +34,10 @@ pub const FIRST_CORRECTED_LEVEL: u32 = 4;
 /// ([`IndexChoice::Auto`]); smaller ones exactly.
 pub const COHERENT_FROM_SIDE: u32 = 256;
 
+/// Version of the coherent search (part of coherent analyses' ids): 2 since its k-d tree
+/// queries are approximate.
+pub const COHERENT_VERSION: u32 = 2;
+
 /// How the candidate sets are searched (design note §1.2d).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -41,9 +45,10 @@ pub enum SearchIndex {
     /// Exact nearest neighbours of every texel in a k-d tree.
     #[default]
     Exact,
-    /// Exact matches on a grid of texels, propagated to the texels between by coherence and
-    /// refined locally ([`candidates::candidate_sets`]): several times faster on large
-    /// exemplars, most candidates identical or one texel off.
+    /// Approximate matches on a grid of texels, propagated to the texels between by coherence
+    /// and refined locally, and approximate matches of every texel at the finest two levels
+    /// ([`candidates::SearchPlan::coherent`]): several times faster on large exemplars, most
+    /// candidates identical or one texel off.
     Coherent,
 }
 
@@ -273,6 +278,7 @@ fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
     h.update(&ALGORITHM_VERSION.to_le_bytes());
     if search == SearchIndex::Coherent {
         h.update(b"coherent");
+        h.update(&COHERENT_VERSION.to_le_bytes());
     }
     h.update(&ex.side.to_le_bytes());
     h.update(&[ex.toroidal as u8]);
@@ -287,7 +293,7 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_inde
     let cols = LevelColours { px, m: m as i64, toroidal, h: h as i64 };
     let dirs5 = principal_directions(&cols, 2, RUNTIME_DIMS);
     let proj = quantise_projection(&dirs5);
-    let dirs7 = principal_directions(&cols, 3, SEARCH_DIMS);
+    let search_proj = SearchProjection::new(&principal_directions(&cols, 3, SEARCH_DIMS));
     let (runtime, search): (Vec<[i16; RUNTIME_DIMS]>, Vec<[f64; SEARCH_DIMS]>) = (0..m * m)
         .into_par_iter()
         .map_init(Vec::new, |buf, i| {
@@ -303,11 +309,14 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_inde
             }
             let r = project_runtime(&proj, buf);
             cols.neighbourhood(x, y, 3, buf);
-            (r, project_search(&dirs7, buf))
+            (r, search_proj.project(buf))
         })
         .unzip();
-    let step = if search_index == SearchIndex::Coherent { grid_step(h) } else { 1 };
-    let sets = candidate_sets(&search, &CandidateRules::new(m, toroidal), step);
+    let plan = match search_index {
+        SearchIndex::Exact => SearchPlan::EXACT,
+        SearchIndex::Coherent => SearchPlan::coherent(h),
+    };
+    let sets = candidate_sets(&search, &CandidateRules::new(m, toroidal), plan);
     let cand = |i: u32| {
         let i = i as usize;
         Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }
