@@ -71,7 +71,10 @@ async fn catalog_and_metadata_agree() {
         let tj = s.json(&tj_path).await;
         assert_eq!(tj["maxzoom"], meta["maxzoom"]);
         assert_eq!(tj["minzoom"], meta["minzoom"]);
-        assert_eq!(meta["native_zoom"], meta["maxzoom"]);
+        // Served magnified beyond native zoom.
+        let steps = meta["magnification"]["steps"].as_u64().unwrap();
+        assert_eq!(meta["native_zoom"].as_u64().unwrap() + steps, meta["maxzoom"].as_u64().unwrap());
+        assert_eq!(steps, 3);
         let side = meta["exemplar"]["width"].as_u64().unwrap();
         let ex = s.image(&format!("/textures/{id}/exemplar.png")).await;
         assert_eq!(ex.dimensions(), (side as u32, side as u32));
@@ -187,7 +190,7 @@ async fn a_textures_configured_kappa_shapes_its_synthesis_and_only_that() {
 #[tokio::test]
 async fn every_listed_mode_is_served_and_its_tiles_equal_one_window() {
     // Whatever modes the server lists (a new mode is covered without editing this test): 2×2
-    // tiles equal the same area as one window, at native zoom and one step out; a mode's key
+    // tiles equal the same area as one window, at native zoom, one step out and two in; a mode's key
     // given to another mode is refused naming the mode it belongs to; /metrics counts each.
     let s = Server::builder().start();
     let meta = s.json("/textures/brick").await;
@@ -195,7 +198,7 @@ async fn every_listed_mode_is_served_and_its_tiles_equal_one_window() {
         meta["modes"].as_array().unwrap().iter().map(|m| m.as_str().unwrap().to_string()).collect();
     assert!(modes.len() >= 2, "{modes:?}");
     for mode in &modes {
-        for (z, x0, y0) in [(7, -1, 2), (6, 3, -4)] {
+        for (z, x0, y0) in [(7, -1, 2), (6, 3, -4), (9, -3, 5)] {
             let mut stitched = image::RgbImage::new(512, 512);
             for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                 let tile = s.image(&format!("/tiles/brick/{z}/{}/{}.png?mode={mode}&seed=5", x0 + i, y0 + j)).await;
@@ -228,6 +231,118 @@ async fn every_listed_mode_is_served_and_its_tiles_equal_one_window() {
     for mode in &modes {
         assert!(metrics.contains(&format!("textile_syntheses_total{{mode=\"{mode}\"}}")), "{mode} not counted");
     }
+}
+
+#[tokio::test]
+async fn magnified_zooms_are_served_up_to_maxzoom_and_stay_true_to_native() {
+    let s = Server::builder().start();
+    let meta = s.json("/textures/gravel").await;
+    let (native, max) = (meta["native_zoom"].as_u64().unwrap(), meta["maxzoom"].as_u64().unwrap());
+    assert_eq!(max, native + 3);
+    // One step in: a native tile's four children, box-filtered 2×2, are close to it (the
+    // magnification interpolates between texel centres: a slight blur, not a different image).
+    let parent = s.image(&format!("/tiles/gravel/{native}/3/-2.png")).await;
+    let mut children = image::RgbImage::new(512, 512);
+    for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let tile = s.image(&format!("/tiles/gravel/{}/{}/{}.png", native + 1, 6 + i, -4 + j)).await;
+        support::paste(&mut children, &tile, 256 * i as u32, 256 * j as u32);
+    }
+    let mad = box_difference(&children, &parent);
+    assert!(mad < 14.0, "mean absolute difference {mad:.2}");
+    // `@2x` at a magnified zoom is the next zoom's pixels.
+    let big = s.image(&format!("/tiles/gravel/{}/1/-1@2x.png", native + 1)).await;
+    let window = s.image(&format!("/windows/gravel.png?z={}&x=512&y=-512&w=512&h=512", native + 2)).await;
+    assert!(big == window, "@2x at z = native + 1 differs from the window at native + 2");
+    // The highest zoom is served; past it, a 400 naming the range.
+    assert_eq!(s.image(&format!("/tiles/gravel/{max}/-5/7.png")).await.dimensions(), (256, 256));
+    let r = s.get(&format!("/tiles/gravel/{}/0/0.png", max + 1)).await;
+    assert_eq!(r.status(), 400);
+    let body: serde_json::Value = r.json().await.unwrap();
+    assert!(body["message"].as_str().unwrap().contains(&max.to_string()), "{body}");
+    // Samples stay at native zoom or coarser.
+    let body = serde_json::json!({ "points": [[0, 0, native + 1]] }).to_string().into_bytes();
+    let (status, _, answer) = s.post("/samples/gravel", "application/json", body).await;
+    assert_eq!(status, 400, "{}", String::from_utf8_lossy(&answer));
+    assert!(String::from_utf8_lossy(&answer).contains("not magnified"));
+}
+
+/// Mean absolute difference per channel between `a` box-filtered 2×2 and `b` (half its size).
+fn box_difference(a: &image::RgbImage, b: &image::RgbImage) -> f64 {
+    let mut diff = 0u64;
+    for (x, y, p) in b.enumerate_pixels() {
+        for c in 0..3 {
+            let sum: u32 =
+                [(0, 0), (1, 0), (0, 1), (1, 1)].iter().map(|(i, j)| a.get_pixel(2 * x + i, 2 * y + j)[c] as u32).sum();
+            diff += ((sum + 2) / 4).abs_diff(p[c] as u32) as u64;
+        }
+    }
+    diff as f64 / (3 * b.width() * b.height()) as f64
+}
+
+#[tokio::test]
+async fn a_high_resolution_exemplar_gives_magnified_tiles_its_own_detail() {
+    // `plain` is the embedded gravel reduced 2×2 to 64²; `hires` is made from the 128² gravel
+    // with `exemplar_hires`, so its exemplar is the same 64² image.
+    let dir = tempfile::tempdir().unwrap();
+    let gravel = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png");
+    let big = image::open(&gravel).unwrap().to_rgb8();
+    let small = image::RgbImage::from_fn(64, 64, |x, y| {
+        image::Rgb(std::array::from_fn(|c| {
+            let s: u32 = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                .iter()
+                .map(|(i, j)| big.get_pixel(2 * x + i, 2 * y + j)[c] as u32)
+                .sum();
+            ((s + 2) / 4) as u8
+        }))
+    });
+    small.save(dir.path().join("small.png")).unwrap();
+    let cfg = dir.path().join("textile.toml");
+    let text = format!(
+        "[[textures]]\nid = \"plain\"\nexemplar = \"small.png\"\n\n[[textures]]\nid = \"hires\"\nexemplar_hires = \"{}\"\n",
+        gravel.display()
+    );
+    std::fs::write(&cfg, text).unwrap();
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    let meta = s.json("/textures/hires").await;
+    assert_eq!(meta["exemplar"]["width"], 64);
+    assert_eq!(meta["native_zoom"], 6);
+    assert_eq!(meta["magnification"]["detail"], "exemplar_hires 128x128", "{meta}");
+    assert_eq!(s.json("/textures/plain").await["magnification"]["detail"], "exemplar");
+    // Same exemplar pixels: the same native tiles; different identities (the detail image is
+    // part of the texture), so different ETags.
+    let (a, b) = (s.get("/tiles/plain/6/2/-1.png").await, s.get("/tiles/hires/6/2/-1.png").await);
+    assert_ne!(a.headers()["etag"], b.headers()["etag"]);
+    assert_eq!(a.bytes().await.unwrap(), b.bytes().await.unwrap());
+    // One step in, the hires texture copies the 128² image inside every patch, whose 2×2
+    // averages are the exemplar: box-filtered back, nearly the native tile (differences only
+    // where patches meet); the plain one interpolates, a blur.
+    let native = s.image("/tiles/plain/6/2/-1.png").await;
+    let mut close = Vec::new();
+    for id in ["plain", "hires"] {
+        let mut children = image::RgbImage::new(512, 512);
+        for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let tile = s.image(&format!("/tiles/{id}/7/{}/{}.png", 4 + i, -2 + j)).await;
+            support::paste(&mut children, &tile, 256 * i as u32, 256 * j as u32);
+        }
+        close.push(box_difference(&children, &native));
+    }
+    assert!(close[1] < 0.5 * close[0], "box-filtered back: plain {:.2}, hires {:.2}", close[0], close[1]);
+    // A texture cannot name both images.
+    let both = dir.path().join("both.toml");
+    std::fs::write(&both, "[[textures]]\nid = \"x\"\nexemplar = \"small.png\"\nexemplar_hires = \"small.png\"\n")
+        .unwrap();
+    let out = dir.path().join("x.png");
+    let run = std::process::Command::new(binary())
+        .args(["render", "--config", both.to_str().unwrap(), "--texture", "x", "--x", "0", "--y", "0"])
+        .args(["-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    assert!(
+        String::from_utf8_lossy(&run.stderr).contains("exemplar_hires"),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 }
 
 #[tokio::test]

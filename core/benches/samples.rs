@@ -287,10 +287,8 @@ fn main() {
     let t = Instant::now();
     let mut computed = 0;
     for &(k, tx, ty) in &tiles {
-        computed += p
-            .render(&src, &cache, View { zoom_out: k, rect: Rect::new(256 * tx, 256 * ty, 256, 256) })
-            .expect("tile")
-            .synthesized;
+        computed +=
+            p.render(&src, &cache, View::out(k, Rect::new(256 * tx, 256 * ty, 256, 256))).expect("tile").synthesized;
     }
     let tile_secs = t.elapsed().as_secs_f64();
     println!("| | time | computed pixels |\n|---|---|---|");

@@ -1,6 +1,6 @@
 //! Engine benchmarks (criterion): analysis time for 64², 128² and 256² exemplars, a cold
-//! 256×256 native window (full padded pyramid, nothing cached), a zoomed-out tile, and a
-//! 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
+//! 256×256 native window (full padded pyramid, nothing cached), a zoomed-out tile, a tile
+//! magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
 //! 512² windows.
 //!
 //! `cargo bench -p textile-core --bench synthesis`
@@ -10,8 +10,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use textile_core::modes::mosaic::MosaicParams;
-use textile_core::modes::synth::{render, SynthParams};
-use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress, Rect};
+use textile_core::modes::synth::{render, Synth, SynthParams};
+use textile_core::{Analysis, Exemplar, ExemplarOptions, Mode, NoProgress, Pyramid, Rect, Source};
 
 fn exemplar(side: u32) -> Exemplar {
     // The 256² gravel of the development set, area-resampled to the side wanted.
@@ -42,7 +42,8 @@ fn analysis(c: &mut Criterion) {
 }
 
 fn windows(c: &mut Criterion) {
-    let an = Analysis::build(&exemplar(128), &NoProgress);
+    let ex = exemplar(128);
+    let an = Analysis::build(&ex, &NoProgress);
     let p = SynthParams::default();
     let mut g = c.benchmark_group("window");
     g.sample_size(30).measurement_time(Duration::from_secs(10));
@@ -57,6 +58,12 @@ fn windows(c: &mut Criterion) {
         b.iter(|| {
             i += 1;
             render(&an, &p, 1, Rect::new(256 * i, 256, 256, 256)).unwrap()
+        })
+    });
+    g.bench_function("cold_256_magnified_1", |b| {
+        b.iter(|| {
+            i += 1;
+            Synth::magnify(&p, &Source::new(&ex, &an), &Pyramid::off(), 1, Rect::new(256 * i, 512, 256, 256)).unwrap()
         })
     });
     g.sample_size(10);

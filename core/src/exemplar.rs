@@ -63,6 +63,9 @@ pub struct Exemplar {
     pub toroidal: bool,
     /// What preparation did.
     pub preparation: Preparation,
+    /// The image the exemplar was reduced from, twice as wide (`2·side` squared), when it was
+    /// given ([`Exemplar::from_hires`]): magnified zooms sample their detail from it.
+    pub hires: Option<Vec<[u8; 3]>>,
 }
 
 impl Exemplar {
@@ -123,7 +126,26 @@ impl Exemplar {
                 seam_ratio,
                 toroidal_synthesized: false,
             },
+            hires: None,
         }
+    }
+
+    /// The exemplar of a high-resolution image: `hires` (prepared, side `2m`) reduced by the
+    /// exact 2×2 box average to side `m`, keeping `hires` for magnified zooms (design note
+    /// §1.8: magnified tiles then show the image's own detail, not interpolation). The toroidal
+    /// flag is `hires`'s when forced, else detected on the reduced exemplar.
+    pub fn from_hires(hires: Exemplar) -> Result<Exemplar> {
+        let big = hires.side;
+        if big < 2 * MIN_SIDE {
+            return Err(CoreError::ExemplarSize { width: big, height: big, min: 2 * MIN_SIDE, max: MAX_SIDE });
+        }
+        let side = big / 2;
+        let pixels = area_resample(&hires.pixels, big as usize, side as usize);
+        let seam_ratio = seam_ratio(&pixels, side as usize);
+        let forced = hires.preparation.toroidal_forced;
+        let toroidal = if forced { hires.toroidal } else { seam_ratio <= 1.5 };
+        let preparation = Preparation { side, seam_ratio, ..hires.preparation };
+        Ok(Exemplar { side, pixels, toroidal, preparation, hires: Some(hires.pixels) })
     }
 }
 

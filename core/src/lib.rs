@@ -34,7 +34,7 @@
 //! // A request's parameters, read as the server reads a query string.
 //! let params = Defaults::builtin(&src).request(&src, ParamReader::request([("mode", "synth"), ("seed", "7")])?)?;
 //! // Any window, anywhere: negative and far coordinates included.
-//! let tile = params.render(&src, &Pyramid::off(), View { zoom_out: 0, rect: Rect::new(-1 << 40, 12, 32, 32) })?;
+//! let tile = params.render(&src, &Pyramid::off(), View::native(Rect::new(-1 << 40, 12, 32, 32)))?;
 //! assert_eq!((tile.image.width, tile.image.height), (32, 32));
 //! # Ok::<(), textile_core::CoreError>(())
 //! ```

@@ -26,7 +26,7 @@ fn render_mode((ex, an): &(Exemplar, Analysis), query: &str, zoom_out: u32, rect
     let src = Source::new(ex, an);
     let pairs = query.split('&').filter_map(|kv| kv.split_once('='));
     let params = Defaults::builtin(&src).request(&src, ParamReader::request(pairs).unwrap()).unwrap();
-    params.render(&src, &Pyramid::off(), View { zoom_out, rect }).unwrap().image
+    params.render(&src, &Pyramid::off(), View::out(zoom_out, rect)).unwrap().image
 }
 
 /// A 96×64 window straddling tile borders, away from the origin.

@@ -15,7 +15,7 @@ fn params(src: &Source, mode: &str) -> ModeParams {
 /// The pixel of `t` cut from a 48×40 window around it.
 fn from_window(p: &ModeParams, src: &Source, t: Texel) -> [u8; 3] {
     let rect = Rect::new(t.x - 17, t.y - 23, 48, 40);
-    let w = p.render(src, &Pyramid::off(), View { zoom_out: t.zoom_out, rect }).unwrap();
+    let w = p.render(src, &Pyramid::off(), View::out(t.zoom_out, rect)).unwrap();
     w.image.pixel(17, 23)
 }
 
@@ -75,7 +75,7 @@ fn a_batch_computes_shared_cones_once() {
     assert!(batch.synthesized * 4 < apart, "batch {} vs one cone per point {apart}", batch.synthesized);
     // Seen before as a tile: nothing more to compute.
     let cache = Pyramid::new(16 << 20);
-    p.render(&src, &cache, View { zoom_out: 0, rect: Rect::new(0, 0, 64, 64) }).unwrap();
+    p.render(&src, &cache, View::native(Rect::new(0, 0, 64, 64))).unwrap();
     assert_eq!(samples::texels(&p, &src, &cache, &pts).unwrap().synthesized, 0);
 }
 
@@ -138,7 +138,7 @@ fn batches_bigger_than_a_chunk_equal_the_window_they_cover() {
     let src = Source::new(ex, an);
     let p = params(&src, "synth");
     let rect = Rect::new(-100, 40, 256, 256);
-    let window = p.render(&src, &Pyramid::off(), View { zoom_out: 0, rect }).unwrap();
+    let window = p.render(&src, &Pyramid::off(), View::native(rect)).unwrap();
     let pts: Vec<Texel> = (0..70_000u64)
         .map(|i| {
             let h = textile_core::hash::hash(0x7C, 9, i as i64, 0, 0);

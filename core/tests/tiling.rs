@@ -12,7 +12,7 @@ fn render(query: &[(&str, &str)], zoom_out: u32, rect: Rect) -> RgbWindow {
     let mut pairs = vec![("mode", "tiling")];
     pairs.extend_from_slice(query);
     let p = Defaults::builtin(&src).request(&src, ParamReader::request(pairs).unwrap()).unwrap();
-    p.render(&src, &Pyramid::off(), View { zoom_out, rect }).unwrap().image
+    p.render(&src, &Pyramid::off(), View::out(zoom_out, rect)).unwrap().image
 }
 
 #[test]

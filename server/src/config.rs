@@ -79,7 +79,12 @@ pub struct TextureConfig {
     #[serde(default)]
     pub name: String,
     /// Exemplar path (relative to the config file) or `embedded:NAME`.
+    #[serde(default)]
     pub exemplar: String,
+    /// Instead of `exemplar`: a high-resolution image (path or `embedded:NAME`); the exemplar
+    /// is its 2× reduction, and magnified zooms show the image's own detail.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exemplar_hires: Option<String>,
     /// Toroidal flag.
     #[serde(default = "default_toroidal")]
     pub toroidal: Toroidal,
@@ -104,12 +109,18 @@ pub struct TextureConfig {
 }
 
 impl TextureConfig {
+    /// The image file the texture is made from: `exemplar_hires` when given, else `exemplar`.
+    pub fn image(&self) -> &str {
+        self.exemplar_hires.as_deref().unwrap_or(&self.exemplar)
+    }
+
     /// A texture of this id and exemplar with every other key at its default.
     pub fn new(id: &str, exemplar: &str) -> Self {
         TextureConfig {
             id: id.into(),
             name: id.into(),
             exemplar: exemplar.into(),
+            exemplar_hires: None,
             toroidal: Toroidal::Auto,
             index: IndexChoice::Auto,
             default_mode: default_mode(),
@@ -126,6 +137,19 @@ impl TextureConfig {
         let bad = |key: String, msg: String| Err((key, msg));
         if !valid_id(&self.id) {
             return bad(format!("{at}.id"), format!("'{}' must be 1-64 of a-z 0-9 _ -", clip(&self.id)));
+        }
+        match (self.exemplar.is_empty(), &self.exemplar_hires) {
+            (true, None) => return bad(format!("{at}.exemplar"), "is required (or exemplar_hires)".into()),
+            (false, Some(_)) => {
+                return bad(format!("{at}.exemplar_hires"), "replaces exemplar: give one of the two".into())
+            }
+            (true, Some(_)) if self.toroidal == Toroidal::Synthesize => {
+                return bad(
+                    format!("{at}.toroidal"),
+                    "\"synthesize\" would not match exemplar_hires's detail; use auto, true or false".into(),
+                )
+            }
+            _ => {}
         }
         if !MODE_NAMES.contains(&self.default_mode.as_str()) {
             return bad(

@@ -86,20 +86,19 @@ impl ImageJob {
         etag_for(&self.key())
     }
 
-    /// The view rendered, and whether it is upscaled 2× (`@2x` at native zoom).
+    /// The view rendered, and whether it is upscaled 2× (`@2x` at native zoom, pixel-doubled
+    /// as it always was; `@2x` tiles at other zooms are rendered one zoom finer).
     fn view(&self) -> (View, bool) {
-        let native = self.tex.native_zoom();
+        let native = self.tex.native_zoom() as i64;
         match self.target {
-            Target::Window(w) => (View { zoom_out: native - w.z, rect: Rect::new(w.x, w.y, w.w, w.h) }, false),
+            Target::Window(w) => (View::at(native - w.z as i64, Rect::new(w.x, w.y, w.w, w.h)), false),
             Target::Tile(t) => {
-                let k = native - t.z;
+                let k = native - t.z as i64;
                 let (s, big) = (TILE_SIZE, 2 * TILE_SIZE);
                 match (t.scale, k) {
-                    (1, _) => (View { zoom_out: k, rect: Rect::new(s * t.x, s * t.y, s, s) }, false),
-                    (_, k) if k >= 1 => {
-                        (View { zoom_out: k - 1, rect: Rect::new(big * t.x, big * t.y, big, big) }, false)
-                    }
-                    _ => (View { zoom_out: 0, rect: Rect::new(s * t.x, s * t.y, s, s) }, true),
+                    (1, _) => (View::at(k, Rect::new(s * t.x, s * t.y, s, s)), false),
+                    (_, 0) => (View::native(Rect::new(s * t.x, s * t.y, s, s)), true),
+                    _ => (View::at(k - 1, Rect::new(big * t.x, big * t.y, big, big)), false),
                 }
             }
         }
@@ -224,7 +223,7 @@ fn render_pieces(
             }
             let (pw, ph) = ((w - px).min(PIECE as usize), (h - py).min(PIECE as usize));
             let rect = Rect::new(view.rect.x0 + px as i64, view.rect.y0 + py as i64, pw as i64, ph as i64);
-            let r = params.render(&tex.source(), cache, View { zoom_out: view.zoom_out, rect })?;
+            let r = params.render(&tex.source(), cache, View { rect, ..view })?;
             synthesized += r.synthesized;
             for j in 0..ph {
                 let dst = 3 * ((py + j) * w + px);

@@ -91,9 +91,10 @@ fn invalid(index: usize, message: String) -> ApiError {
 
 /// A tile-grid pixel checked against the texture's zoom and coordinate ranges.
 fn texel(tex: &Texture, index: usize, x: i64, y: i64, z: i64) -> Result<Texel, ApiError> {
-    let (zmin, zmax) = (tex.min_zoom() as i64, tex.max_zoom() as i64);
+    // Samples are texels of the tile grid at native zoom or coarser (not magnified).
+    let (zmin, zmax) = (tex.min_zoom() as i64, tex.native_zoom() as i64);
     if !(zmin..=zmax).contains(&z) {
-        return Err(invalid(index, format!("z = {z} is outside {zmin}..={zmax}")));
+        return Err(invalid(index, format!("z = {z} is outside {zmin}..={zmax} (samples are not magnified)")));
     }
     for (name, v) in [("x", x), ("y", y)] {
         if !(PIXEL_MIN..=PIXEL_MAX).contains(&v) {

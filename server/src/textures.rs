@@ -12,6 +12,10 @@ use std::sync::{Arc, OnceLock};
 use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, Progress, Source};
 
 use crate::config::{Config, TextureConfig};
+
+/// Zoom steps served beyond native, magnified (design note §1.8); `@2x` tiles at the highest
+/// zoom are rendered one step further, within [`textile_core::modes::magnify::MAX_ZOOM_IN`].
+pub const MAGNIFY_STEPS: u32 = 3;
 use crate::state::Cancel;
 
 /// Exemplars compiled into the binary (`config/exemplars`, CC0; see LICENSE.md there).
@@ -92,6 +96,12 @@ impl Texture {
         for p in &exemplar.pixels {
             h.update(p);
         }
+        if let Some(hires) = &exemplar.hires {
+            h.update(b"hires");
+            for p in hires {
+                h.update(p);
+            }
+        }
         let exemplar_hash = h.finalize().to_hex()[..16].to_string();
         Ok(Texture {
             config,
@@ -153,9 +163,9 @@ impl Texture {
     pub fn min_zoom(&self) -> u32 {
         0
     }
-    /// Largest zoom served.
+    /// Largest zoom served: magnified [`MAGNIFY_STEPS`] steps beyond native.
     pub fn max_zoom(&self) -> u32 {
-        self.native_zoom()
+        self.native_zoom() + MAGNIFY_STEPS
     }
 }
 
@@ -254,12 +264,12 @@ pub enum LoadError {
 
 /// Read the exemplar bytes a texture config names.
 pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadError> {
-    if let Some(name) = t.exemplar.strip_prefix("embedded:") {
+    if let Some(name) = t.image().strip_prefix("embedded:") {
         return embedded(name)
             .map(|b| b.to_vec())
             .ok_or_else(|| LoadError::NoEmbedded { id: t.id.clone(), name: name.into() });
     }
-    let path = cfg.base_dir.join(&t.exemplar);
+    let path = cfg.base_dir.join(t.image());
     // Regular files only (a FIFO or device would block the read or never end), of a bounded size.
     let meta =
         std::fs::metadata(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path: path.clone(), source })?;
@@ -312,6 +322,11 @@ pub fn prepare_texture(
     let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
     let core = |source| LoadError::Core { id: t.id.clone(), source };
     let mut ex = Exemplar::from_bytes(bytes, &opts).map_err(core)?;
+    if t.exemplar_hires.is_some() {
+        ex = Exemplar::from_hires(ex).map_err(core)?;
+        let (m, big) = (ex.side, 2 * ex.side);
+        log(format!("texture '{}': exemplar {m}x{m} reduced from its {big}x{big} exemplar_hires", t.id));
+    }
     if t.toroidal == crate::config::Toroidal::Synthesize {
         let started = std::time::Instant::now();
         ex = textile_core::tileable::make_toroidal(&ex, 0).map_err(core)?;

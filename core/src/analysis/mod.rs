@@ -271,7 +271,9 @@ fn derive_stack8(stack: &[Vec<[u16; 3]>]) -> Vec<Vec<[u8; 3]>> {
 }
 
 /// Content hash of what determines an analysis: algorithm version, side, toroidal flag, pixels,
-/// and the search (only when not exact, so exact analyses keep the ids they always had).
+/// and the search (only when not exact, so exact analyses keep the ids they always had); also
+/// the high-resolution image when there is one, which magnified tiles show, so that the id
+/// (and through it every cache key and ETag) names everything a tile's pixels depend on.
 fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
     let mut h = blake3::Hasher::new();
     h.update(b"textile-analysis");
@@ -284,6 +286,13 @@ fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
     h.update(&[ex.toroidal as u8]);
     for p in &ex.pixels {
         h.update(p);
+    }
+    // The image magnified zooms sample (only when given, so other ids are unchanged).
+    if let Some(hires) = &ex.hires {
+        h.update(b"hires");
+        for p in hires {
+            h.update(p);
+        }
     }
     h.finalize().to_hex()[..16].to_string()
 }

@@ -7,6 +7,7 @@
 //! part of every ETag and cache key of its tiles, bumped whenever its pixels change (the golden
 //! test in `core/tests/golden.rs` says when).
 
+pub mod magnify;
 pub mod params;
 
 use std::collections::BTreeMap;
@@ -73,13 +74,33 @@ impl<'a> Source<'a> {
 }
 
 /// What to render: `rect` viewed `zoom_out` steps coarser than native (0: one pixel per texel;
-/// `k`: one pixel covers `2^k × 2^k` texels).
+/// `k`: one pixel covers `2^k × 2^k` texels), or `zoom_in` steps finer (magnified: a texel
+/// covers `2^k × 2^k` pixels). At most one of the two is non-zero.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct View {
     /// Steps coarser than native.
     pub zoom_out: u32,
+    /// Steps finer than native (at most [`magnify::MAX_ZOOM_IN`]).
+    pub zoom_in: u32,
     /// Pixels at that zoom.
     pub rect: Rect,
+}
+
+impl View {
+    /// `rect` at `zoom` steps from native: coarser when positive, magnified when negative.
+    pub fn at(zoom: i64, rect: Rect) -> View {
+        View { zoom_out: zoom.max(0) as u32, zoom_in: (-zoom).max(0) as u32, rect }
+    }
+
+    /// `rect` at native zoom.
+    pub fn native(rect: Rect) -> View {
+        View::at(0, rect)
+    }
+
+    /// `rect` `k` steps coarser than native.
+    pub fn out(k: u32, rect: Rect) -> View {
+        View { zoom_out: k, zoom_in: 0, rect }
+    }
 }
 
 /// An engine: its name, version, parameters and rendering of any window.
@@ -108,8 +129,17 @@ pub trait Mode {
     fn values(p: &Self::Params, src: &Source) -> Map<String, Value>;
     /// Canonical text of every field, for cache keys and ETags.
     fn canonical(p: &Self::Params) -> String;
-    /// Render a view; `cache` is the shared pyramidal cache (modes that keep nothing ignore it).
+    /// Render a view that is not magnified (`view.zoom_in = 0`); `cache` is the shared
+    /// pyramidal cache (modes that keep nothing ignore it).
     fn render(p: &Self::Params, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered>;
+
+    /// Render `rect` magnified `k` steps beyond native (design note §1.8). By default the
+    /// native pixels are magnified bilinearly; modes that synthesize exemplar coordinates
+    /// extrapolate each texel's patch instead ([`magnify::patches`]).
+    fn magnify(p: &Self::Params, src: &Source, cache: &Pyramid, k: u32, rect: Rect) -> Result<Rendered> {
+        let native = Self::render(p, src, cache, View::native(magnify::source_rect(rect, k)))?;
+        Ok(Rendered { image: magnify::bilinear(&native.image, k, rect), synthesized: native.synthesized })
+    }
 }
 
 /// A mode as data: what the server, the CLI and the viewer describe.
@@ -201,8 +231,14 @@ macro_rules! modes {
                 }
             }
 
-            /// Render a view.
+            /// Render a view, magnified or not.
             pub fn render(&self, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
+                if view.zoom_in > 0 {
+                    magnify::check_steps(view.zoom_in)?;
+                    return match self {
+                        $(ModeParams::$variant(p) => <$module::$ty as Mode>::magnify(p, src, cache, view.zoom_in, view.rect),)+
+                    };
+                }
                 match self {
                     $(ModeParams::$variant(p) => <$module::$ty as Mode>::render(p, src, cache, view),)+
                 }

@@ -203,7 +203,7 @@ fn texels_together(
             if cancelled() {
                 return Err(CoreError::Cancelled);
             }
-            let r = params.render(src, cache, View { zoom_out: *zoom_out, rect: *rect })?;
+            let r = params.render(src, cache, View::out(*zoom_out, *rect))?;
             let out = members
                 .iter()
                 .map(|&i| {

@@ -120,6 +120,14 @@ pub async fn texture_meta(
         "native_zoom": t.native_zoom(),
         "minzoom": t.min_zoom(),
         "maxzoom": t.max_zoom(),
+        "magnification": {
+            "steps": t.max_zoom() - t.native_zoom(),
+            "method": "patch extrapolation (synth), bilinear (other modes)",
+            "detail": match &t.exemplar.hires {
+                Some(_) => format!("exemplar_hires {0}x{0}", 2 * ex.side),
+                None => "exemplar".to_string(),
+            },
+        },
         "tile_size": TILE_SIZE,
         "levels": t.native_zoom() + 1,
         "settings": settings(&t),
@@ -265,7 +273,10 @@ pub async fn tilejson(
         "bounds": [-180.0, -85.051_128_779_806_59, 180.0, 85.051_128_779_806_59],
         "center": [0.0, 0.0, t.native_zoom()],
         "tileSize": TILE_SIZE,
-        "textile": { "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.side },
+        "textile": {
+            "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.side,
+            "magnified_zooms": t.max_zoom() - t.native_zoom(),
+        },
     })))
 }
 

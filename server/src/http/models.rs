@@ -36,7 +36,8 @@ fn generator() -> String {
 }
 
 fn quad(tex: &Texture, t: &TileSpec) -> Quad {
-    let size = (TILE_SIZE << (tex.native_zoom() - t.z)) as f64;
+    // Native texels per tile side (a fraction of a tile when magnified).
+    let size = TILE_SIZE as f64 * 2f64.powi(tex.native_zoom() as i32 - t.z as i32);
     Quad { name: format!("tile {}/{}/{}", t.z, t.x, t.y), origin: (size * t.x as f64, size * t.y as f64), size }
 }
 

@@ -4,7 +4,8 @@
 //! 1. [`plan`] — which padded rectangle each level must compute for a window to be exact;
 //! 2. [`window`] — upsample, jitter by a hash of absolute coordinates, correct in subpasses
 //!    (`kernel`); `generations` and `history` share work through the pyramidal cache;
-//! 3. [`colour`] — exemplar coordinates to colours, at native or zoomed-out scale;
+//! 3. [`colour`] — exemplar coordinates to colours, at native or zoomed-out scale (magnified:
+//!    [`crate::modes::magnify::patches`]);
 //! 4. [`params`] — the validated parameters.
 
 pub mod colour;
@@ -19,7 +20,9 @@ use serde_json::{json, Map, Value};
 
 use crate::cache::Pyramid;
 use crate::error::Result;
+use crate::geom::Rect;
 use crate::image::Rendered;
+use crate::modes::magnify::{self, Detail};
 use crate::modes::params::{Common, Kind, ParamReader, ParamSpec, Scope, ONE_Q16};
 use crate::modes::{Cost, Mode, Needs, Source, View};
 
@@ -113,5 +116,17 @@ impl Mode for Synth {
 
     fn render(p: &SynthParams, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
         render_with(cache, src.analysis(Self::NAME)?, p, view.zoom_out, view.rect)
+    }
+
+    fn magnify(p: &SynthParams, src: &Source, cache: &Pyramid, k: u32, rect: Rect) -> Result<Rendered> {
+        let an = src.analysis(Self::NAME)?;
+        let sw = synthesize_with(cache, an, p, an.levels(), magnify::source_rect(rect, k))?;
+        let toroidal = an.header.toroidal;
+        let detail = match &src.exemplar.hires {
+            Some(h) => Detail { pixels: h, side: 2 * an.side(), toroidal },
+            None => Detail { pixels: &an.exemplar, side: an.side(), toroidal },
+        };
+        let image = magnify::patches(&sw.window.coords, an.side(), detail, k, rect);
+        Ok(Rendered { image, synthesized: sw.synthesized })
     }
 }
