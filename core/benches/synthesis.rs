@@ -1,6 +1,6 @@
 //! Engine benchmarks (criterion): analysis time for 64², 128² and 256² exemplars, a cold
-//! 256×256 native window (full padded pyramid, nothing cached), a zoomed-out tile, a tile
-//! magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
+//! 256×256 native window (full padded pyramid, nothing cached), the same with a randomness
+//! mask, a zoomed-out tile, a tile magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
 //! 512² windows.
 //!
 //! `cargo bench -p textile-core --bench synthesis`
@@ -58,6 +58,26 @@ fn windows(c: &mut Criterion) {
         b.iter(|| {
             i += 1;
             render(&an, &p, 1, Rect::new(256 * i, 256, 256, 256)).unwrap()
+        })
+    });
+    // The same exemplar with a randomness mask keeping a 16×16 element (a logo): its cost is
+    // the jitter's and correction's mask lookups (kept pixels skip correction).
+    let logo = |i: usize| (56..72).contains(&(i % 128)) && (56..72).contains(&(i / 128));
+    let half: Vec<[u8; 4]> = (0..128 * 128).map(|i| if logo(i) { [0, 0, 0, 255] } else { [255; 4] }).collect();
+    let masked = ex
+        .clone()
+        .with_randomness_mask(&Exemplar::from_rgba(
+            128,
+            128,
+            &half,
+            &ExemplarOptions { toroidal: Some(ex.toroidal), ..Default::default() },
+        ))
+        .expect("mask");
+    let man = Analysis::build(&masked, &NoProgress);
+    g.bench_function("cold_256_native_masked", |b| {
+        b.iter(|| {
+            i += 1;
+            render(&man, &p, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
         })
     });
     g.bench_function("cold_256_magnified_1", |b| {

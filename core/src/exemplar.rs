@@ -8,6 +8,7 @@ use image::{ImageReader, Limits};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
+use crate::mask::RandomnessMask;
 
 /// Smallest exemplar side accepted on input.
 pub const MIN_INPUT_SIDE: u32 = 16;
@@ -66,6 +67,9 @@ pub struct Exemplar {
     /// The image the exemplar was reduced from, twice as wide (`2·side` squared), when it was
     /// given ([`Exemplar::from_hires`]): magnified zooms sample their detail from it.
     pub hires: Option<Vec<[u8; 3]>>,
+    /// The randomness mask over the exemplar (`R_E`), when the texture has one
+    /// ([`Exemplar::with_randomness_mask`]).
+    pub randomness_mask: Option<RandomnessMask>,
 }
 
 impl Exemplar {
@@ -127,6 +131,7 @@ impl Exemplar {
                 toroidal_synthesized: false,
             },
             hires: None,
+            randomness_mask: None,
         }
     }
 
@@ -145,7 +150,35 @@ impl Exemplar {
         let forced = hires.preparation.toroidal_forced;
         let toroidal = if forced { hires.toroidal } else { seam_ratio <= 1.5 };
         let preparation = Preparation { side, seam_ratio, ..hires.preparation };
-        Ok(Exemplar { side, pixels, toroidal, preparation, hires: Some(hires.pixels) })
+        Ok(Exemplar { side, pixels, toroidal, preparation, hires: Some(hires.pixels), randomness_mask: None })
+    }
+
+    /// This exemplar with a randomness mask (design note §1.9, `R_E`): `mask` is the mask
+    /// image prepared like the exemplar's own image (same input size, so the same crop and
+    /// resampling; for an exemplar reduced from `exemplar_hires`, the size of that image), its
+    /// luma the mask values (white: free, black: kept as in the exemplar).
+    pub fn with_randomness_mask(mut self, mask: &Exemplar) -> Result<Exemplar> {
+        let (p, q) = (&self.preparation, &mask.preparation);
+        if (p.input_width, p.input_height) != (q.input_width, q.input_height) {
+            return Err(CoreError::Param {
+                name: "randomness_mask",
+                message: format!(
+                    "is {}x{}; it must be the size of the exemplar image, {}x{}",
+                    q.input_width, q.input_height, p.input_width, p.input_height
+                ),
+            });
+        }
+        let pixels = if mask.side == self.side {
+            mask.pixels.clone()
+        } else {
+            area_resample(&mask.pixels, mask.side as usize, self.side as usize)
+        };
+        let luma = pixels
+            .iter()
+            .map(|c| ((299 * c[0] as u32 + 587 * c[1] as u32 + 114 * c[2] as u32 + 500) / 1000) as u8)
+            .collect();
+        self.randomness_mask = Some(RandomnessMask::new(self.side, luma, self.toroidal)?);
+        Ok(self)
     }
 }
 

@@ -85,6 +85,11 @@ pub struct TextureConfig {
     /// is its 2× reduction, and magnified zooms show the image's own detail.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exemplar_hires: Option<String>,
+    /// Randomness mask over the exemplar (`R_E`): a greyscale image the size of the exemplar
+    /// image (path or `embedded:NAME`), white where synthesis moves content freely, black
+    /// where it keeps the exemplar as it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub randomness_mask: Option<String>,
     /// Toroidal flag.
     #[serde(default = "default_toroidal")]
     pub toroidal: Toroidal,
@@ -121,6 +126,7 @@ impl TextureConfig {
             name: id.into(),
             exemplar: exemplar.into(),
             exemplar_hires: None,
+            randomness_mask: None,
             toroidal: Toroidal::Auto,
             index: IndexChoice::Auto,
             default_mode: default_mode(),
@@ -139,9 +145,14 @@ impl TextureConfig {
             return bad(format!("{at}.id"), format!("'{}' must be 1-64 of a-z 0-9 _ -", clip(&self.id)));
         }
         match (self.exemplar.is_empty(), &self.exemplar_hires) {
-            (true, None) => return bad(format!("{at}.exemplar"), "is required (or exemplar_hires)".into()),
             (false, Some(_)) => {
                 return bad(format!("{at}.exemplar_hires"), "replaces exemplar: give one of the two".into())
+            }
+            _ if self.randomness_mask.is_some() && self.toroidal == Toroidal::Synthesize => {
+                return bad(
+                    format!("{at}.toroidal"),
+                    "\"synthesize\" remakes the exemplar, which randomness_mask could no longer follow".into(),
+                )
             }
             (true, Some(_)) if self.toroidal == Toroidal::Synthesize => {
                 return bad(
@@ -475,6 +486,9 @@ impl Config {
         }
         let mut seen = std::collections::HashSet::new();
         for (i, t) in self.textures.iter().enumerate() {
+            if t.exemplar.is_empty() && t.exemplar_hires.is_none() {
+                return Err(ConfigError(format!("key 'textures[{i}].exemplar': is required (or exemplar_hires)")));
+            }
             t.validate(&format!("textures[{i}]")).map_err(|(key, msg)| ConfigError(format!("key '{key}': {msg}")))?;
             if !seen.insert(&t.id) {
                 return bad(&format!("textures[{i}].id"), format!("'{}' is used twice", t.id));

@@ -96,6 +96,10 @@ impl Texture {
         for p in &exemplar.pixels {
             h.update(p);
         }
+        if let Some(mask) = &exemplar.randomness_mask {
+            h.update(b"randomness-mask");
+            h.update(mask.hash.as_bytes());
+        }
         if let Some(hires) = &exemplar.hires {
             h.update(b"hires");
             for p in hires {
@@ -119,15 +123,19 @@ impl Texture {
     /// A texture with its analysis.
     pub fn new(config: TextureConfig, index: usize, exemplar: Exemplar, analysis: Analysis) -> Result<Self, LoadError> {
         let t = Texture::prepare(config, index, exemplar)?;
-        t.set_analysis(analysis);
+        t.set_analysis(analysis).map_err(|source| LoadError::Core { id: t.config.id.clone(), source })?;
         Ok(t)
     }
 
-    /// Attach the analysis (once; later calls are ignored).
-    pub fn set_analysis(&self, analysis: Analysis) {
+    /// Attach the analysis (once; later calls are ignored), with what it keeps with the
+    /// exemplar (its randomness mask) attached to it: an analysis made for another mask is
+    /// refused.
+    pub fn set_analysis(&self, mut analysis: Analysis) -> Result<(), textile_core::CoreError> {
+        analysis.attach(&self.exemplar)?;
         let hash = analysis.file_hash();
         self.progress.store(100, Ordering::Relaxed);
         let _ = self.analysis.set((Arc::new(analysis), hash));
+        Ok(())
     }
 
     /// Where the texture stands.
@@ -264,12 +272,17 @@ pub enum LoadError {
 
 /// Read the exemplar bytes a texture config names.
 pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadError> {
-    if let Some(name) = t.image().strip_prefix("embedded:") {
+    image_bytes(cfg, t, t.image())
+}
+
+/// Read the bytes of an image a texture config names (`embedded:NAME` or a path).
+fn image_bytes(cfg: &Config, t: &TextureConfig, image: &str) -> Result<Vec<u8>, LoadError> {
+    if let Some(name) = image.strip_prefix("embedded:") {
         return embedded(name)
             .map(|b| b.to_vec())
             .ok_or_else(|| LoadError::NoEmbedded { id: t.id.clone(), name: name.into() });
     }
-    let path = cfg.base_dir.join(t.image());
+    let path = cfg.base_dir.join(image);
     // Regular files only (a FIFO or device would block the read or never end), of a bounded size.
     let meta =
         std::fs::metadata(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path: path.clone(), source })?;
@@ -322,6 +335,11 @@ pub fn prepare_texture(
     let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
     let core = |source| LoadError::Core { id: t.id.clone(), source };
     let mut ex = Exemplar::from_bytes(bytes, &opts).map_err(core)?;
+    // The mask is prepared like the exemplar's image, so that they stay aligned.
+    let mask = match &t.randomness_mask {
+        Some(path) => Some(Exemplar::from_bytes(&image_bytes(cfg, t, path)?, &opts).map_err(core)?),
+        None => None,
+    };
     if t.exemplar_hires.is_some() {
         ex = Exemplar::from_hires(ex).map_err(core)?;
         let (m, big) = (ex.side, 2 * ex.side);
@@ -335,6 +353,9 @@ pub fn prepare_texture(
             t.id,
             started.elapsed().as_secs_f64()
         ));
+    }
+    if let Some(mask) = &mask {
+        ex = ex.with_randomness_mask(mask).map_err(core)?;
     }
     let prep = &ex.preparation;
     if prep.input_width != prep.input_height || prep.crop_side != ex.side {
@@ -468,7 +489,7 @@ pub fn analyse_texture(
             a
         }
     };
-    tex.set_analysis(analysis);
+    tex.set_analysis(analysis)?;
     Ok(())
 }
 

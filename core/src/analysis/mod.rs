@@ -18,6 +18,7 @@ use crate::analysis::features::{
 use crate::analysis::stack::{build_stack, to_u8};
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
+use crate::mask::RandomnessMask;
 
 /// Version of the analysis (its content and file layout; part of the analysis id, so a change
 /// recomputes stored analyses). Each mode's output has its own version (`Mode::VERSION`).
@@ -154,6 +155,10 @@ pub struct AnalysisHeader {
     /// How the candidate sets were searched (files from before the choice existed: exact).
     #[serde(default)]
     pub index: SearchIndex,
+    /// Hash of the exemplar's randomness mask, when it has one: synthesis then needs the mask
+    /// ([`Analysis::attach`]), which is kept with the exemplar, not in the file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub randomness_mask: Option<String>,
 }
 
 /// A complete exemplar analysis.
@@ -169,6 +174,8 @@ pub struct Analysis {
     pub corrected: Vec<CorrectionLevel>,
     /// Derived: 8-bit stack colours (not stored).
     pub(crate) stack8: Vec<Vec<[u8; 3]>>,
+    /// The exemplar's randomness mask (not stored: [`Analysis::attach`]).
+    pub(crate) randomness_mask: Option<RandomnessMask>,
 }
 
 impl Analysis {
@@ -219,8 +226,10 @@ impl Analysis {
             toroidal: ex.toroidal,
             preparation: ex.preparation.clone(),
             index: search,
+            randomness_mask: ex.randomness_mask.as_ref().map(|m| m.hash.clone()),
         };
-        Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8 })
+        let randomness_mask = ex.randomness_mask.clone();
+        Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8, randomness_mask })
     }
 
     /// The analysis id an exemplar would get with the search `index` chooses: compare with a
@@ -262,7 +271,35 @@ impl Analysis {
         corrected: Vec<CorrectionLevel>,
     ) -> Analysis {
         let stack8 = derive_stack8(&stack);
-        Analysis { header, exemplar, stack, corrected, stack8 }
+        Analysis { header, exemplar, stack, corrected, stack8, randomness_mask: None }
+    }
+
+    /// Attach what an analysis read from a file keeps with the exemplar instead (its
+    /// randomness mask), from the exemplar it was made for; an exemplar whose mask differs
+    /// from the one the analysis was made with is refused.
+    pub fn attach(&mut self, ex: &Exemplar) -> Result<()> {
+        let hash = ex.randomness_mask.as_ref().map(|m| m.hash.clone());
+        if hash != self.header.randomness_mask {
+            return Err(CoreError::Param {
+                name: "randomness_mask",
+                message: "differs from the one the analysis was made with".into(),
+            });
+        }
+        self.randomness_mask = ex.randomness_mask.clone();
+        Ok(())
+    }
+
+    /// The randomness mask synthesis scales jitter by: `Ok(None)` without one, an error when
+    /// the analysis was made with a mask that was not [`Analysis::attach`]ed.
+    pub fn randomness_mask(&self) -> Result<Option<&RandomnessMask>> {
+        match (&self.header.randomness_mask, &self.randomness_mask) {
+            (None, _) => Ok(None),
+            (Some(_), Some(m)) => Ok(Some(m)),
+            (Some(_), None) => Err(CoreError::Param {
+                name: "randomness_mask",
+                message: "the analysis was made with a randomness mask that is not attached (Analysis::attach)".into(),
+            }),
+        }
     }
 }
 
@@ -286,6 +323,10 @@ fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
     h.update(&[ex.toroidal as u8]);
     for p in &ex.pixels {
         h.update(p);
+    }
+    if let Some(mask) = &ex.randomness_mask {
+        h.update(b"randomness-mask");
+        h.update(mask.hash.as_bytes());
     }
     // The image magnified zooms sample (only when given, so other ids are unchanged).
     if let Some(hires) = &ex.hires {

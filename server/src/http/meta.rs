@@ -112,6 +112,7 @@ pub async fn texture_meta(
             "input_width": prep.input_width, "input_height": prep.input_height,
             "crop_side": prep.crop_side, "toroidal_forced": prep.toroidal_forced,
             "toroidal_synthesized": prep.toroidal_synthesized,
+            "randomness_mask": ex.randomness_mask.is_some(),
         },
         "analysis": analysis,
         "modes": MODE_NAMES,

@@ -15,6 +15,7 @@ use crate::analysis::features::TAPS5;
 use super::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash, TAG_JITTER};
+use crate::mask::RandomnessMask;
 use super::history::{block_index, capture, for_rows, overlay, pending};
 use super::kernel::{projection_pairs, projection_run_pairs, tap_spans, Kernel};
 use super::params::SynthParams;
@@ -101,7 +102,7 @@ pub fn synthesize_with(
             message: format!("must be non-empty with at most {MAX_WINDOW_PIXELS} pixels"),
         });
     }
-    let ctx = Ctx::new(an, params, pyr);
+    let ctx = Ctx::new(an, params, pyr, an.randomness_mask()?);
     let mut synthesized = 0;
     let buf = ctx.level(level, rect, &mut synthesized);
     Ok(Synthesized { window: CoordWindow { level, rect, coords: buf.s }, synthesized })
@@ -126,11 +127,14 @@ struct Ctx<'a> {
     period: Option<i64>,
     m: i64,
     levels: u32,
+    /// The randomness mask over the exemplar (`R_E`), scaling jitter.
+    mask: Option<&'a RandomnessMask>,
 }
 
 impl<'a> Ctx<'a> {
-    fn new(an: &'a Analysis, p: &SynthParams, pyr: &'a Pyramid) -> Self {
+    fn new(an: &'a Analysis, p: &SynthParams, pyr: &'a Pyramid, mask: Option<&'a RandomnessMask>) -> Self {
         Ctx {
+            mask,
             an,
             pyr,
             stream: StreamId::new(&format!("{}|v{}|{}|{}", Synth::NAME, Synth::VERSION, an.header.id, p.canonical())),
@@ -240,9 +244,11 @@ impl<'a> Ctx<'a> {
                 let (sr, colr) = (&s, &col);
                 out.par_chunks_mut(cols.max(1)).zip(rows.par_iter()).with_min_len(4).for_each(|(orow, &j)| {
                     let base = (oy + j) * w + ox + c0;
+                    // R_E: a pixel showing a kept (black) part of the exemplar stays as it is.
+                    let kept = |v: u32| self.mask.is_some_and(|mk| mk.at(l, v & 0xFFFF, v >> 16) == 0);
                     let todo = |c: usize| {
                         let p = base + c * step;
-                        top[p] >= k8 && lo[p] < k8
+                        top[p] >= k8 && lo[p] < k8 && !kept(sr[p])
                     };
                     let mut c = 0;
                     while c < cols {
@@ -256,6 +262,16 @@ impl<'a> Ctx<'a> {
                             c += 1;
                         }
                         kern.row(sr, colr, base + start * step, step, &mut orow[start..c]);
+                    }
+                    // Nor is any other pixel corrected into one: kept parts arrive whole, by
+                    // upsampling, never texel by texel.
+                    if self.mask.is_some() {
+                        for (c, o) in orow.iter_mut().enumerate() {
+                            let v = sr[base + c * step];
+                            if *o != v && kept(*o) {
+                                *o = v;
+                            }
+                        }
                     }
                 });
                 for (orow, &j) in out.chunks(cols.max(1)).zip(&rows) {
@@ -317,7 +333,13 @@ impl<'a> Ctx<'a> {
         };
         let mut sx = (v & 0xFFFF) as i64 + off(par(x));
         let mut sy = (v >> 16) as i64 + off(par(y));
-        if c.rq != 0 {
+        // R_E (design note §1.9): the mask's minimum around the upsampled coordinate scales
+        // this level's randomness (0 keeps the exemplar there).
+        let rq = match self.mask {
+            Some(mk) if c.rq != 0 => (c.rq * mk.at(c.l, (sx & c.mask) as u32, (sy & c.mask) as u32) as i64 + 127) / 255,
+            _ => c.rq,
+        };
+        if rq != 0 {
             let (hx_, hy_) = match c.period {
                 Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
                 None => (x, y),
@@ -325,8 +347,12 @@ impl<'a> Ctx<'a> {
             let z = hash(TAG_JITTER, self.seed, c.l as i64, hx_, hy_);
             let hx = ((z >> 40) as i64) - (1 << 23);
             let hy = (((z >> 16) & 0xFF_FFFF) as i64) - (1 << 23);
-            sx += (h * hx * c.rq + (1 << 38)) >> 39;
-            sy += (h * hy * c.rq + (1 << 38)) >> 39;
+            let (jx, jy) = (sx + ((h * hx * rq + (1 << 38)) >> 39), sy + ((h * hy * rq + (1 << 38)) >> 39));
+            // Nor does a jump land inside a kept part (it would show it cut).
+            let lands_kept = self.mask.is_some_and(|mk| mk.at(c.l, (jx & c.mask) as u32, (jy & c.mask) as u32) == 0);
+            if !lands_kept {
+                (sx, sy) = (jx, jy);
+            }
         }
         ((sx & c.mask) | ((sy & c.mask) << 16)) as u32
     }

@@ -1,0 +1,64 @@
+//! Controls of synthesis that belong to a texture (design note §1.9), through the real binary:
+//! a randomness mask (`randomness_mask`, R_E) configured beside the exemplar — black keeps the
+//! exemplar as it is, so an all-black mask serves the tiling; the mask is part of the texture's
+//! identity (ETags, metadata); a mask of the wrong size is a clear configuration error.
+
+mod support;
+
+use support::{binary, Server};
+
+/// Write a 128×128 greyscale mask (`value(x, y)`) into `dir` as `name`.
+fn mask(dir: &std::path::Path, name: &str, side: u32, value: impl Fn(u32, u32) -> u8) {
+    image::GrayImage::from_fn(side, side, |x, y| image::Luma([value(x, y)])).save(dir.join(name)).unwrap();
+}
+
+#[tokio::test]
+async fn a_randomness_mask_keeps_black_parts_of_the_exemplar_and_is_part_of_the_identity() {
+    let dir = tempfile::tempdir().unwrap();
+    mask(dir.path(), "black.png", 128, |_, _| 0);
+    mask(dir.path(), "half.png", 128, |x, _| if x < 64 { 0 } else { 255 });
+    mask(dir.path(), "small.png", 64, |_, _| 0);
+    let texture =
+        |id: &str, extra: &str| format!("[[textures]]\nid = \"{id}\"\nexemplar = \"embedded:gravel.png\"\n{extra}\n\n");
+    let cfg = dir.path().join("textile.toml");
+    let text = texture("plain", "")
+        + &texture("black", "randomness_mask = \"black.png\"\ntoroidal = \"true\"")
+        + &texture("half", "randomness_mask = \"half.png\"");
+    std::fs::write(&cfg, text).unwrap();
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    assert_eq!(s.json("/textures/half").await["exemplar"]["randomness_mask"], true);
+    assert_eq!(s.json("/textures/plain").await["exemplar"]["randomness_mask"], false);
+    // All black: nothing moves, the synthesis of a toroidal exemplar is the exemplar tiled.
+    for (z, x, y) in [(7, -3, 2), (6, 1, 1)] {
+        let synth = s.image(&format!("/tiles/black/{z}/{x}/{y}.png")).await;
+        let tiling = s.image(&format!("/tiles/black/{z}/{x}/{y}.png?mode=tiling")).await;
+        assert!(synth == tiling, "z {z}: an all-black mask differs from the tiling");
+    }
+    // A mask changes the texture (and its ETags); the cheap modes are unaffected by it.
+    let (a, b) = (s.get("/tiles/plain/7/0/0.png").await, s.get("/tiles/half/7/0/0.png").await);
+    assert_ne!(a.headers()["etag"], b.headers()["etag"]);
+    assert_ne!(a.bytes().await.unwrap(), b.bytes().await.unwrap());
+    assert_eq!(
+        s.get_bytes("/tiles/plain/7/0/0.png?mode=mosaic").await.1,
+        s.get_bytes("/tiles/half/7/0/0.png?mode=mosaic").await.1
+    );
+    // Windows are still the same pixels as the tiles they cover.
+    let mut stitched = image::RgbImage::new(512, 256);
+    for i in 0..2 {
+        let tile = s.image(&format!("/tiles/half/7/{}/-1.png", 5 + i)).await;
+        support::paste(&mut stitched, &tile, 256 * i, 0);
+    }
+    assert!(stitched == s.image("/windows/half.png?x=1280&y=-256&w=512&h=256").await);
+    // A mask that is not the exemplar's size is refused, naming it.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, texture("x", "randomness_mask = \"small.png\"")).unwrap();
+    let out = dir.path().join("x.png");
+    let run = std::process::Command::new(binary())
+        .args(["render", "--config", bad.to_str().unwrap(), "--texture", "x", "--x", "0", "--y", "0"])
+        .args(["-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && err.contains("randomness_mask") && err.contains("128x128"), "{err}");
+    assert!(!out.exists());
+}
