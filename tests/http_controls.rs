@@ -1,7 +1,9 @@
-//! Controls of synthesis that belong to a texture (design note §1.9), through the real binary:
-//! a randomness mask (`randomness_mask`, R_E) configured beside the exemplar — black keeps the
-//! exemplar as it is, so an all-black mask serves the tiling; the mask is part of the texture's
-//! identity (ETags, metadata); a mask of the wrong size is a clear configuration error.
+//! Controls of synthesis (design note §1.9), through the real binary: a texture's randomness
+//! mask (`randomness_mask`, R_E) configured beside the exemplar — black keeps the exemplar as it
+//! is, so an all-black mask serves the tiling; the mask is part of the texture's identity
+//! (ETags, metadata); a mask of the wrong size is a clear configuration error — and a request's
+//! `controls` (R_S: noise and strokes) in the URL: canonical, stitched, refused when malformed,
+//! and the same from `textile render --controls`.
 
 mod support;
 
@@ -61,4 +63,58 @@ async fn a_randomness_mask_keeps_black_parts_of_the_exemplar_and_is_part_of_the_
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success() && err.contains("randomness_mask") && err.contains("128x128"), "{err}");
     assert!(!out.exists());
+}
+
+fn encode(json: &str) -> String {
+    use base64::Engine;
+    base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(json)
+}
+
+#[tokio::test]
+async fn request_controls_modulate_randomness_in_the_url_and_in_the_cli() {
+    let s = Server::builder().start();
+    let spec = &s.json("/textures/gravel").await["parameters"]["controls"];
+    assert_eq!(spec["type"], "text", "{spec}");
+    // A stroke straddling the border of tiles (0,0) and (1,0), over noise.
+    let json = r#"{"noise": {"scale": 64, "range": [0.2, 1]}, "strokes": [{"at": [256, 100], "radius": 30, "soft": 20, "value": 0}]}"#;
+    let same =
+        r#"{"strokes":[{"value":0.0,"soft":20,"radius":30,"at":[256,100]}],"noise":{"range":[0.20,1.0],"scale":64}}"#;
+    let (c, c2) = (encode(json), encode(same));
+    let plain = s.get("/tiles/gravel/7/0/0.png").await;
+    let with = s.get(&format!("/tiles/gravel/7/0/0.png?controls={c}")).await;
+    assert_eq!(with.status(), 200);
+    let etag = with.headers()["etag"].clone();
+    assert_ne!(plain.headers()["etag"], etag);
+    let bytes = with.bytes().await.unwrap();
+    assert_ne!(plain.bytes().await.unwrap(), bytes);
+    // The same controls written otherwise are the same request.
+    let again = s.get(&format!("/tiles/gravel/7/0/0.png?controls={c2}")).await;
+    assert_eq!(again.headers()["etag"], etag);
+    assert_eq!(again.bytes().await.unwrap(), bytes);
+    // Tiles under the stroke are one window.
+    let mut stitched = image::RgbImage::new(512, 256);
+    for i in 0..2 {
+        let tile = s.image(&format!("/tiles/gravel/7/{i}/0.png?controls={c}")).await;
+        support::paste(&mut stitched, &tile, 256 * i, 0);
+    }
+    assert!(stitched == s.image(&format!("/windows/gravel.png?x=0&y=0&w=512&h=256&controls={c}")).await);
+    // Bad controls: 400 naming the parameter.
+    for bad in ["%%%".to_string(), encode(r#"{"strokes": 3}"#), "A".repeat(3000)] {
+        let r = s.get(&format!("/tiles/gravel/7/0/0.png?controls={bad}")).await;
+        assert_eq!(r.status(), 400, "{bad}");
+        let body: serde_json::Value = r.json().await.unwrap();
+        assert!(body["message"].as_str().unwrap().contains("controls"), "{body}");
+    }
+    // `textile render --controls FILE.json` renders what the server serves.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("c.json"), json).unwrap();
+    let out = dir.path().join("t.png");
+    let data = support::shared_data_dir();
+    let run = std::process::Command::new(binary())
+        .args(["render", "--texture", "gravel", "--x", "0", "--y", "0", "--data-dir", data.to_str().unwrap()])
+        .args(["--controls", dir.path().join("c.json").to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_eq!(std::fs::read(&out).unwrap(), bytes.to_vec());
 }

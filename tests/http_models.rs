@@ -141,7 +141,7 @@ async fn x3d_is_well_formed_and_points_at_the_tile() {
 async fn bad_model_requests_are_json_4xx() {
     let s = Server::builder().start();
     for (path, status, code) in [
-        ("/gltf/gravel/8/0/0.glb", 400, "invalid_coordinate"),
+        ("/gltf/gravel/11/0/0.glb", 400, "invalid_coordinate"),
         ("/gltf/gravel/7/x/0.glb", 400, "invalid_coordinate"),
         ("/gltf/gravel/7/0/0.obj", 400, "invalid_format"),
         ("/gltf/nosuch/7/0/0.glb", 404, "unknown_texture"),

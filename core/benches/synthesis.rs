@@ -1,6 +1,6 @@
 //! Engine benchmarks (criterion): analysis time for 64², 128² and 256² exemplars, a cold
 //! 256×256 native window (full padded pyramid, nothing cached), the same with a randomness
-//! mask, a zoomed-out tile, a tile magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
+//! mask and with request controls (noise and 64 strokes), a zoomed-out tile, a tile magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
 //! 512² windows.
 //!
 //! `cargo bench -p textile-core --bench synthesis`
@@ -10,6 +10,7 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use textile_core::modes::mosaic::MosaicParams;
+use textile_core::modes::synth::controls::Controls;
 use textile_core::modes::synth::{render, Synth, SynthParams};
 use textile_core::{Analysis, Exemplar, ExemplarOptions, Mode, NoProgress, Pyramid, Rect, Source};
 
@@ -78,6 +79,19 @@ fn windows(c: &mut Criterion) {
         b.iter(|| {
             i += 1;
             render(&man, &p, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
+        })
+    });
+    // Request controls (R_S): noise and 64 strokes, evaluated per jittered pixel.
+    let strokes: Vec<String> = (0..64)
+        .map(|k| format!(r#"{{"at": [{}, {}], "radius": 20, "soft": 10, "value": 0.2}}"#, (k % 8) * 32, (k / 8) * 32))
+        .collect();
+    let json = format!(r#"{{"noise": {{"scale": 64, "range": [0.3, 1]}}, "strokes": [{}]}}"#, strokes.join(","));
+    let mut pc = p.clone();
+    pc.controls = Controls::from_json(&serde_json::from_str(&json).expect("json")).expect("controls");
+    g.bench_function("cold_256_native_controls", |b| {
+        b.iter(|| {
+            i += 1;
+            render(&an, &pc, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
         })
     });
     g.bench_function("cold_256_magnified_1", |b| {

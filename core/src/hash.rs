@@ -4,6 +4,8 @@
 
 /// Domain tag for per-pixel jitter (§1.3).
 pub const TAG_JITTER: u64 = 0x4A49_5454_4552_0001;
+/// Domain tag for the lattice values of the randomness modulation's noise (§1.9).
+pub const TAG_NOISE: u64 = 0x4E4F_4953_4500_0001;
 
 /// SplitMix64 finaliser: full avalanche on 64 bits.
 #[inline]

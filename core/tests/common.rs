@@ -67,3 +67,13 @@ pub fn small() -> &'static Analysis {
     static A: OnceLock<Analysis> = OnceLock::new();
     A.get_or_init(|| Analysis::build(small_exemplar(), &NoProgress))
 }
+
+/// The `w × h` part of `img` at `(x, y)`.
+pub fn crop(img: &textile_core::RgbWindow, x: u32, y: u32, w: u32, h: u32) -> textile_core::RgbWindow {
+    let mut pixels = Vec::new();
+    for j in y..y + h {
+        let s = 3 * (j * img.width + x) as usize;
+        pixels.extend_from_slice(&img.pixels[s..s + 3 * w as usize]);
+    }
+    textile_core::RgbWindow { width: w, height: h, pixels }
+}

@@ -15,15 +15,6 @@ fn render(mode: &str, view: View) -> RgbWindow {
     p.render(&src, &Pyramid::off(), view).unwrap().image
 }
 
-fn crop(img: &RgbWindow, x: u32, y: u32, w: u32, h: u32) -> RgbWindow {
-    let mut pixels = Vec::new();
-    for j in y..y + h {
-        let s = 3 * (j * img.width + x) as usize;
-        pixels.extend_from_slice(&img.pixels[s..s + 3 * w as usize]);
-    }
-    RgbWindow { width: w, height: h, pixels }
-}
-
 #[test]
 fn magnified_windows_equal_the_same_pixels_of_a_larger_one_in_every_mode() {
     for mode in ["synth", "mosaic", "tiling"] {
@@ -37,7 +28,7 @@ fn magnified_windows_equal_the_same_pixels_of_a_larger_one_in_every_mode() {
                     let part = render(mode, View::at(-(k as i64), Rect::new(x0 + px, y0 + py, pw, ph)));
                     assert_eq!(
                         part,
-                        crop(&whole, px as u32, py as u32, pw as u32, ph as u32),
+                        common::crop(&whole, px as u32, py as u32, pw as u32, ph as u32),
                         "{mode} k {k} at {x0},{y0}"
                     );
                 }

@@ -178,6 +178,11 @@ pub struct RenderArgs {
     /// Period in native tiles (power of two): periodic, seamless output.
     #[arg(long)]
     pub world: Option<u64>,
+    /// Spatial controls (synth's `controls`) from a JSON file: `{"noise": {"scale": 64,
+    /// "range": [0.2, 1]}, "strokes": [{"at": [x, y], "radius": 40, "soft": 8, "value": 0}]}`;
+    /// renders what the server serves for the same file's base64url as `controls=`.
+    #[arg(long, value_name = "FILE.json")]
+    pub controls: Option<PathBuf>,
     /// A parameter of the mode, as in a query string or a texture's configuration (repeatable):
     /// e.g. `--param randomness=0.5`, `--param kappa=0.8`, `--param passes=0` (synth),
     /// `--param iterations=0` (mosaic). `textile render --list-params` lists them all.

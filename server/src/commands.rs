@@ -5,6 +5,7 @@
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 
+use base64::Engine;
 use indicatif::{ProgressBar, ProgressStyle};
 use textile_core::modes::params::{Scope, COMMON};
 use textile_core::samples::{self, camera::GroundCamera, Footprint};
@@ -179,7 +180,15 @@ pub fn render(a: RenderArgs) -> CliResult {
         configured_texture(&a.config, a.texture.as_deref().unwrap_or_default())?
     };
     // The flags and `--param` pairs are read like a query string, with texture settings allowed.
-    let pairs = param_pairs(&a.params, &a.mode, a.seed, a.world)?;
+    let mut pairs = param_pairs(&a.params, &a.mode, a.seed, a.world)?;
+    if let Some(file) = &a.controls {
+        let text = std::fs::read(file).map_err(|e| format!("--controls {}: {e}", file.display()))?;
+        let json: serde_json::Value =
+            serde_json::from_slice(&text).map_err(|e| format!("--controls {}: not JSON: {e}", file.display()))?;
+        // As a client would send it: compact JSON, base64url.
+        let compact = serde_json::to_vec(&json).map_err(|e| e.to_string())?;
+        pairs.push(("controls".into(), base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(compact)));
+    }
     let params = tex.defaults.request(&tex.source(), ParamReader::texture(pairs)?)?;
     let z = a.z.unwrap_or(tex.native_zoom());
     if z > tex.max_zoom() {

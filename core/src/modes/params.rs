@@ -65,6 +65,12 @@ pub enum Kind {
         /// Largest value.
         max: f64,
     },
+    /// Structured text checked by its mode (e.g. synth's `controls`), at most `max_len`
+    /// characters.
+    Text {
+        /// Longest value.
+        max_len: u64,
+    },
 }
 
 /// One parameter: its name as the API spells it, its type and range, where it may be given, and
@@ -91,6 +97,7 @@ impl ParamSpec {
             Kind::Unit => json!({ "type": "number", "min": 0.0, "max": 1.0 }),
             Kind::Levels => json!({ "type": "levels", "min": 0.0, "max": 1.0 }),
             Kind::Interval { min, max } => json!({ "type": "interval", "min": min, "max": max }),
+            Kind::Text { max_len } => json!({ "type": "text", "max_length": max_len }),
         };
         v["scope"] = json!(match self.scope {
             Scope::Request => "request",
@@ -110,6 +117,8 @@ impl ParamSpec {
             Kind::Unit => self.unit(s).map(drop),
             Kind::Levels => s.split(',').try_for_each(|v| self.unit(v).map(drop)),
             Kind::Interval { .. } => self.interval_milli(s).map(drop),
+            Kind::Text { max_len } if s.len() as u64 <= max_len => Ok(()),
+            Kind::Text { max_len } => Err(self.error(format!("is {} characters; at most {max_len}", s.len()))),
         }
     }
 

@@ -60,13 +60,16 @@ fn parameter(spec: &ParamSpec, modes: &[&str]) -> Parameter {
             schema.schema_type(Type::Integer).minimum(Some(min as f64)).maximum(Some(max as f64))
         }
         Kind::Unit => schema.schema_type(Type::Number).minimum(Some(0.0)).maximum(Some(1.0)),
-        Kind::Levels | Kind::Interval { .. } => schema.schema_type(Type::String),
+        Kind::Levels | Kind::Interval { .. } | Kind::Text { .. } => schema.schema_type(Type::String),
     };
     let applies = if modes.is_empty() { String::new() } else { format!(" (mode={})", modes.join(", mode=")) };
     let shape = match spec.kind {
         Kind::Levels => " One value in [0, 1], or a comma list of one per level, coarse to fine.".to_string(),
         Kind::Interval { min, max } => format!(" LOW,HIGH with {min} <= LOW <= HIGH <= {max}."),
         Kind::PowerOfTwo { .. } => " A power of two.".to_string(),
+        // The length is checked by the server (400), not declared: a longer query is a 414 the
+        // URL limit answers before any parameter is read.
+        Kind::Text { max_len } => format!(" At most {max_len} characters."),
         _ => String::new(),
     };
     ParameterBuilder::new()

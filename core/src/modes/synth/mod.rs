@@ -9,6 +9,7 @@
 //! 4. [`params`] — the validated parameters.
 
 pub mod colour;
+pub mod controls;
 mod generations;
 mod history;
 mod kernel;
@@ -39,6 +40,12 @@ const RANDOMNESS: ParamSpec = ParamSpec {
     scope: Scope::Request,
     help: "jitter strength per synthesis level: one value in [0, 1] for every level, or a comma list of one per level, coarse to fine",
 };
+const CONTROLS: ParamSpec = ParamSpec {
+    name: "controls",
+    kind: Kind::Text { max_len: controls::MAX_CONTROLS_LEN as u64 },
+    scope: Scope::Request,
+    help: "spatial modulation of randomness over the output (R_S): base64url of JSON {\"noise\": {\"scale\": 64, \"range\": [0.2, 1]}, \"strokes\": [{\"at\": [x, y], \"radius\": 40, \"soft\": 8, \"value\": 0}]} (native texels; values in [0, 1]: 0 calm, 1 the full randomness; at most 64 strokes)",
+};
 const KAPPA: ParamSpec = ParamSpec {
     name: "kappa",
     kind: Kind::Unit,
@@ -57,7 +64,7 @@ const SUBPASSES: ParamSpec = ParamSpec {
     scope: Scope::Texture,
     help: "subpasses per pass: 4 (parity classes, the paper's order) or 1 (all pixels at once)",
 };
-const SPECS: &[ParamSpec] = &[RANDOMNESS, KAPPA, PASSES, SUBPASSES];
+const SPECS: &[ParamSpec] = &[RANDOMNESS, KAPPA, PASSES, SUBPASSES, CONTROLS];
 
 /// A fixed-point value in `[0, 1]` as a short decimal (4 places: no float noise).
 fn unit_value(v: u32) -> f64 {
@@ -86,6 +93,9 @@ impl Mode for Synth {
         if let Some(s) = r.get(&RANDOMNESS) {
             p.randomness = Randomness::parse(&s)?;
         }
+        if let Some(s) = r.get(&CONTROLS) {
+            p.controls = controls::Controls::parse(&s)?;
+        }
         if let Some(s) = r.get(&KAPPA) {
             p.kappa = KAPPA.unit(&s)?;
         }
@@ -105,6 +115,7 @@ impl Mode for Synth {
         m.insert("seed".into(), json!(p.seed));
         m.insert(RANDOMNESS.name.into(), json!(r));
         m.insert(KAPPA.name.into(), json!(unit_value(p.kappa)));
+        m.insert(CONTROLS.name.into(), p.controls.to_json());
         m.insert(PASSES.name.into(), json!(p.passes));
         m.insert(SUBPASSES.name.into(), json!(p.subpasses));
         m

@@ -5,6 +5,8 @@ use crate::analysis::FIRST_CORRECTED_LEVEL;
 use crate::error::{CoreError, Result};
 use crate::modes::params::{check_period, parse_unit, ONE_Q16};
 
+use super::controls::Controls;
+
 /// Largest number of correction passes accepted.
 pub const MAX_PASSES: u32 = 4;
 
@@ -88,6 +90,8 @@ pub struct SynthParams {
     pub kappa: u32,
     /// Optional period in texels (a power of two ≥ the exemplar side): periodic output.
     pub period: Option<i64>,
+    /// Spatial modulation of randomness over the output (`R_S`), from the request.
+    pub controls: Controls,
 }
 
 impl Default for SynthParams {
@@ -99,6 +103,7 @@ impl Default for SynthParams {
             subpasses: 4,
             kappa: ONE_Q16,
             period: None,
+            controls: Controls::default(),
         }
     }
 }
@@ -133,12 +138,13 @@ impl SynthParams {
             return Err(CoreError::Param { name: "kappa", message: "must be in [0, 1]".into() });
         }
         check_period(self.period, side)?;
+        self.controls.check_period(self.period)?;
         Ok(())
     }
 
     /// Canonical text form of every field, for cache keys and ETags.
     pub fn canonical(&self) -> String {
-        format!(
+        let base = format!(
             "seed={};r={};passes={};sub={};kappa={};period={}",
             self.seed,
             self.randomness.canonical(),
@@ -146,7 +152,12 @@ impl SynthParams {
             self.subpasses,
             self.kappa,
             self.period.map(|p| p.to_string()).unwrap_or_else(|| "none".into())
-        )
+        );
+        // Only when given, so that every other request keeps its identity.
+        match self.controls.is_empty() {
+            true => base,
+            false => format!("{base};controls={}", self.controls.canonical()),
+        }
     }
 
     /// Candidate weights `φ_1 = 2^16`, `φ_2 = (1+κ)²·2^16`, in integer arithmetic.

@@ -16,6 +16,8 @@ use super::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash, TAG_JITTER};
 use crate::mask::RandomnessMask;
+use crate::modes::params::ONE_Q16;
+use super::controls::Controls;
 use super::history::{block_index, capture, for_rows, overlay, pending};
 use super::kernel::{projection_pairs, projection_run_pairs, tap_spans, Kernel};
 use super::params::SynthParams;
@@ -129,12 +131,15 @@ struct Ctx<'a> {
     levels: u32,
     /// The randomness mask over the exemplar (`R_E`), scaling jitter.
     mask: Option<&'a RandomnessMask>,
+    /// The request's modulation over the output (`R_S`), scaling jitter.
+    controls: Controls,
 }
 
 impl<'a> Ctx<'a> {
     fn new(an: &'a Analysis, p: &SynthParams, pyr: &'a Pyramid, mask: Option<&'a RandomnessMask>) -> Self {
         Ctx {
             mask,
+            controls: p.controls.clone(),
             an,
             pyr,
             stream: StreamId::new(&format!("{}|v{}|{}|{}", Synth::NAME, Synth::VERSION, an.header.id, p.canonical())),
@@ -202,6 +207,7 @@ impl<'a> Ctx<'a> {
 
         // Generation 0: upsample the parents and jitter, or take the cached values.
         let lc = self.level_consts(l);
+        let rs = Modulation::over(&self.controls, ext, lc.h, self.period);
         let mut s = vec![0u32; lo.len()];
         s.par_chunks_mut(w).enumerate().with_min_len(8).for_each(|(j, row)| {
             let y = ext.y0 + j as i64;
@@ -214,7 +220,7 @@ impl<'a> Ctx<'a> {
                 if trow[i] >= 0 && lrow[i] < 0 {
                     let x = ext.x0 + i as i64;
                     let v = prow.map_or(0, |(pr, px0)| pr[(fl2(x) - px0) as usize]);
-                    *out = self.jitter(&lc, x, y, v);
+                    *out = self.jitter(&lc, x, y, v, rs.at(x, y));
                 }
             }
         });
@@ -318,7 +324,7 @@ impl<'a> Ctx<'a> {
     /// Generation 0 of pixel `(x, y)`: its parent's coordinate `v` shifted to the child's
     /// position, plus the hash jitter of its absolute position.
     #[inline]
-    fn jitter(&self, c: &LevelConsts, x: i64, y: i64, v: u32) -> u32 {
+    fn jitter(&self, c: &LevelConsts, x: i64, y: i64, v: u32, rs: i64) -> u32 {
         let h = c.h;
         let off = |d: i64| -> i64 {
             if h >= 2 {
@@ -339,6 +345,8 @@ impl<'a> Ctx<'a> {
             Some(mk) if c.rq != 0 => (c.rq * mk.at(c.l, (sx & c.mask) as u32, (sy & c.mask) as u32) as i64 + 127) / 255,
             _ => c.rq,
         };
+        // R_S: the request's modulation around the pixel (see `Modulation`).
+        let rq = rq * rs / ONE_Q16 as i64;
         if rq != 0 {
             let (hx_, hy_) = match c.period {
                 Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
@@ -390,6 +398,46 @@ impl<'a> Ctx<'a> {
 }
 
 /// Per-level constants of generation 0.
+/// The request's modulation `R_S` over a level's rectangle: one value per block of
+/// [`MOD_BLOCK`]² pixels (blocks aligned to absolute multiples), taken at the block's centre —
+/// a pure function of absolute coordinates, evaluated once per block instead of per pixel.
+struct Modulation {
+    /// Blocks covered, in block units; empty without controls.
+    blocks: Rect,
+    values: Vec<i64>,
+}
+
+/// Side of the blocks `R_S` is evaluated on, in pixels of a level.
+const MOD_BLOCK: i64 = 4;
+
+impl Modulation {
+    fn over(controls: &Controls, rect: Rect, h: i64, period: Option<i64>) -> Modulation {
+        if controls.is_empty() {
+            return Modulation { blocks: Rect::new(0, 0, 0, 0), values: Vec::new() };
+        }
+        let (bx0, by0) = (rect.x0.div_euclid(MOD_BLOCK), rect.y0.div_euclid(MOD_BLOCK));
+        let (bx1, by1) = ((rect.x1 - 1).div_euclid(MOD_BLOCK) + 1, (rect.y1 - 1).div_euclid(MOD_BLOCK) + 1);
+        let blocks = Rect::new(bx0, by0, bx1 - bx0, by1 - by0);
+        // The block's centre in native texels.
+        let centre = |b: i64| (b * MOD_BLOCK + MOD_BLOCK / 2) * h;
+        let values = (by0..by1)
+            .flat_map(|by| (bx0..bx1).map(move |bx| (bx, by)))
+            .map(|(bx, by)| controls.at(centre(bx), centre(by), period))
+            .collect();
+        Modulation { blocks, values }
+    }
+
+    /// `R_S` (fixed point) for level pixel `(x, y)` inside the rectangle; 1 without controls.
+    #[inline]
+    fn at(&self, x: i64, y: i64) -> i64 {
+        if self.values.is_empty() {
+            return ONE_Q16 as i64;
+        }
+        let (bx, by) = (x.div_euclid(MOD_BLOCK) - self.blocks.x0, y.div_euclid(MOD_BLOCK) - self.blocks.y0);
+        self.values[(by * self.blocks.width() + bx) as usize]
+    }
+}
+
 struct LevelConsts {
     l: u32,
     h: i64,
