@@ -2,8 +2,9 @@
 //! mask (`randomness_mask`, R_E) configured beside the exemplar — black keeps the exemplar as it
 //! is, so an all-black mask serves the tiling; the mask is part of the texture's identity
 //! (ETags, metadata); a mask of the wrong size is a clear configuration error — and a request's
-//! `controls` (R_S: noise and strokes) in the URL: canonical, stitched, refused when malformed,
-//! and the same from `textile render --controls`.
+//! `controls` (R_S: noise and strokes; dropped features) in the URL: canonical, stitched,
+//! refused when malformed, a feature's disc the exemplar itself, and the same from
+//! `textile render --controls`.
 
 mod support;
 
@@ -104,6 +105,24 @@ async fn request_controls_modulate_randomness_in_the_url_and_in_the_cli() {
         assert_eq!(r.status(), 400, "{bad}");
         let body: serde_json::Value = r.json().await.unwrap();
         assert!(body["message"].as_str().unwrap().contains("controls"), "{body}");
+    }
+    // A feature dropped across the border of two tiles: within its inner radius, the exemplar
+    // around its source, texel for texel, on both tiles.
+    let ex = s.image("/textures/gravel/exemplar.png").await;
+    let f = encode(r#"{"features": [{"at": [256, 60], "source": [64, 64], "inner": 12, "outer": 40}]}"#);
+    let tiles = [
+        s.image(&format!("/tiles/gravel/7/0/0.png?controls={f}")).await,
+        s.image(&format!("/tiles/gravel/7/1/0.png?controls={f}")).await,
+    ];
+    for dy in -11i64..=11 {
+        for dx in -11i64..=11 {
+            if dx * dx + dy * dy >= 144 {
+                continue;
+            }
+            let (x, y) = (256 + dx, 60 + dy);
+            let got = tiles[(x / 256) as usize].get_pixel((x % 256) as u32, y as u32);
+            assert_eq!(got, ex.get_pixel((64 + dx) as u32, (64 + dy) as u32), "({dx}, {dy})");
+        }
     }
     // `textile render --controls FILE.json` renders what the server serves.
     let dir = tempfile::tempdir().unwrap();

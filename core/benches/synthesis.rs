@@ -81,18 +81,29 @@ fn windows(c: &mut Criterion) {
             render(&man, &p, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
         })
     });
-    // Request controls (R_S): noise and 64 strokes, evaluated per jittered pixel.
+    // Request controls: noise and 64 strokes (R_S), and 32 features, all on one tile.
     let strokes: Vec<String> = (0..64)
         .map(|k| format!(r#"{{"at": [{}, {}], "radius": 20, "soft": 10, "value": 0.2}}"#, (k % 8) * 32, (k / 8) * 32))
         .collect();
-    let json = format!(r#"{{"noise": {{"scale": 64, "range": [0.3, 1]}}, "strokes": [{}]}}"#, strokes.join(","));
+    let features: Vec<String> = (0..32)
+        .map(|k| {
+            format!(
+                r#"{{"at": [{}, {}], "source": [60, 60], "inner": 8, "outer": 30}}"#,
+                (k % 8) * 32 + 16,
+                (k / 8) * 64 + 16
+            )
+        })
+        .collect();
+    let json = format!(
+        r#"{{"noise": {{"scale": 64, "range": [0.3, 1]}}, "strokes": [{}], "features": [{}]}}"#,
+        strokes.join(","),
+        features.join(",")
+    );
     let mut pc = p.clone();
     pc.controls = Controls::from_json(&serde_json::from_str(&json).expect("json")).expect("controls");
+    // The tile they all lie on (nothing is cached: every iteration is cold).
     g.bench_function("cold_256_native_controls", |b| {
-        b.iter(|| {
-            i += 1;
-            render(&an, &pc, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
-        })
+        b.iter(|| render(&an, &pc, 0, Rect::new(0, 0, 256, 256)).unwrap())
     });
     g.bench_function("cold_256_magnified_1", |b| {
         b.iter(|| {

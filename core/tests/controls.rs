@@ -52,3 +52,39 @@ fn a_calm_stroke_keeps_the_tiled_exemplar_under_it() {
     // Outside the stroke, the texture is the one without controls.
     assert_eq!(render(&ex, &an, &q, far), render(&ex, &an, &[], far));
 }
+
+#[test]
+fn inside_a_features_inner_radius_the_output_is_the_exemplar_around_its_source() {
+    let (ex, an) = (common::small_exemplar(), common::small());
+    let m = ex.side as i64;
+    // Two features, one straddling the border of two windows, one far away.
+    for (x, y) in [(-37i64, 50i64), (7 << 36, -(9 << 35))] {
+        let json = format!(r#"{{"features": [{{"at": [{x}, {y}], "source": [30, 25], "inner": 10, "outer": 24}}]}}"#);
+        let c = encode(&json);
+        let q = [("controls", c.as_str())];
+        let rect = Rect::new(x - 40, y - 30, 80, 64);
+        let img = render(ex, an, &q, rect);
+        let mut inside = 0;
+        for j in 0..rect.height() {
+            for i in 0..rect.width() {
+                let (dx, dy) = (rect.x0 + i - x, rect.y0 + j - y);
+                if dx * dx + dy * dy < 100 {
+                    let (u, v) = ((30 + dx).rem_euclid(m), (25 + dy).rem_euclid(m));
+                    assert_eq!(img.pixel(i as u32, j as u32), ex.pixels[(v * m + u) as usize], "({dx}, {dy})");
+                    inside += 1;
+                }
+            }
+        }
+        assert!(inside > 250);
+        // The windows that cut the feature in parts agree with the whole.
+        for (px, py, pw, ph) in [(0, 0, 40, 30), (40, 30, 40, 34), (31, 12, 20, 40)] {
+            let part = render(ex, an, &q, Rect::new(rect.x0 + px, rect.y0 + py, pw, ph));
+            assert_eq!(part, common::crop(&img, px as u32, py as u32, pw as u32, ph as u32));
+        }
+    }
+    // A source outside the exemplar is refused.
+    let src = Source::new(ex, an);
+    let bad = encode(r#"{"features": [{"at": [0, 0], "source": [64, 3], "inner": 4, "outer": 8}]}"#);
+    let e = Defaults::builtin(&src).request(&src, ParamReader::request(vec![("controls", bad.as_str())]).unwrap());
+    assert!(e.unwrap_err().to_string().contains("outside"));
+}

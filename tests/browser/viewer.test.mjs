@@ -183,6 +183,12 @@ test('every mode is offered from the specs, with its own controls; texture picke
       assert.equal(Boolean(shown), spec.modes.includes(mode), `${name} control with mode=${mode}`);
     }
   }
+  // The noise modulation toggle of synth puts `controls` into the tile URLs.
+  await page.selectOption('#mode', 'synth');
+  await page.check('#p-controls');
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('controls=')));
+  await settled(page);
+  assertTexture(await tileStats(page));
   await page.selectOption('#mode', 'mosaic');
   await page.focus('#p-iterations');
   await page.keyboard.press('ArrowLeft');

@@ -6,10 +6,16 @@
 //! function of absolute coordinates, so windows stay the same pixels cut from larger ones and
 //! replicas agree with no shared state.
 //!
+//! Features (design note §1.9, drag-and-drop) travel with them: each imposes the exemplar
+//! around a source coordinate over a disc of the output, exactly at native zoom within its inner
+//! radius, over a disc growing to its outer radius at the coarsest level (the surroundings
+//! adapt); imposed pixels are not corrected.
+//!
 //! The parameter is base64url (unpadded) of JSON, at most [`MAX_CONTROLS_LEN`] characters:
 //! `{"noise": {"scale": 64, "range": [0.2, 1]}, "strokes": [{"at": [x, y], "radius": 40,
-//! "soft": 8, "value": 0}]}` (native texels; values in `[0, 1]`; at most [`MAX_STROKES`]
-//! strokes). It is parsed once into fixed point; its canonical text is part of cache keys
+//! "soft": 8, "value": 0}], "features": [{"at": [x, y], "source": [u, v], "inner": 12,
+//! "outer": 40}]}` (native texels; values in `[0, 1]`; at most [`MAX_STROKES`] strokes and
+//! [`MAX_FEATURES`] features). It is parsed once into fixed point; its canonical text is part of cache keys
 //! and ETags, so equal controls written differently are one request.
 
 use base64::Engine;
@@ -56,13 +62,38 @@ pub struct Stroke {
     pub value: u32,
 }
 
-/// The request's controls (empty: `R_S ≡ 1`).
+/// A dragged-and-dropped exemplar feature (design note §1.9): around output position
+/// `(x, y)` the texture is the exemplar around `(u, v)`, exactly within `inner` texels at native
+/// zoom; the disc it is imposed on grows linearly to `outer` at the coarsest level, so the
+/// surroundings adapt.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Feature {
+    /// Output position, native texels.
+    pub x: i64,
+    /// Output position, native texels.
+    pub y: i64,
+    /// Exemplar coordinate.
+    pub u: i64,
+    /// Exemplar coordinate.
+    pub v: i64,
+    /// Radius kept exact at native zoom (texels).
+    pub inner: i64,
+    /// Radius at the coarsest level (texels), at least `inner`.
+    pub outer: i64,
+}
+
+/// Most features in one request.
+pub const MAX_FEATURES: usize = 32;
+
+/// The request's controls (empty: `R_S ≡ 1`, no features).
 #[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
 pub struct Controls {
     /// Noise modulation, if any (else 1 under the strokes).
     pub noise: Option<Noise>,
     /// Strokes, painted in order.
     pub strokes: Vec<Stroke>,
+    /// Features; where discs overlap, the later one wins.
+    pub features: Vec<Feature>,
 }
 
 fn err(message: impl Into<String>) -> CoreError {
@@ -106,7 +137,7 @@ impl Controls {
 
     /// The controls of a JSON document (what [`Controls::parse`] decodes).
     pub fn from_json(json: &Value) -> Result<Controls> {
-        let o = object(json, "controls", &["noise", "strokes"])?;
+        let o = object(json, "controls", &["noise", "strokes", "features"])?;
         let noise = match o.get("noise") {
             None | Some(Value::Null) => None,
             Some(n) => {
@@ -149,11 +180,79 @@ impl Controls {
                     .collect::<Result<_>>()?
             }
         };
-        Ok(Controls { noise, strokes })
+        let features = match o.get("features") {
+            None | Some(Value::Null) => Vec::new(),
+            Some(list) => {
+                let list = list.as_array().ok_or_else(|| err("features must be a list"))?;
+                if list.len() > MAX_FEATURES {
+                    return Err(err(format!("has {} features; at most {MAX_FEATURES}", list.len())));
+                }
+                list.iter()
+                    .map(|f| {
+                        let f = object(f, "a feature", &["at", "source", "inner", "outer"])?;
+                        let pair = |key: &str, lo: i64, hi: i64| -> Result<(i64, i64)> {
+                            let a = f.get(key).and_then(Value::as_array).filter(|a| a.len() == 2);
+                            let a = a.ok_or_else(|| err(format!("a feature's {key} must be [x, y]")))?;
+                            let what = format!("a feature's {key}");
+                            Ok((integer(&a[0], &what, lo, hi)?, integer(&a[1], &what, lo, hi)?))
+                        };
+                        let (x, y) = pair("at", -MAX_COORD, MAX_COORD)?;
+                        let (u, v) = pair("source", 0, 65535)?;
+                        let null = Value::Null;
+                        let inner = integer(f.get("inner").unwrap_or(&null), "a feature's inner", 0, MAX_EXTENT)?;
+                        let outer = integer(f.get("outer").unwrap_or(&null), "a feature's outer", inner, MAX_EXTENT)?;
+                        Ok(Feature { x, y, u, v, inner, outer })
+                    })
+                    .collect::<Result<_>>()?
+            }
+        };
+        Ok(Controls { noise, strokes, features })
     }
 
-    /// No modulation at all.
+    /// Check against an exemplar of side `side`: every feature's source lies in it.
+    pub fn check_side(&self, side: u32) -> Result<()> {
+        match self.features.iter().find(|f| f.u >= side as i64 || f.v >= side as i64) {
+            Some(f) => Err(err(format!(
+                "a feature's source [{}, {}] is outside the {side}×{side} exemplar",
+                f.u, f.v
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The exemplar coordinate (before wrapping) a feature imposes on the pixel whose footprint
+    /// centre is native position `(px, py)` at level `l` of `levels`, if one does.
+    #[inline]
+    pub fn feature_at(&self, l: u32, levels: u32, px: i64, py: i64, period: Option<i64>) -> Option<(i64, i64)> {
+        let mut found = None;
+        for f in &self.features {
+            let r = (f.inner * l as i64 + f.outer * (levels - l) as i64) / levels.max(1) as i64;
+            let d = |a: i64, b: i64| match period {
+                Some(p) => {
+                    let d = (a - b).rem_euclid(p);
+                    if d > p / 2 {
+                        d - p
+                    } else {
+                        d
+                    }
+                }
+                None => a - b,
+            };
+            let (dx, dy) = (d(px, f.x), d(py, f.y));
+            if dx.abs() < r && dy.abs() < r && dx * dx + dy * dy < r * r {
+                found = Some((f.u + dx, f.v + dy));
+            }
+        }
+        found
+    }
+
+    /// No modulation and no features at all.
     pub fn is_empty(&self) -> bool {
+        self.noise.is_none() && self.strokes.is_empty() && self.features.is_empty()
+    }
+
+    /// No modulation of randomness (`R_S ≡ 1`; features aside).
+    pub fn is_unmodulated(&self) -> bool {
         self.noise.is_none() && self.strokes.is_empty()
     }
 
@@ -165,6 +264,9 @@ impl Controls {
         }
         for st in &self.strokes {
             s += &format!("s{},{},{},{},{}", st.x, st.y, st.radius, st.soft, st.value);
+        }
+        for f in &self.features {
+            s += &format!("f{},{},{},{},{},{}", f.x, f.y, f.u, f.v, f.inner, f.outer);
         }
         s
     }
@@ -183,6 +285,14 @@ impl Controls {
                 .map(|s| serde_json::json!({ "at": [s.x, s.y], "radius": s.radius, "soft": s.soft, "value": unit(s.value) }))
                 .collect();
             o.insert("strokes".into(), Value::Array(list));
+        }
+        if !self.features.is_empty() {
+            let list: Vec<Value> = self
+                .features
+                .iter()
+                .map(|f| serde_json::json!({ "at": [f.x, f.y], "source": [f.u, f.v], "inner": f.inner, "outer": f.outer }))
+                .collect();
+            o.insert("features".into(), Value::Array(list));
         }
         Value::Object(o)
     }
@@ -259,8 +369,8 @@ mod tests {
 
     #[test]
     fn controls_parse_canonically_and_refuse_what_is_wrong() {
-        let a = Controls::parse(&encode(r#"{"noise": {"scale": 64, "range": [0.2, 1]}, "strokes": [{"at": [-5, 7], "radius": 40, "soft": 8, "value": 0.5}]}"#)).unwrap();
-        let b = Controls::parse(&encode(r#"{"strokes":[{"value":0.50,"at":[-5,7],"soft":8,"radius":40}],"noise":{"range":[0.20,1.0],"scale":64}}"#)).unwrap();
+        let a = Controls::parse(&encode(r#"{"noise": {"scale": 64, "range": [0.2, 1]}, "strokes": [{"at": [-5, 7], "radius": 40, "soft": 8, "value": 0.5}], "features": [{"at": [1, 2], "source": [3, 4], "inner": 5, "outer": 9}]}"#)).unwrap();
+        let b = Controls::parse(&encode(r#"{"strokes":[{"value":0.50,"at":[-5,7],"soft":8,"radius":40}],"features":[{"outer":9,"inner":5,"source":[3,4],"at":[1,2]}],"noise":{"range":[0.20,1.0],"scale":64}}"#)).unwrap();
         assert_eq!(a, b);
         assert_eq!(a.canonical(), b.canonical());
         assert_eq!(Controls::from_json(&a.to_json()).unwrap(), a);
@@ -271,6 +381,7 @@ mod tests {
             encode(r#"{"noise": {"scale": 48, "range": [0, 1]}}"#),
             encode(r#"{"noise": {"scale": 64, "range": [0.8, 0.2]}}"#),
             encode(r#"{"strokes": [{"at": [0, 0], "radius": 5, "value": 2}]}"#),
+            encode(r#"{"features": [{"at": [0, 0], "source": [1, 1], "inner": 9, "outer": 4}]}"#),
             encode(&format!(r#"{{"strokes": [{}]}}"#, vec![r#"{"at":[0,0],"radius":1,"value":0}"#; 65].join(","))),
             "A".repeat(MAX_CONTROLS_LEN + 1),
         ] {
@@ -284,6 +395,7 @@ mod tests {
         let c = Controls {
             noise: Some(Noise { scale: 16, lo: 13107, hi: 52429 }),
             strokes: vec![Stroke { x: 100, y: -40, radius: 10, soft: 10, value: 0 }],
+            features: Vec::new(),
         };
         assert_eq!(c.at(105, -38, None), 0);
         for (x, y) in [(-1000, 3), (7, 7), (1 << 30, -(1 << 33))] {

@@ -44,7 +44,7 @@ const CONTROLS: ParamSpec = ParamSpec {
     name: "controls",
     kind: Kind::Text { max_len: controls::MAX_CONTROLS_LEN as u64 },
     scope: Scope::Request,
-    help: "spatial modulation of randomness over the output (R_S): base64url of JSON {\"noise\": {\"scale\": 64, \"range\": [0.2, 1]}, \"strokes\": [{\"at\": [x, y], \"radius\": 40, \"soft\": 8, \"value\": 0}]} (native texels; values in [0, 1]: 0 calm, 1 the full randomness; at most 64 strokes)",
+    help: "spatial modulation of randomness over the output (R_S): base64url of JSON {\"noise\": {\"scale\": 64, \"range\": [0.2, 1]}, \"strokes\": [{\"at\": [x, y], \"radius\": 40, \"soft\": 8, \"value\": 0}], \"features\": [{\"at\": [x, y], \"source\": [u, v], \"inner\": 12, \"outer\": 40}]} (native texels; values in [0, 1]: 0 calm, 1 the full randomness; a feature shows the exemplar around its source within its inner radius; at most 64 strokes and 32 features)",
 };
 const KAPPA: ParamSpec = ParamSpec {
     name: "kappa",

@@ -139,6 +139,7 @@ impl SynthParams {
         }
         check_period(self.period, side)?;
         self.controls.check_period(self.period)?;
+        self.controls.check_side(side)?;
         Ok(())
     }
 

@@ -208,6 +208,8 @@ impl<'a> Ctx<'a> {
         // Generation 0: upsample the parents and jitter, or take the cached values.
         let lc = self.level_consts(l);
         let rs = Modulation::over(&self.controls, ext, lc.h, self.period);
+        // What features impose on this level's pixels, drawn once (usually nothing).
+        let imposed = Imposed::draw(&self.controls, l, self.levels, ext, lc.h, lc.mask, self.period);
         let mut s = vec![0u32; lo.len()];
         s.par_chunks_mut(w).enumerate().with_min_len(8).for_each(|(j, row)| {
             let y = ext.y0 + j as i64;
@@ -220,7 +222,10 @@ impl<'a> Ctx<'a> {
                 if trow[i] >= 0 && lrow[i] < 0 {
                     let x = ext.x0 + i as i64;
                     let v = prow.map_or(0, |(pr, px0)| pr[(fl2(x) - px0) as usize]);
-                    *out = self.jitter(&lc, x, y, v, rs.at(x, y));
+                    *out = match imposed.at(j * w + i) {
+                        Some(v) => v,
+                        None => self.jitter(&lc, x, y, v, rs.at(x, y)),
+                    };
                 }
             }
         });
@@ -252,9 +257,10 @@ impl<'a> Ctx<'a> {
                     let base = (oy + j) * w + ox + c0;
                     // R_E: a pixel showing a kept (black) part of the exemplar stays as it is.
                     let kept = |v: u32| self.mask.is_some_and(|mk| mk.at(l, v & 0xFFFF, v >> 16) == 0);
+                    // Pixels a feature imposes are not corrected either.
                     let todo = |c: usize| {
                         let p = base + c * step;
-                        top[p] >= k8 && lo[p] < k8 && !kept(sr[p])
+                        top[p] >= k8 && lo[p] < k8 && !kept(sr[p]) && imposed.at(p).is_none()
                     };
                     let mut c = 0;
                     while c < cols {
@@ -362,6 +368,7 @@ impl<'a> Ctx<'a> {
                 (sx, sy) = (jx, jy);
             }
         }
+
         ((sx & c.mask) | ((sy & c.mask) << 16)) as u32
     }
 
@@ -407,12 +414,60 @@ struct Modulation {
     values: Vec<i64>,
 }
 
+/// What the request's features impose on a level's rectangle (design note §1.9): per pixel,
+/// the exemplar coordinate of the feature whose disc holds the pixel's footprint centre (the
+/// later feature where discs overlap), drawn feature by feature over their bounding boxes.
+struct Imposed {
+    /// Packed coordinates, `NONE` where no feature reaches; empty without features.
+    cells: Vec<u32>,
+}
+
+impl Imposed {
+    const NONE: u32 = u32::MAX;
+
+    fn draw(controls: &Controls, l: u32, levels: u32, rect: Rect, h: i64, mask: i64, period: Option<i64>) -> Imposed {
+        if controls.features.is_empty() {
+            return Imposed { cells: Vec::new() };
+        }
+        let w = rect.width();
+        let mut cells = vec![Self::NONE; rect.area() as usize];
+        for f in &controls.features {
+            let one = Controls { features: vec![*f], ..Controls::default() };
+            // The feature's box in this level's pixels (the whole rectangle when the output
+            // repeats, whose discs wrap).
+            let area = match period {
+                Some(_) => rect,
+                None => {
+                    let r = f.outer + h;
+                    let (x0, y0) = ((f.x - r).div_euclid(h), (f.y - r).div_euclid(h));
+                    let (x1, y1) = ((f.x + r).div_euclid(h) + 1, (f.y + r).div_euclid(h) + 1);
+                    Rect::new(x0, y0, x1 - x0, y1 - y0).intersect(&rect)
+                }
+            };
+            for y in area.y0..area.y1 {
+                for x in area.x0..area.x1 {
+                    if let Some((u, v)) = one.feature_at(l, levels, x * h + h / 2, y * h + h / 2, period) {
+                        cells[((y - rect.y0) * w + (x - rect.x0)) as usize] = ((u & mask) | ((v & mask) << 16)) as u32;
+                    }
+                }
+            }
+        }
+        Imposed { cells }
+    }
+
+    /// The coordinate imposed on pixel `p` of the rectangle (row-major), if any.
+    #[inline]
+    fn at(&self, p: usize) -> Option<u32> {
+        self.cells.get(p).copied().filter(|&v| v != Self::NONE)
+    }
+}
+
 /// Side of the blocks `R_S` is evaluated on, in pixels of a level.
 const MOD_BLOCK: i64 = 4;
 
 impl Modulation {
     fn over(controls: &Controls, rect: Rect, h: i64, period: Option<i64>) -> Modulation {
-        if controls.is_empty() {
+        if controls.is_unmodulated() {
             return Modulation { blocks: Rect::new(0, 0, 0, 0), values: Vec::new() };
         }
         let (bx0, by0) = (rect.x0.div_euclid(MOD_BLOCK), rect.y0.div_euclid(MOD_BLOCK));
