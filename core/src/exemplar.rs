@@ -135,6 +135,27 @@ impl Exemplar {
         }
     }
 
+    /// Feed everything that determines this exemplar's pixels in every mode to `h`: side,
+    /// toroidal flag, pixels, and its randomness mask and high-resolution image when it has them
+    /// (only then, so the hashes of exemplars without them never change).
+    pub fn hash_content(&self, h: &mut blake3::Hasher) {
+        h.update(&self.side.to_le_bytes());
+        h.update(&[self.toroidal as u8]);
+        for p in &self.pixels {
+            h.update(p);
+        }
+        if let Some(mask) = &self.randomness_mask {
+            h.update(b"randomness-mask");
+            h.update(mask.hash.as_bytes());
+        }
+        if let Some(hires) = &self.hires {
+            h.update(b"hires");
+            for p in hires {
+                h.update(p);
+            }
+        }
+    }
+
     /// The exemplar of a high-resolution image: `hires` (prepared, side `2m`) reduced by the
     /// exact 2×2 box average to side `m`, keeping `hires` for magnified zooms (design note
     /// §1.8: magnified tiles then show the image's own detail, not interpolation). The toroidal

@@ -91,21 +91,7 @@ impl Texture {
         let defaults = Defaults::configure(&src, &config.default_mode, config.default_seed, &config.mode_tables())
             .map_err(|source| LoadError::Defaults { id: config.id.clone(), index, source })?;
         let mut h = blake3::Hasher::new();
-        h.update(&exemplar.side.to_le_bytes());
-        h.update(&[exemplar.toroidal as u8]);
-        for p in &exemplar.pixels {
-            h.update(p);
-        }
-        if let Some(mask) = &exemplar.randomness_mask {
-            h.update(b"randomness-mask");
-            h.update(mask.hash.as_bytes());
-        }
-        if let Some(hires) = &exemplar.hires {
-            h.update(b"hires");
-            for p in hires {
-                h.update(p);
-            }
-        }
+        exemplar.hash_content(&mut h);
         let exemplar_hash = h.finalize().to_hex()[..16].to_string();
         Ok(Texture {
             config,

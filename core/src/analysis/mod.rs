@@ -319,22 +319,7 @@ fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
         h.update(b"coherent");
         h.update(&COHERENT_VERSION.to_le_bytes());
     }
-    h.update(&ex.side.to_le_bytes());
-    h.update(&[ex.toroidal as u8]);
-    for p in &ex.pixels {
-        h.update(p);
-    }
-    if let Some(mask) = &ex.randomness_mask {
-        h.update(b"randomness-mask");
-        h.update(mask.hash.as_bytes());
-    }
-    // The image magnified zooms sample (only when given, so other ids are unchanged).
-    if let Some(hires) = &ex.hires {
-        h.update(b"hires");
-        for p in hires {
-            h.update(p);
-        }
-    }
+    ex.hash_content(&mut h);
     h.finalize().to_hex()[..16].to_string()
 }
 

@@ -82,6 +82,30 @@ pub struct Feature {
     pub outer: i64,
 }
 
+impl Feature {
+    /// The exemplar coordinate (before wrapping) this feature imposes on the pixel whose
+    /// footprint centre is native position `(px, py)` at level `l` of `levels`, if its disc
+    /// there (radius from `outer` at level 0 to `inner` at `levels`) holds that centre; with a
+    /// `period`, the disc wraps.
+    #[inline]
+    pub fn imposes(&self, l: u32, levels: u32, px: i64, py: i64, period: Option<i64>) -> Option<(i64, i64)> {
+        let r = (self.inner * l as i64 + self.outer * (levels - l) as i64) / levels.max(1) as i64;
+        let d = |a: i64, b: i64| match period {
+            Some(p) => {
+                let d = (a - b).rem_euclid(p);
+                if d > p / 2 {
+                    d - p
+                } else {
+                    d
+                }
+            }
+            None => a - b,
+        };
+        let (dx, dy) = (d(px, self.x), d(py, self.y));
+        (dx.abs() < r && dy.abs() < r && dx * dx + dy * dy < r * r).then_some((self.u + dx, self.v + dy))
+    }
+}
+
 /// Most features in one request.
 pub const MAX_FEATURES: usize = 32;
 
@@ -218,32 +242,6 @@ impl Controls {
             ))),
             None => Ok(()),
         }
-    }
-
-    /// The exemplar coordinate (before wrapping) a feature imposes on the pixel whose footprint
-    /// centre is native position `(px, py)` at level `l` of `levels`, if one does.
-    #[inline]
-    pub fn feature_at(&self, l: u32, levels: u32, px: i64, py: i64, period: Option<i64>) -> Option<(i64, i64)> {
-        let mut found = None;
-        for f in &self.features {
-            let r = (f.inner * l as i64 + f.outer * (levels - l) as i64) / levels.max(1) as i64;
-            let d = |a: i64, b: i64| match period {
-                Some(p) => {
-                    let d = (a - b).rem_euclid(p);
-                    if d > p / 2 {
-                        d - p
-                    } else {
-                        d
-                    }
-                }
-                None => a - b,
-            };
-            let (dx, dy) = (d(px, f.x), d(py, f.y));
-            if dx.abs() < r && dy.abs() < r && dx * dx + dy * dy < r * r {
-                found = Some((f.u + dx, f.v + dy));
-            }
-        }
-        found
     }
 
     /// No modulation and no features at all.

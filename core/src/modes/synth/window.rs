@@ -432,7 +432,6 @@ impl Imposed {
         let w = rect.width();
         let mut cells = vec![Self::NONE; rect.area() as usize];
         for f in &controls.features {
-            let one = Controls { features: vec![*f], ..Controls::default() };
             // The feature's box in this level's pixels (the whole rectangle when the output
             // repeats, whose discs wrap).
             let area = match period {
@@ -446,7 +445,7 @@ impl Imposed {
             };
             for y in area.y0..area.y1 {
                 for x in area.x0..area.x1 {
-                    if let Some((u, v)) = one.feature_at(l, levels, x * h + h / 2, y * h + h / 2, period) {
+                    if let Some((u, v)) = f.imposes(l, levels, x * h + h / 2, y * h + h / 2, period) {
                         cells[((y - rect.y0) * w + (x - rect.x0)) as usize] = ((u & mask) | ((v & mask) << 16)) as u32;
                     }
                 }
