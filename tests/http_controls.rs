@@ -4,7 +4,9 @@
 //! (ETags, metadata); a mask of the wrong size is a clear configuration error — and a request's
 //! `controls` (R_S: noise and strokes; dropped features) in the URL: canonical, stitched,
 //! refused when malformed, a feature's disc the exemplar itself, and the same from
-//! `textile render --controls`.
+//! `textile render --controls`; a near-regular texture's lattice (the built-in corkboard):
+//! shown in its metadata, part of its identity, the same as `textile render --lattice`, and a
+//! lattice that does not divide the exemplar a clear configuration error.
 
 mod support;
 
@@ -64,6 +66,57 @@ async fn a_randomness_mask_keeps_black_parts_of_the_exemplar_and_is_part_of_the_
     let err = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success() && err.contains("randomness_mask") && err.contains("128x128"), "{err}");
     assert!(!out.exists());
+}
+
+#[tokio::test]
+async fn a_lattice_is_configured_served_and_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = Server::builder().start();
+    let meta = s.json("/textures/corkboard").await;
+    assert_eq!(meta["exemplar"]["lattice"], serde_json::json!([2, 4]), "{meta}");
+    assert_eq!(meta["exemplar"]["toroidal"], true);
+    assert_eq!(s.json("/textures/gravel").await["exemplar"]["lattice"], serde_json::Value::Null);
+    // Tiles under the lattice are one window, and what `textile render --lattice` makes of the
+    // same exemplar file.
+    let mut stitched = image::RgbImage::new(512, 256);
+    for i in 0..2 {
+        let tile = s.image(&format!("/tiles/corkboard/7/{}/3.png?seed=4", i - 1)).await;
+        support::paste(&mut stitched, &tile, 256 * i as u32, 0);
+    }
+    assert!(stitched == s.image("/windows/corkboard.png?x=-256&y=768&w=512&h=256&seed=4").await);
+    let exemplar = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/corkboard.png");
+    let render = |lattice: Option<&str>, name: &str| {
+        let out = dir.path().join(name);
+        let mut cmd = std::process::Command::new(binary());
+        cmd.args(["render", "--exemplar", exemplar.to_str().unwrap(), "--x", "0", "--y", "3", "--seed", "4"]);
+        if let Some(l) = lattice {
+            cmd.args(["--lattice", l]);
+        }
+        let run = cmd.args(["-o", out.to_str().unwrap()]).output().unwrap();
+        (run, out)
+    };
+    let (run, out) = render(Some("2,4"), "lattice.png");
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let served = s.image("/tiles/corkboard/7/0/3.png?seed=4").await;
+    assert!(image::open(&out).unwrap().to_rgb8() == served, "render --lattice differs from the served tile");
+    let (run, out) = render(None, "free.png");
+    assert!(run.status.success());
+    assert!(image::open(&out).unwrap().to_rgb8() != served, "without its lattice the texture is another");
+    // A lattice that does not divide the 128² exemplar: a clear error naming it, nothing written.
+    let (run, out) = render(Some("3,4"), "bad.png");
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && err.contains("lattice") && err.contains("3x4"), "{err}");
+    assert!(!out.exists());
+    let bad = dir.path().join("bad.toml");
+    let text = format!("[[textures]]\nid = \"x\"\nexemplar = {:?}\nlattice = [2, 6]\n", exemplar.to_str().unwrap());
+    std::fs::write(&bad, text).unwrap();
+    let run = std::process::Command::new(binary())
+        .args(["render", "--config", bad.to_str().unwrap(), "--texture", "x", "--x", "0", "--y", "0"])
+        .args(["-o", dir.path().join("x.png").to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && err.contains("lattice") && err.contains("2x6"), "{err}");
 }
 
 fn encode(json: &str) -> String {

@@ -8,6 +8,7 @@ use image::{ImageReader, Limits};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
+use crate::lattice::Lattice;
 use crate::mask::RandomnessMask;
 
 /// Smallest exemplar side accepted on input.
@@ -70,6 +71,8 @@ pub struct Exemplar {
     /// The randomness mask over the exemplar (`R_E`), when the texture has one
     /// ([`Exemplar::with_randomness_mask`]).
     pub randomness_mask: Option<RandomnessMask>,
+    /// The lattice of a near-regular exemplar ([`Exemplar::with_lattice`]).
+    pub lattice: Option<Lattice>,
 }
 
 impl Exemplar {
@@ -132,11 +135,12 @@ impl Exemplar {
             },
             hires: None,
             randomness_mask: None,
+            lattice: None,
         }
     }
 
     /// Feed everything that determines this exemplar's pixels in every mode to `h`: side,
-    /// toroidal flag, pixels, and its randomness mask and high-resolution image when it has them
+    /// toroidal flag, pixels, and its randomness mask, lattice and high-resolution image when it has them
     /// (only then, so the hashes of exemplars without them never change).
     pub fn hash_content(&self, h: &mut blake3::Hasher) {
         h.update(&self.side.to_le_bytes());
@@ -147,6 +151,11 @@ impl Exemplar {
         if let Some(mask) = &self.randomness_mask {
             h.update(b"randomness-mask");
             h.update(mask.hash.as_bytes());
+        }
+        if let Some(l) = &self.lattice {
+            h.update(b"lattice");
+            h.update(&l.nx.to_le_bytes());
+            h.update(&l.ny.to_le_bytes());
         }
         if let Some(hires) = &self.hires {
             h.update(b"hires");
@@ -171,7 +180,15 @@ impl Exemplar {
         let forced = hires.preparation.toroidal_forced;
         let toroidal = if forced { hires.toroidal } else { seam_ratio <= 1.5 };
         let preparation = Preparation { side, seam_ratio, ..hires.preparation };
-        Ok(Exemplar { side, pixels, toroidal, preparation, hires: Some(hires.pixels), randomness_mask: None })
+        Ok(Exemplar {
+            side,
+            pixels,
+            toroidal,
+            preparation,
+            hires: Some(hires.pixels),
+            randomness_mask: None,
+            lattice: None,
+        })
     }
 
     /// This exemplar with a randomness mask (design note §1.9, `R_E`): `mask` is the mask
@@ -199,6 +216,22 @@ impl Exemplar {
             .map(|c| ((299 * c[0] as u32 + 587 * c[1] as u32 + 114 * c[2] as u32 + 500) / 1000) as u8)
             .collect();
         self.randomness_mask = Some(RandomnessMask::new(self.side, luma, self.toroidal)?);
+        Ok(self)
+    }
+
+    /// This exemplar as a near-regular one (design note §1.9): a rectified exemplar that a
+    /// lattice of `nx × ny` cells tiles. Synthesis moves its coarse content by whole cells and
+    /// keeps coarse candidates on the same lattice phase, so the grid survives while the cells
+    /// vary. The exemplar must be toroidal (a lattice that tiles it wraps around it; force
+    /// `toroidal` when preparing it) and the counts must divide its side.
+    pub fn with_lattice(mut self, nx: u32, ny: u32) -> Result<Exemplar> {
+        if !self.toroidal {
+            return Err(CoreError::Param {
+                name: "lattice",
+                message: "needs a toroidal exemplar (the lattice tiles it, so it wraps around): set toroidal".into(),
+            });
+        }
+        self.lattice = Some(Lattice::new(nx, ny, self.side)?);
         Ok(self)
     }
 }

@@ -46,6 +46,7 @@ pub mod exemplar;
 pub mod geom;
 pub mod hash;
 pub mod image;
+pub mod lattice;
 pub mod mask;
 pub mod modes;
 pub mod samples;

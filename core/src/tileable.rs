@@ -285,5 +285,13 @@ pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
         toroidal_synthesized: true,
         ..ex.preparation.clone()
     };
-    Ok(Exemplar { side: ex.side, pixels, toroidal: true, preparation, hires: None, randomness_mask: None })
+    Ok(Exemplar {
+        side: ex.side,
+        pixels,
+        toroidal: true,
+        preparation,
+        hires: None,
+        randomness_mask: None,
+        lattice: None,
+    })
 }

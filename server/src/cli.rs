@@ -145,6 +145,11 @@ pub struct RenderArgs {
     /// Candidate search of the on-the-fly analysis (with --exemplar): auto, exact or coherent.
     #[arg(long, default_value = "auto", value_parser = index_choice, requires = "exemplar")]
     pub index: IndexChoice,
+    /// A near-regular exemplar (with --exemplar): the NX×NY lattice cells that tile it, each
+    /// count a power of two dividing its side; the output keeps that grid. Implies a toroidal
+    /// exemplar.
+    #[arg(long, value_name = "NX,NY", value_parser = lattice_counts, requires = "exemplar")]
+    pub lattice: Option<[u32; 2]>,
     /// Zoom (default: the texture's native zoom).
     #[arg(long)]
     pub z: Option<u32>,
@@ -278,4 +283,17 @@ pub struct LoadtestArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--lattice NX,NY`: two positive cell counts.
+fn lattice_counts(s: &str) -> Result<[u32; 2], String> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|p| p.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| "expected NX,NY: two positive integers".to_string())?;
+    match v[..] {
+        [nx, ny] if nx > 0 && ny > 0 => Ok([nx, ny]),
+        _ => Err("expected NX,NY: two positive integers".into()),
+    }
 }

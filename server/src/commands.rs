@@ -131,6 +131,10 @@ pub fn info(a: InfoArgs) -> CliResult {
     );
     println!("levels:            {} (native zoom {})", h.levels + 1, h.levels);
     println!("candidate search:  {}", h.index.name());
+    if let Some(l) = h.lattice {
+        let (cw, ch) = l.cell(h.side);
+        println!("lattice:           {}x{} cells of {cw}x{ch} texels (near-regular)", l.nx, l.ny);
+    }
     Ok(())
 }
 
@@ -173,7 +177,11 @@ pub fn render(a: RenderArgs) -> CliResult {
     }
     let output = a.output.clone().ok_or("--output is required")?;
     let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
-        let ex = read_exemplar(path, &ExemplarOptions::default())?;
+        let toroidal = a.lattice.map(|_| true);
+        let mut ex = read_exemplar(path, &ExemplarOptions { toroidal, ..ExemplarOptions::default() })?;
+        if let Some([nx, ny]) = a.lattice {
+            ex = ex.with_lattice(nx, ny)?;
+        }
         let an = Analysis::try_build_with(&ex, a.index, &textile_core::NoProgress)?;
         Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
     } else {

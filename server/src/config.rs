@@ -90,6 +90,10 @@ pub struct TextureConfig {
     /// where it keeps the exemplar as it is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub randomness_mask: Option<String>,
+    /// Near-regular texture: `[nx, ny]` lattice cells that tile the (rectified) exemplar; the
+    /// output keeps the exemplar's grid while the cells vary. Makes the exemplar toroidal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lattice: Option<[u32; 2]>,
     /// Toroidal flag.
     #[serde(default = "default_toroidal")]
     pub toroidal: Toroidal,
@@ -127,6 +131,7 @@ impl TextureConfig {
             exemplar: exemplar.into(),
             exemplar_hires: None,
             randomness_mask: None,
+            lattice: None,
             toroidal: Toroidal::Auto,
             index: IndexChoice::Auto,
             default_mode: default_mode(),
@@ -152,6 +157,12 @@ impl TextureConfig {
                 return bad(
                     format!("{at}.toroidal"),
                     "\"synthesize\" remakes the exemplar, which randomness_mask could no longer follow".into(),
+                )
+            }
+            _ if self.lattice.is_some() && !matches!(self.toroidal, Toroidal::Auto | Toroidal::True) => {
+                return bad(
+                    format!("{at}.toroidal"),
+                    "a lattice tiles the exemplar, which therefore wraps around: use auto or true".into(),
                 )
             }
             (true, Some(_)) if self.toroidal == Toroidal::Synthesize => {
@@ -544,8 +555,20 @@ mod tests {
     #[test]
     fn built_in_config_is_valid() {
         let cfg = Config::load(None, &Overrides::default()).unwrap();
-        assert_eq!(cfg.textures.len(), 3);
+        assert_eq!(cfg.textures.len(), 4);
         assert_eq!(cfg.bind, "127.0.0.1:8080");
+        assert_eq!(cfg.textures[3].lattice, Some([2, 4]));
+    }
+
+    #[test]
+    fn a_lattice_needs_a_wrapping_exemplar() {
+        let mut t = TextureConfig::new("cork", "cork.png");
+        t.lattice = Some([2, 4]);
+        assert!(t.validate("textures[0]").is_ok());
+        t.toroidal = Toroidal::False;
+        let (key, msg) = t.validate("textures[0]").unwrap_err();
+        assert_eq!(key, "textures[0].toroidal");
+        assert!(msg.contains("lattice"), "{msg}");
     }
 
     #[test]

@@ -18,11 +18,12 @@ use crate::config::{Config, TextureConfig};
 pub const MAGNIFY_STEPS: u32 = 3;
 use crate::state::Cancel;
 
-/// Exemplars compiled into the binary (`config/exemplars`, CC0; see LICENSE.md there).
+/// Exemplars compiled into the binary (`config/exemplars`; licences in LICENSE.md there).
 const EMBEDDED: &[(&str, &[u8])] = &[
     ("gravel.png", include_bytes!("../../config/exemplars/gravel.png")),
     ("grass.png", include_bytes!("../../config/exemplars/grass.png")),
     ("brick.png", include_bytes!("../../config/exemplars/brick.png")),
+    ("corkboard.png", include_bytes!("../../config/exemplars/corkboard.png")),
 ];
 
 /// The bytes of an embedded exemplar.
@@ -216,7 +217,7 @@ pub enum LoadError {
         source: std::io::Error,
     },
     /// `embedded:NAME` names no embedded exemplar.
-    #[error("texture '{id}': no embedded exemplar '{name}' (have: gravel.png, grass.png, brick.png)")]
+    #[error("texture '{id}': no embedded exemplar '{name}' (have: gravel.png, grass.png, brick.png, corkboard.png)")]
     NoEmbedded {
         /// Texture id.
         id: String,
@@ -318,7 +319,9 @@ pub fn prepare_texture(
     bytes: &[u8],
     log: &dyn Fn(String),
 ) -> Result<Texture, LoadError> {
-    let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal: t.toroidal.as_option() };
+    // A lattice tiles the exemplar, which therefore wraps around.
+    let toroidal = if t.lattice.is_some() { Some(true) } else { t.toroidal.as_option() };
+    let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal };
     let core = |source| LoadError::Core { id: t.id.clone(), source };
     let mut ex = Exemplar::from_bytes(bytes, &opts).map_err(core)?;
     // The mask is prepared like the exemplar's image, so that they stay aligned.
@@ -339,6 +342,9 @@ pub fn prepare_texture(
             t.id,
             started.elapsed().as_secs_f64()
         ));
+    }
+    if let Some([nx, ny]) = t.lattice {
+        ex = ex.with_lattice(nx, ny).map_err(core)?;
     }
     if let Some(mask) = &mask {
         ex = ex.with_randomness_mask(mask).map_err(core)?;

@@ -17,12 +17,30 @@ pub struct CandidateRules {
     pub toroidal: bool,
     /// Minimum distance between the two candidates.
     pub separation: usize,
+    /// Lattice phase moduli `(px, py)` (design note §1.9, near-regular textures): `C_2(u)` only
+    /// among texels `v ≡ u (mod px, py)`; `(1, 1)` without a lattice.
+    pub phase: (usize, usize),
 }
 
 impl CandidateRules {
     /// Rules for an `m × m` exemplar (separation `⌈0.05·m⌉`).
     pub fn new(m: usize, toroidal: bool) -> Self {
-        CandidateRules { m, toroidal, separation: (m * 5).div_ceil(100) }
+        CandidateRules { m, toroidal, separation: (m * 5).div_ceil(100), phase: (1, 1) }
+    }
+
+    /// These rules with second candidates restricted to the lattice phase of their texel
+    /// (moduli `px`, `py`; 1 leaves an axis free).
+    pub fn with_phase(mut self, px: usize, py: usize) -> Self {
+        self.phase = (px.max(1), py.max(1));
+        self
+    }
+
+    /// Whether `v` may be the second candidate of `u`: far enough from it, on its lattice phase.
+    fn allowed(&self, v: usize, u: usize) -> bool {
+        let (px, py) = self.phase;
+        let same_phase =
+            (px == 1 || (v % self.m) % px == (u % self.m) % px) && (py == 1 || (v / self.m) % py == (u / self.m) % py);
+        same_phase && self.far_enough(v, u)
     }
 
     /// Texel `c` moved by `(dx, dy)` (wrapping when toroidal), unless that leaves the exemplar.
@@ -104,7 +122,7 @@ pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, plan
     let tree = KdTree::new((0..feats.len()).map(|i| (feats[i], i as u32)).collect());
     let search = |u: usize| {
         let c2 = tree
-            .nearest_k_approx(&feats[u], 1, plan.slack, |v| rules.far_enough(v as usize, u))
+            .nearest_k_approx(&feats[u], 1, plan.slack, |v| rules.allowed(v as usize, u))
             .first()
             .map_or(u as u32, |b| b.1);
         [u as u32, c2]
@@ -119,7 +137,7 @@ pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, plan
         .into_par_iter()
         .map(|g| {
             let u = (g / gm) * step * m + (g % gm) * step;
-            tree.nearest_k_approx(&feats[u], GRID_MATCHES, plan.slack, |x| rules.far_enough(x as usize, u))
+            tree.nearest_k_approx(&feats[u], GRID_MATCHES, plan.slack, |x| rules.allowed(x as usize, u))
                 .into_iter()
                 .map(|b| b.1)
                 .collect()
@@ -137,7 +155,7 @@ pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, plan
             let q = &feats[u];
             let best = props
                 .iter()
-                .filter(|&&v| rules.far_enough(v as usize, u))
+                .filter(|&&v| rules.allowed(v as usize, u))
                 .map(|&v| (distance(q, &feats[v as usize]), v))
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             match best {

@@ -18,6 +18,7 @@ use crate::analysis::features::{
 use crate::analysis::stack::{build_stack, to_u8};
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
+use crate::lattice::Lattice;
 use crate::mask::RandomnessMask;
 
 /// Version of the analysis (its content and file layout; part of the analysis id, so a change
@@ -159,6 +160,10 @@ pub struct AnalysisHeader {
     /// ([`Analysis::attach`]), which is kept with the exemplar, not in the file.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub randomness_mask: Option<String>,
+    /// The lattice of a near-regular exemplar: coarse candidates keep their lattice phase, and
+    /// synthesis rounds coarse jitter to whole cells.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lattice: Option<Lattice>,
 }
 
 /// A complete exemplar analysis.
@@ -215,7 +220,10 @@ impl Analysis {
                 return Err(CoreError::Cancelled);
             }
             progress.step(l - FIRST_CORRECTED_LEVEL + 1, total, "neighbourhoods and candidates");
-            corrected.push(analyse_level(&stack8[l as usize], m, ex.toroidal, 1 << (levels - l), search));
+            let h = 1 << (levels - l);
+            let phase = ex.lattice.map_or((1, 1), |lat| lat.moduli(ex.side, h));
+            let rules = CandidateRules::new(m, ex.toroidal).with_phase(phase.0 as usize, phase.1 as usize);
+            corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search));
         }
         progress.step(total, total, "done");
         let header = AnalysisHeader {
@@ -227,6 +235,7 @@ impl Analysis {
             preparation: ex.preparation.clone(),
             index: search,
             randomness_mask: ex.randomness_mask.as_ref().map(|m| m.hash.clone()),
+            lattice: ex.lattice,
         };
         let randomness_mask = ex.randomness_mask.clone();
         Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8, randomness_mask })
@@ -323,8 +332,9 @@ fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
     h.finalize().to_hex()[..16].to_string()
 }
 
-fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_index: SearchIndex) -> CorrectionLevel {
+fn analyse_level(px: &[[u8; 3]], rules: &CandidateRules, h: usize, search_index: SearchIndex) -> CorrectionLevel {
     use rayon::prelude::*;
+    let (m, toroidal) = (rules.m, rules.toroidal);
     let cols = LevelColours { px, m: m as i64, toroidal, h: h as i64 };
     let dirs5 = principal_directions(&cols, 2, RUNTIME_DIMS);
     let proj = quantise_projection(&dirs5);
@@ -351,7 +361,7 @@ fn analyse_level(px: &[[u8; 3]], m: usize, toroidal: bool, h: usize, search_inde
         SearchIndex::Exact => SearchPlan::EXACT,
         SearchIndex::Coherent => SearchPlan::coherent(h),
     };
-    let sets = candidate_sets(&search, &CandidateRules::new(m, toroidal), plan);
+    let sets = candidate_sets(&search, rules, plan);
     let cand = |i: u32| {
         let i = i as usize;
         Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }

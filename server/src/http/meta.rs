@@ -113,6 +113,7 @@ pub async fn texture_meta(
             "crop_side": prep.crop_side, "toroidal_forced": prep.toroidal_forced,
             "toroidal_synthesized": prep.toroidal_synthesized,
             "randomness_mask": ex.randomness_mask.is_some(),
+            "lattice": ex.lattice.map(|l| [l.nx, l.ny]),
         },
         "analysis": analysis,
         "modes": MODE_NAMES,

@@ -15,6 +15,7 @@ use crate::analysis::features::TAPS5;
 use super::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash, TAG_JITTER};
+use crate::lattice::round_to;
 use crate::mask::RandomnessMask;
 use crate::modes::params::ONE_Q16;
 use super::controls::Controls;
@@ -324,6 +325,10 @@ impl<'a> Ctx<'a> {
             mask: self.m - 1,
             rq: self.r[l as usize] as i64,
             period: self.period.map(|n| n >> (self.levels - l)),
+            cells: self.an.header.lattice.map_or((1, 1), |lat| {
+                let (qx, qy) = lat.moduli(self.m as u32, 1 << (self.levels - l));
+                (qx as i64, qy as i64)
+            }),
         }
     }
 
@@ -361,7 +366,9 @@ impl<'a> Ctx<'a> {
             let z = hash(TAG_JITTER, self.seed, c.l as i64, hx_, hy_);
             let hx = ((z >> 40) as i64) - (1 << 23);
             let hy = (((z >> 16) & 0xFF_FFFF) as i64) - (1 << 23);
-            let (jx, jy) = (sx + ((h * hx * rq + (1 << 38)) >> 39), sy + ((h * hy * rq + (1 << 38)) >> 39));
+            // A lattice's coarse levels move content by whole cells (§1.9).
+            let (dx, dy) = ((h * hx * rq + (1 << 38)) >> 39, (h * hy * rq + (1 << 38)) >> 39);
+            let (jx, jy) = (sx + round_to(dx, c.cells.0), sy + round_to(dy, c.cells.1));
             // Nor does a jump land inside a kept part (it would show it cut).
             let lands_kept = self.mask.is_some_and(|mk| mk.at(c.l, (jx & c.mask) as u32, (jy & c.mask) as u32) == 0);
             if !lands_kept {
@@ -498,4 +505,6 @@ struct LevelConsts {
     mask: i64,
     rq: i64,
     period: Option<i64>,
+    /// Lattice cell sizes jitter is rounded to at this level (1: not rounded).
+    cells: (i64, i64),
 }
