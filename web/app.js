@@ -94,11 +94,6 @@ function changed() {
   debounce = setTimeout(refreshLayer, 120);
 }
 
-// Unpadded base64url of a string (ASCII JSON), as the `controls` parameter carries it.
-function base64url(text) {
-  return btoa(text).replace(/\+/g, '-').replace(/\//g, '_').replace(/=+$/, '');
-}
-
 // One slider: label, range input and live value; `set` receives the new value.
 function slider(id, text, min, max, step, value, aria, set) {
   const row = document.createElement('div');
@@ -144,22 +139,12 @@ function control(name, spec) {
         state.p[name] = values.map(num).join(',');
       })));
   } else if (spec.type === 'text' && name === 'controls') {
-    // The noise modulation of randomness (R_S): calm and wild regions over the plane. Other
-    // controls given in the permalink (strokes, features) are kept as they are.
-    const row = document.createElement('div');
-    row.className = 'toggle';
-    const input = document.createElement('input');
-    Object.assign(input, { type: 'checkbox', id: `p-${name}`, checked: Boolean(given) });
-    const label = document.createElement('label');
-    label.htmlFor = input.id;
-    label.textContent = 'calm and wild regions (noise modulation)';
-    input.addEventListener('change', () => {
-      if (input.checked) state.p[name] = base64url(JSON.stringify({ noise: { scale: 256, range: [0, 1] } }));
-      else delete state.p[name];
-      changed();
-    });
-    row.append(input, label);
-    box.append(row);
+    // Synth's spatial controls: noise, features dragged from the thumbnail, painted strokes
+    // (web/controls.js).
+    box.append(TextileControls.editor({
+      map, side: meta.exemplar.width, scale: 2 ** native(), thumb: $('thumb'), value: given, slider, changed,
+      set: (v) => { if (v) state.p[name] = v; else delete state.p[name]; },
+    }));
   } else if (spec.type === 'integer' || spec.type === 'number') {
     const step = spec.type === 'integer' ? 1 : 0.05;
     box.append(slider(`p-${name}`, name, spec.min, spec.max, step, given ?? spec.default, spec.description,
@@ -169,6 +154,7 @@ function control(name, spec) {
 }
 
 function buildControls() {
+  TextileControls.dispose();
   const box = $('controls');
   box.textContent = '';
   const params = modeParams();

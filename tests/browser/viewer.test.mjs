@@ -165,6 +165,136 @@ test('a randomness slider (by keyboard) changes tile URLs and pixels; the permal
   await second.page.close();
 });
 
+/** The controls a hash (or tile URL) carries, decoded. */
+function controlsOf(text) {
+  const m = text.match(/controls=([A-Za-z0-9_-]+)/);
+  return m ? JSON.parse(Buffer.from(m[1], 'base64url').toString()) : null;
+}
+
+/** Poll the page's permalink until its controls satisfy `pred`; they are returned. */
+async function waitControls(page, pred) {
+  for (let i = 0; i < 200; i++) {
+    const c = controlsOf(await page.evaluate(() => location.hash));
+    if (pred(c)) return c;
+    await page.waitForTimeout(50);
+  }
+  assert.fail(`the permalink's controls never matched: ${await page.evaluate(() => location.hash)}`);
+}
+
+/** Wait until every tile image on the map carries `controls=value` (none: without controls). */
+async function tilesCarry(page, value) {
+  await page.waitForFunction((v) => [...document.querySelectorAll('img.leaflet-tile')].every((i) => {
+    const m = i.src.match(/controls=([A-Za-z0-9_-]+)/);
+    return (m ? m[1] : null) === v;
+  }), value);
+  await settled(page);
+}
+
+const controlsValue = (hash) => { const m = hash.match(/controls=([A-Za-z0-9_-]+)/); return m ? m[1] : null; };
+
+/** Where texel (x, y) is on the page, at the map's current view. */
+function screenOf(page, x, y) {
+  return page.evaluate(([x, y]) => {
+    const map = window.textileMap;
+    const s = 2 ** map.getZoom();
+    const r = map.getContainer().getBoundingClientRect();
+    const p = map.latLngToContainerPoint(L.latLng(-y / s, x / s));
+    return { x: r.left + p.x, y: r.top + p.y };
+  }, [x, y]);
+}
+
+test('a feature dragged from the thumbnail shows the exemplar under it, strokes paint calm, the permalink restores both', async () => {
+  // At native zoom (7 for the 128² gravel), one screen pixel is one texel.
+  const { page, errors } = await open('/#t=gravel&m=synth&s=3&z=7&x=200&y=120');
+  await settled(page);
+  const find = (stats, key) => stats.find((s) => s.src.includes(key));
+  const before = await tileStats(page);
+  const key = '/7/0/0.png', other = '/7/1/0.png';
+  assert.ok(find(before, key) && find(before, other), 'tiles 7/0/0 and 7/1/0 on screen');
+  // Drag the centre of the thumbnail (exemplar texel 64, 64) onto texel (100, 60).
+  const thumb = await page.locator('#thumb').boundingBox();
+  const target = await screenOf(page, 100, 60);
+  await page.mouse.move(thumb.x + thumb.width / 2, thumb.y + thumb.height / 2);
+  await page.mouse.down();
+  await page.mouse.move(target.x, target.y, { steps: 8 });
+  await page.mouse.up();
+  const placed = await waitControls(page, (c) => c && c.features);
+  await tilesCarry(page, controlsValue(await page.evaluate(() => location.hash)));
+  assert.equal(placed.features.length, 1, JSON.stringify(placed));
+  const f = placed.features[0];
+  assert.deepEqual(f.source, [64, 64]);
+  assert.ok(Math.abs(f.at[0] - 100) <= 1 && Math.abs(f.at[1] - 60) <= 1, JSON.stringify(f));
+  assert.equal(await page.locator('#p-controls-features li').count(), 1);
+  const withFeature = await tileStats(page);
+  assert.notEqual(find(withFeature, key).sum, find(before, key).sum, 'the tile under the feature changed');
+  // Under the feature the tile is the exemplar around the dragged point, texel for texel.
+  const mismatches = await page.evaluate(async ([f, key]) => {
+    const pixels = async (src, w, h) => {
+      const img = new Image();
+      img.src = src;
+      await img.decode();
+      const c = document.createElement('canvas');
+      c.width = w; c.height = h;
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      return g.getImageData(0, 0, w, h).data;
+    };
+    const tile = [...document.querySelectorAll('img.leaflet-tile')].find((i) => i.src.includes(key));
+    const t = await pixels(tile.src, 256, 256);
+    const e = await pixels(document.querySelector('#thumb').src, 128, 128);
+    let bad = 0;
+    for (let dy = -4; dy <= 4; dy++) {
+      for (let dx = -4; dx <= 4; dx++) {
+        const ti = 4 * ((f.at[1] + dy) * 256 + f.at[0] + dx), ei = 4 * ((f.source[1] + dy) * 128 + f.source[0] + dx);
+        if (t[ti] !== e[ei] || t[ti + 1] !== e[ei + 1] || t[ti + 2] !== e[ei + 2]) bad++;
+      }
+    }
+    return bad;
+  }, [f, key]);
+  assert.equal(mismatches, 0, 'the 9×9 texels around the feature are the exemplar around its source');
+  // Paint a calm stroke across tile 7/1/0.
+  await page.check('#p-controls-brush');
+  const from = await screenOf(page, 300, 100), to = await screenOf(page, 480, 140);
+  await page.mouse.move(from.x, from.y);
+  await page.mouse.down();
+  await page.mouse.move(to.x, to.y, { steps: 12 });
+  await page.mouse.up();
+  const painted = await waitControls(page, (c) => c && c.strokes);
+  assert.ok(painted.strokes.length >= 2 && painted.strokes.every((s) => s.value === 0), JSON.stringify(painted.strokes));
+  assert.equal(painted.features.length, 1);
+  await tilesCarry(page, controlsValue(await page.evaluate(() => location.hash)));
+  const withStrokes = await tileStats(page);
+  assert.notEqual(find(withStrokes, other).sum, find(withFeature, other).sum, 'the painted tile changed');
+  await page.uncheck('#p-controls-brush');
+  // The permalink, in a fresh page, shows the same bytes and lists the feature.
+  const hash = await page.evaluate(() => location.hash);
+  const second = await open('/' + hash);
+  await settled(second.page);
+  const restored = await tileStats(second.page);
+  for (const k of [key, other]) assert.equal(find(restored, k).sum, find(withStrokes, k).sum, `${k} after reload`);
+  assert.equal(await second.page.locator('#p-controls-features li').count(), 1);
+  await second.page.close();
+  // Move the feature by its handle, then delete it; clearing removes the controls altogether.
+  const handle = await page.locator('.feature-handle').boundingBox();
+  const dest = await screenOf(page, 150, 90);
+  await page.mouse.move(handle.x + handle.width / 2, handle.y + handle.height / 2);
+  await page.mouse.down();
+  await page.mouse.move(dest.x, dest.y, { steps: 8 });
+  await page.mouse.up();
+  const moved = await waitControls(page, (c) => Math.abs(c.features[0].at[0] - 150) <= 2);
+  assert.ok(Math.abs(moved.features[0].at[1] - 90) <= 2, JSON.stringify(moved.features));
+  await page.click('#p-controls-f0-delete');
+  const left = await waitControls(page, (c) => !c.features);
+  assert.equal(left.strokes.length, painted.strokes.length);
+  assert.equal(await page.locator('#p-controls-features li').count(), 0);
+  await page.click('#p-controls-clear');
+  await waitControls(page, (c) => c === null);
+  await tilesCarry(page, null);
+  assert.deepEqual(errors, []);
+  assert.deepEqual(second.errors, []);
+  await page.close();
+});
+
 test('every mode is offered from the specs, with its own controls; texture picker; zoom out stays within minzoom', async () => {
   const { page, errors } = await open('/#t=gravel&z=7&x=0&y=0');
   await settled(page);

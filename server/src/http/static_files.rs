@@ -10,6 +10,7 @@ use crate::error::ApiError;
 /// `(path under /static/, content type, bytes)`.
 const FILES: &[(&str, &str, &[u8])] = &[
     ("app.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/app.js")),
+    ("controls.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/controls.js")),
     ("world.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/world.js")),
     ("pmtiles.html", "text/html; charset=utf-8", include_bytes!("../../../web/pmtiles.html")),
     ("pmtiles.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/pmtiles.js")),
