@@ -145,6 +145,19 @@ function control(name, spec) {
       map, side: meta.exemplar.width, scale: 2 ** native(), thumb: $('thumb'), value: given, slider, changed,
       set: (v) => { if (v) state.p[name] = v; else delete state.p[name]; },
     }));
+  } else if (spec.type === 'choice') {
+    const row = document.createElement('div');
+    row.className = 'row';
+    const label = document.createElement('label');
+    label.htmlFor = `p-${name}`;
+    label.textContent = name;
+    const select = document.createElement('select');
+    select.id = `p-${name}`;
+    for (const v of spec.values) select.append(new Option(v, v));
+    select.value = given ?? spec.default;
+    select.addEventListener('change', () => { state.p[name] = select.value; changed(); });
+    row.append(label, select);
+    box.append(row);
   } else if (spec.type === 'integer' || spec.type === 'number') {
     const step = spec.type === 'integer' ? 1 : 0.05;
     box.append(slider(`p-${name}`, name, spec.min, spec.max, step, given ?? spec.default, spec.description,

@@ -1,7 +1,7 @@
 //! Engine benchmarks (criterion): analysis time for 64², 128² and 256² exemplars, a cold
 //! 256×256 native window (full padded pyramid, nothing cached), the same with a randomness
 //! mask and with request controls (noise and 64 strokes), a zoomed-out tile, a tile magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
-//! 512² windows.
+//! 512² windows; cold 256² umbrella tiles from native zoom to the exemplar's minzoom.
 //!
 //! `cargo bench -p textile-core --bench synthesis`
 
@@ -138,5 +138,29 @@ fn mosaic(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, analysis, windows, mosaic);
+fn umbrella(c: &mut Criterion) {
+    use textile_core::modes::umbrella::{Umbrella, UmbrellaParams};
+    use textile_core::View;
+    let ex = exemplar(128);
+    let an = Analysis::build(&ex, &NoProgress);
+    let src = Source::new(&ex, &an);
+    let p = UmbrellaParams::default();
+    let mut g = c.benchmark_group("umbrella");
+    g.sample_size(20).measurement_time(Duration::from_secs(5));
+    let mut i = 0i64;
+    // Cold: every iteration a new place, so no cell list is cached; zoom-out 0 (native) to 7
+    // (the 128² exemplar's minzoom).
+    for k in [0u32, 1, 2, 3, 5, 7] {
+        g.bench_function(format!("cold_256_zoom_out_{k}"), |b| {
+            b.iter(|| {
+                i += 1;
+                let rect = Rect::new(256 * i, -256 * i, 256, 256);
+                <Umbrella as Mode>::render(&p, &src, &Pyramid::off(), View::out(k, rect)).unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, analysis, windows, mosaic, umbrella);
 criterion_main!(benches);

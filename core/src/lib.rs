@@ -10,8 +10,9 @@
 //! 2. [`analysis`] — Gaussian stack, PCA neighbourhoods, k-coherence candidates, computed once
 //!    and stored in a file;
 //! 3. [`modes`] — the engines, one folder each behind one [`Mode`] trait:
-//!    [`modes::synth`] (Lefebvre & Hoppe's parallel controllable synthesis, the main engine)
-//!    and [`modes::mosaic`] (Xu, Guo & Shum's chaos mosaic, the cheap one); their parameters
+//!    [`modes::synth`] (Lefebvre & Hoppe's parallel controllable synthesis, the main engine),
+//!    [`modes::mosaic`] (Xu, Guo & Shum's chaos mosaic, the cheap one) and
+//!    [`modes::umbrella`] (just-in-time umbrella patches, for textures of elements); their parameters
 //!    are declared once as [`modes::params::ParamSpec`]s and read by one
 //!    [`modes::params::ParamReader`];
 //! 4. [`cache`] — the pyramidal cache that lets neighbouring windows share work;

@@ -131,10 +131,56 @@ pub fn info(a: InfoArgs) -> CliResult {
     );
     println!("levels:            {} (native zoom {})", h.levels + 1, h.levels);
     println!("candidate search:  {}", h.index.name());
+    // The umbrella mode's extraction is a function of the exemplar the file holds.
+    let ex = Exemplar {
+        side: h.side,
+        pixels: an.exemplar.clone(),
+        toroidal: h.toroidal,
+        preparation: h.preparation.clone(),
+        hires: None,
+        randomness_mask: None,
+        lattice: h.lattice,
+    };
+    match textile_core::modes::umbrella::elements(&ex) {
+        Ok((el, _)) => println!(
+            "umbrella elements: {} found, {} bases, mean area {:.0} texels ({})",
+            el.found,
+            el.bases.len(),
+            el.mean_area,
+            el.segmentation
+        ),
+        Err(e) => println!("umbrella elements: none ({e})"),
+    }
     if let Some(l) = h.lattice {
         let (cw, ch) = l.cell(h.side);
         println!("lattice:           {}x{} cells of {cw}x{ch} texels (near-regular)", l.nx, l.ny);
     }
+    Ok(())
+}
+
+/// `textile render --mode umbrella --debug-umbrellas`: the extraction's sheet.
+fn debug_umbrellas(tex: &Texture, params: &ModeParams, output: &Path) -> CliResult {
+    use textile_core::modes::umbrella::{arrange::Arrangement, elements, sheet::debug_sheet};
+    let ModeParams::Umbrella(p) = params else {
+        return Err("--debug-umbrellas needs --mode umbrella".into());
+    };
+    let format = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .and_then(Format::from_ext)
+        .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
+    let (el, id) = elements(&tex.exemplar)?;
+    let img = debug_sheet(&el, &Arrangement::new(&el, p, &id));
+    write_atomic(output, &encode(&img.pixels, img.width, img.height, format, Effort::Tight)?)?;
+    println!(
+        "wrote {} ({}x{}): {} bases of {} elements found ({})",
+        output.display(),
+        img.width,
+        img.height,
+        el.bases.len(),
+        el.found,
+        el.segmentation
+    );
     Ok(())
 }
 
@@ -198,6 +244,9 @@ pub fn render(a: RenderArgs) -> CliResult {
         pairs.push(("controls".into(), base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(compact)));
     }
     let params = tex.defaults.request(&tex.source(), ParamReader::texture(pairs)?)?;
+    if a.debug_umbrellas {
+        return debug_umbrellas(&tex, &params, &output);
+    }
     let z = a.z.unwrap_or(tex.native_zoom());
     if z > tex.max_zoom() {
         return Err(format!("--z {z} is outside 0..={}", tex.max_zoom()).into());

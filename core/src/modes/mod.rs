@@ -251,6 +251,7 @@ modes! {
     Synth => synth::Synth,
     Mosaic => mosaic::Mosaic,
     Tiling => tiling::Tiling,
+    Umbrella => umbrella::Umbrella,
 }
 
 impl ModeParams {

@@ -1,0 +1,149 @@
+//! One umbrella's geometry and colour (design note §5.2, §5.4): the diamond angle that orders
+//! directions with only + − ÷, the sector of the rim a point falls in, its barycentrics in that
+//! sector's triangle, and the colour there — the base texture at the base vertices' texture
+//! coordinates plus the variant's signed vertex colour offsets.
+
+use super::extract::{ray, BaseUmbrella, RAYS};
+
+/// The diamond angle of direction `(x, y)`: a monotone stand-in for `atan2` in `[0, 4)`,
+/// bit-exact with only additions, subtractions and one division.
+#[inline]
+pub fn diamond(x: f32, y: f32) -> f32 {
+    if y >= 0.0 {
+        if x >= 0.0 {
+            if x + y == 0.0 {
+                0.0
+            } else {
+                y / (x + y)
+            }
+        } else {
+            1.0 - x / (y - x)
+        }
+    } else if x < 0.0 {
+        2.0 - y / (-x - y)
+    } else {
+        3.0 + x / (x - y)
+    }
+}
+
+/// The diamond angles of the rays, increasing from 0.
+pub fn ray_angles() -> [f32; RAYS] {
+    std::array::from_fn(|i| {
+        let d = ray(i);
+        diamond(d[0], d[1])
+    })
+}
+
+/// Where a point falls in an umbrella's local frame: sector `i` (between rim vertices `i` and
+/// `i + 1`) and barycentrics `(α, β, γ)` of the centre and those two vertices.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Sector.
+    pub sector: usize,
+    /// Weight of the centre.
+    pub alpha: f32,
+    /// Weight of rim vertex `sector`.
+    pub beta: f32,
+    /// Weight of rim vertex `sector + 1`.
+    pub gamma: f32,
+}
+
+/// The sector of local point `(x, y)` (binary search of its diamond angle among the rays').
+#[inline]
+pub fn sector(angles: &[f32; RAYS], x: f32, y: f32) -> usize {
+    let a = diamond(x, y);
+    // Largest i with angles[i] <= a.
+    let (mut lo, mut hi) = (0usize, RAYS);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if angles[mid] <= a {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Whether local point `(x, y)` lies inside the star-shaped polygon with rim `radii` (vertex
+/// `i` at `radii[i]·ray(i)`), and where; the centre counts as inside.
+#[inline]
+pub fn locate(angles: &[f32; RAYS], rays: &[[f32; 2]; RAYS], radii: &[f32; RAYS], x: f32, y: f32) -> Option<Hit> {
+    if x == 0.0 && y == 0.0 {
+        return Some(Hit { sector: 0, alpha: 1.0, beta: 0.0, gamma: 0.0 });
+    }
+    let i = sector(angles, x, y);
+    let j = (i + 1) % RAYS;
+    let (a, b) = (rays[i].map(|v| v * radii[i]), rays[j].map(|v| v * radii[j]));
+    let det = a[0] * b[1] - a[1] * b[0];
+    let beta = ((x * b[1] - y * b[0]) / det).max(0.0);
+    let gamma = ((a[0] * y - a[1] * x) / det).max(0.0);
+    let alpha = 1.0 - beta - gamma;
+    (alpha >= 0.0).then_some(Hit { sector: i, alpha, beta, gamma })
+}
+
+/// Whether every sector of a rim keeps positive orientation (no fold).
+pub fn fold_free(rays: &[[f32; 2]; RAYS], radii: &[f32; RAYS]) -> bool {
+    (0..RAYS).all(|i| {
+        let j = (i + 1) % RAYS;
+        let (a, b) = (rays[i].map(|v| v * radii[i]), rays[j].map(|v| v * radii[j]));
+        a[0] * b[1] - a[1] * b[0] > 0.0
+    })
+}
+
+/// The colour at a hit: the base texture (bilinear) at the base vertices' texture coordinates,
+/// plus `offsets` (centre first, then the rim; already scaled by the colour strength)
+/// interpolated over the sector's triangle, clamped to `[0, 1]`.
+#[inline]
+pub fn colour(base: &BaseUmbrella, rays: &[[f32; 2]; RAYS], offsets: &[[f32; 3]; RAYS + 1], hit: Hit) -> [f32; 3] {
+    let (i, j) = (hit.sector, (hit.sector + 1) % RAYS);
+    let (ri, rj) = (base.radii[i], base.radii[j]);
+    let u = base.centre[0] + hit.beta * ri * rays[i][0] + hit.gamma * rj * rays[j][0];
+    let v = base.centre[1] + hit.beta * ri * rays[i][1] + hit.gamma * rj * rays[j][1];
+    let t = bilinear(base, u, v);
+    let (o0, oi, oj) = (offsets[0], offsets[i + 1], offsets[j + 1]);
+    [0, 1, 2].map(|k| (t[k] + hit.alpha * o0[k] + hit.beta * oi[k] + hit.gamma * oj[k]).clamp(0.0, 1.0))
+}
+
+/// Bilinear sample of a base texture at crop coordinates `(u, v)` (texel centres at `+0.5`),
+/// clamped to the crop.
+#[inline]
+fn bilinear(base: &BaseUmbrella, u: f32, v: f32) -> [f32; 3] {
+    let (w, h) = (base.w as i32, base.h as i32);
+    let (fx, fy) = (u - 0.5, v - 0.5);
+    let (x0, y0) = (fx.floor(), fy.floor());
+    let (tx, ty) = (fx - x0, fy - y0);
+    let at = |x: i32, y: i32| base.texture[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize];
+    let (x0, y0) = (x0 as i32, y0 as i32);
+    let (a, b, c, d) = (at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1));
+    [0, 1, 2].map(|k| (a[k] * (1.0 - tx) + b[k] * tx) * (1.0 - ty) + (c[k] * (1.0 - tx) + d[k] * tx) * ty)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_diamond_angle_is_monotone_around_the_circle() {
+        let mut last = -1.0f32;
+        for i in 0..3600 {
+            let a = std::f64::consts::TAU * i as f64 / 3600.0;
+            let d = diamond(a.cos() as f32, a.sin() as f32);
+            assert!((0.0..4.0).contains(&d) && d > last, "step {i}: {d} after {last}");
+            last = d;
+        }
+    }
+
+    #[test]
+    fn points_inside_a_disc_are_found_and_outside_are_not() {
+        let (angles, rays) = (ray_angles(), std::array::from_fn(ray));
+        let radii = [10.0f32; RAYS];
+        for i in 0..360 {
+            let a = (i as f32).to_radians();
+            let inner = locate(&angles, &rays, &radii, 9.0 * a.cos(), 9.0 * a.sin()).expect("inside");
+            assert!((inner.alpha + inner.beta + inner.gamma - 1.0).abs() < 1e-5);
+            assert!(locate(&angles, &rays, &radii, 10.5 * a.cos(), 10.5 * a.sin()).is_none());
+        }
+        assert!(fold_free(&rays, &radii));
+    }
+}
