@@ -1,9 +1,10 @@
 //! The infinite arrangement (design note §5.2–5.3): a table of modified umbrellas (base,
 //! variant, morph amount) drawn from the seed, and spawn cells of `G × G` texels that each place
-//! a hash-drawn number of them (position, rotation, scale, depth); every cell's list holds the
-//! umbrellas whose disc — grown by the shadow offset — meets it, front to back, at most `k`,
-//! positions relative to the cell so that far-away cells lose no precision. Lists are kept in
-//! an LRU shared by all requests.
+//! a hash-drawn number of them (position, rotation, scale, depth); every cell's list holds, front
+//! to back, the umbrellas that cover part of it (an exact polygon–square test) up to the `k`-th,
+//! with those in front of it that may shade the cell, positions relative to the cell so that
+//! far-away cells lose no precision. Lists are built a window at a time and kept in an LRU
+//! shared by all requests.
 
 use std::num::NonZeroUsize;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -11,7 +12,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use lru::LruCache;
 
 use super::extract::{ray, Elements, RAYS};
-use super::shape::fold_free;
+use super::shape::{fold_free, Rim};
 use super::UmbrellaParams;
 use crate::hash::hash;
 use crate::modes::params::ONE_Q16;
@@ -48,6 +49,8 @@ pub struct Modified {
     /// Smallest radius: a disc certainly inside (the rim's chords stay outside
     /// `min·cos(π/RAYS)`).
     pub inner: f32,
+    /// The rim prepared for lookups.
+    pub rim: Rim,
 }
 
 /// An umbrella in a cell list, relative to that cell's origin.
@@ -130,7 +133,7 @@ impl Arrangement {
                 let colour = variant.colour.map(|c| c.map(|v| v * strength));
                 let reach = radii.iter().copied().fold(0.0f32, f32::max);
                 let inner = radii.iter().copied().fold(f32::MAX, f32::min) * (std::f32::consts::PI / RAYS as f32).cos();
-                table.push(Modified { base: b, radii, colour, reach, inner });
+                table.push(Modified { base: b, rim: Rim::new(&rays, &radii), radii, colour, reach, inner });
             }
         }
         let scale = (p.scale.0 as f64 / 1000.0, p.scale.1 as f64 / 1000.0);

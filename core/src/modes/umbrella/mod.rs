@@ -4,8 +4,9 @@
 //! every sample point is evaluated at request time ([`shape`]): the front-most umbrella that
 //! contains it gives its colour, umbrellas in front of it that contain the point moved towards
 //! the light shade it, and where none covers it another mode's output (the background) shows.
-//! Pixels are 4×4 sub-sampled. Everything is a function of absolute coordinates, so windows are
-//! the same pixels cut from larger ones.
+//! A pixel whose four corners see the same thing is sampled once; the others take a fixed 4×4
+//! pattern of sub-samples. Everything is a function of absolute coordinates, so windows are the
+//! same pixels cut from larger ones.
 
 pub mod arrange;
 pub mod extract;
@@ -393,7 +394,7 @@ fn sample_in<'a>(
             // Into the umbrella's frame: rotate back, unscale.
             let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
             let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
-            shape::locate(&tabs.angles, &tabs.rays, &m.radii, lx, ly).map(Some)
+            m.rim.locate(&tabs.sectors, lx, ly).map(Some)
         };
         if let Some(hit) = inside(px, py, colour) {
             let sig = (u.depth | 0xFF) ^ shaded;
@@ -411,8 +412,8 @@ fn sample_in<'a>(
 
 /// Per-ray constants.
 struct Tabs {
-    angles: [f32; RAYS],
     rays: [[f32; 2]; RAYS],
+    sectors: shape::SectorTable,
 }
 
 /// The cell lists covering a view, fetched once.
@@ -441,7 +442,7 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
     let (cx0, cy0) = ((tx0 / g).floor() as i64, (ty0 / g).floor() as i64);
     // Inclusive of the far edge: pixel corners lie on it.
     let (cx1, cy1) = ((tx1 / g).floor() as i64 + 1, (ty1 / g).floor() as i64 + 1);
-    let tabs = Tabs { angles: shape::ray_angles(), rays: std::array::from_fn(ray) };
+    let tabs = Tabs { rays: std::array::from_fn(ray), sectors: shape::SectorTable::default() };
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     // Far zoomed out, a view covers more cells than is worth listing: sample the cells sparsely
     // (the lists are fetched lazily per row band below).
@@ -564,7 +565,7 @@ mod tests {
         let (el, id) = elements(&ex).unwrap();
         let p = UmbrellaParams { shadow_offset: 4, shadow: ONE_Q16 / 2, ..UmbrellaParams::default() };
         let arr = Arrangement::new(&el, &p, &id);
-        let tabs = Tabs { angles: shape::ray_angles(), rays: std::array::from_fn(ray) };
+        let tabs = Tabs { rays: std::array::from_fn(ray), sectors: shape::SectorTable::default() };
         let lists = Lists { x0: -2, y0: -2, w: 6, lists: arr.lists(-2, -2, 4, 4) };
         let (mut shaded, mut hits) = (0, 0);
         for i in 0..4000 {
@@ -580,7 +581,7 @@ mod tests {
                 let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
                 let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
                 dx * dx + dy * dy <= u.reach2
-                    && shape::locate(&tabs.angles, &tabs.rays, &arr.table[u.modified as usize].radii, lx, ly).is_some()
+                    && shape::locate(&shape::ray_angles(), &tabs.rays, &arr.table[u.modified as usize].radii, lx, ly).is_some()
             };
             let list = lists.get(cx, cy);
             let hit = list.iter().position(|u| contains(u, px, py));

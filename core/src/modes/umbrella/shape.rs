@@ -34,6 +34,20 @@ pub fn ray_angles() -> [f32; RAYS] {
     })
 }
 
+/// Largest `i` with `angles[i] <= a`.
+fn sector_at(angles: &[f32; RAYS], a: f32) -> usize {
+    let (mut lo, mut hi) = (0usize, RAYS);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if angles[mid] <= a {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 /// Where a point falls in an umbrella's local frame: sector `i` (between rim vertices `i` and
 /// `i + 1`) and barycentrics `(α, β, γ)` of the centre and those two vertices.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51,18 +65,7 @@ pub struct Hit {
 /// The sector of local point `(x, y)` (binary search of its diamond angle among the rays').
 #[inline]
 pub fn sector(angles: &[f32; RAYS], x: f32, y: f32) -> usize {
-    let a = diamond(x, y);
-    // Largest i with angles[i] <= a.
-    let (mut lo, mut hi) = (0usize, RAYS);
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        if angles[mid] <= a {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
+    sector_at(angles, diamond(x, y))
 }
 
 /// Whether local point `(x, y)` lies inside the star-shaped polygon with rim `radii` (vertex
@@ -80,6 +83,73 @@ pub fn locate(angles: &[f32; RAYS], rays: &[[f32; 2]; RAYS], radii: &[f32; RAYS]
     let gamma = ((a[0] * y - a[1] * x) / det).max(0.0);
     let alpha = 1.0 - beta - gamma;
     (alpha >= 0.0).then_some(Hit { sector: i, alpha, beta, gamma })
+}
+
+/// Diamond-angle bins of [`SectorTable`] per unit.
+const BINS: usize = 1024;
+
+/// The sector of a direction by table: the sector at the lower edge of its diamond-angle bin,
+/// stepped forward while the next ray's angle is still below it — the same answer as
+/// [`sector`]'s binary search, with one load and a comparison or two.
+#[derive(Debug, Clone)]
+pub struct SectorTable {
+    angles: [f32; RAYS],
+    lut: Vec<u8>,
+}
+
+impl Default for SectorTable {
+    fn default() -> Self {
+        let angles = ray_angles();
+        let lut = (0..4 * BINS).map(|b| sector_at(&angles, b as f32 / BINS as f32) as u8).collect();
+        SectorTable { angles, lut }
+    }
+}
+
+impl SectorTable {
+    /// The sector of local point `(x, y)`.
+    #[inline]
+    pub fn sector(&self, x: f32, y: f32) -> usize {
+        let a = diamond(x, y);
+        let mut i = self.lut[((a * BINS as f32) as usize).min(4 * BINS - 1)] as usize;
+        while i + 1 < RAYS && self.angles[i + 1] <= a {
+            i += 1;
+        }
+        i
+    }
+}
+
+/// A rim prepared for lookups: per sector its two rim vertices and their determinant, computed
+/// exactly as [`locate`] computes them, so [`Rim::locate`] gives the same bits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rim {
+    tri: [[f32; 5]; RAYS],
+}
+
+impl Rim {
+    /// The rim with radii `radii` along `rays`.
+    pub fn new(rays: &[[f32; 2]; RAYS], radii: &[f32; RAYS]) -> Rim {
+        Rim {
+            tri: std::array::from_fn(|i| {
+                let j = (i + 1) % RAYS;
+                let (a, b) = (rays[i].map(|v| v * radii[i]), rays[j].map(|v| v * radii[j]));
+                [a[0], a[1], b[0], b[1], a[0] * b[1] - a[1] * b[0]]
+            }),
+        }
+    }
+
+    /// [`locate`] with the sector from `table`.
+    #[inline]
+    pub fn locate(&self, table: &SectorTable, x: f32, y: f32) -> Option<Hit> {
+        if x == 0.0 && y == 0.0 {
+            return Some(Hit { sector: 0, alpha: 1.0, beta: 0.0, gamma: 0.0 });
+        }
+        let i = table.sector(x, y);
+        let [a0, a1, b0, b1, det] = self.tri[i];
+        let beta = ((x * b1 - y * b0) / det).max(0.0);
+        let gamma = ((a0 * y - a1 * x) / det).max(0.0);
+        let alpha = 1.0 - beta - gamma;
+        (alpha >= 0.0).then_some(Hit { sector: i, alpha, beta, gamma })
+    }
 }
 
 /// Whether every sector of a rim keeps positive orientation (no fold).
@@ -145,5 +215,23 @@ mod tests {
             assert!(locate(&angles, &rays, &radii, 10.5 * a.cos(), 10.5 * a.sin()).is_none());
         }
         assert!(fold_free(&rays, &radii));
+    }
+
+    #[test]
+    fn the_sector_table_and_prepared_rims_give_the_same_bits() {
+        let (angles, rays) = (ray_angles(), std::array::from_fn(ray));
+        let table = SectorTable::default();
+        let radii: [f32; RAYS] = std::array::from_fn(|i| 4.0 + (i * 7 % 5) as f32);
+        let rim = Rim::new(&rays, &radii);
+        for i in 0..20000 {
+            let t = i as f32 * 0.000314;
+            let (x, y) = (7.3 * (t * 37.0).cos() * (t * 3.0).sin(), 7.3 * (t * 37.0).sin());
+            assert_eq!(table.sector(x, y), sector(&angles, x, y), "{x},{y}");
+            assert_eq!(rim.locate(&table, x, y), locate(&angles, &rays, &radii, x, y), "{x},{y}");
+        }
+        // Exactly on the rays, too.
+        for r in rays {
+            assert_eq!(table.sector(r[0], r[1]), sector(&angles, r[0], r[1]));
+        }
     }
 }
