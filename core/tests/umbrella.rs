@@ -172,7 +172,8 @@ fn a_zoomed_out_tile_is_close_to_its_children_box_filtered() {
     // looked up at the finest scale. Bound: mean absolute difference ≤ 4/255 per channel (1.6
     // and 2.4 measured), and the mean colours within 1/255 (no drift from zoom to zoom). One
     // step further out the background's own zoomed-out pixels take over (no merged levels of
-    // detail yet): reported, not bounded.
+    // detail yet), shifted to the umbrellas' mean colour: there only the drift is bounded (≤ 1.5;
+    // 0.46 measured, 5.46 before the shift), the detail changes (mean difference 12.1).
     for k in 1..=zooms + 1 {
         let parent = render(&ex, &p, View::out(k, Rect::new(40, -30, 64, 64)));
         let children = render(&ex, &p, View::out(k - 1, Rect::new(80, -60, 128, 128))).box_down(2);
@@ -187,6 +188,8 @@ fn a_zoomed_out_tile_is_close_to_its_children_box_filtered() {
         eprintln!("zoom-out {k}: mean |parent − children box-filtered| {diff:.2}, mean drift {drift:.2}");
         if k <= zooms {
             assert!(diff <= 4.0 && drift <= 1.0, "zoom-out {k}: {diff:.2} / {drift:.2}");
+        } else {
+            assert!(drift <= 1.5, "zoom-out {k} (background): drift {drift:.2}");
         }
     }
 }

@@ -143,10 +143,13 @@ pub fn info(a: InfoArgs) -> CliResult {
     };
     match textile_core::modes::umbrella::elements(&ex) {
         Ok((el, _)) => println!(
-            "umbrella elements: {} found, {} bases, mean area {:.0} texels ({})",
+            "umbrella elements: {} found, {} bases, mean area {:.0} texels, sizes {:.2}–{:.2} of the mean, foreground {:.0} % ({})",
             el.found,
             el.bases.len(),
             el.mean_area,
+            el.scale_spread.0,
+            el.scale_spread.1,
+            100.0 * el.foreground,
             el.segmentation
         ),
         Err(e) => println!("umbrella elements: none ({e})"),

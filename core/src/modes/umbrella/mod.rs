@@ -190,7 +190,7 @@ const SPECS: &[ParamSpec] = &[DENSITY, SCALE, SHAPE, COLOUR, SHADOW, SHADOW_OFFS
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 1;
+    const VERSION: u32 = 2;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -271,8 +271,16 @@ impl Mode for Umbrella {
         // Zoomed out until elements are about two pixels across, and beyond: the background's
         // own zoomed-out pixels (the design note's merged levels of detail are not built; see
         // `umbrella_zooms`).
-        if view.zoom_out > umbrella_zooms(&arr) {
-            return Ok(Rendered { image: background, synthesized: rect.area() as u64 });
+        let zooms = umbrella_zooms(&arr);
+        if view.zoom_out > zooms {
+            // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
+            // zoom changes the detail, not the colour.
+            let shift = colour_shift(&elements, &arr, p, src, cache, zooms, &ident)?;
+            let mut image = background;
+            for (i, v) in image.pixels.iter_mut().enumerate() {
+                *v = (*v as f32 + shift[i % 3]).round().clamp(0.0, 255.0) as u8;
+            }
+            return Ok(Rendered { image, synthesized: rect.area() as u64 });
         }
         let image = paint(&elements, &arr, p, view, &background);
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
@@ -285,6 +293,43 @@ impl Mode for Umbrella {
 /// the background's zoomed-out pixels.
 pub fn umbrella_zooms(arr: &Arrangement) -> u32 {
     (arr.g as u64 / 2).max(1).trailing_zeros()
+}
+
+/// Mean colour of the umbrellas' view minus the background's, per channel, at the last zoom
+/// where umbrellas are drawn, over a fixed 128² window at the origin (memoised per texture and
+/// parameters): what the background is shifted by further out.
+fn colour_shift(
+    el: &Elements,
+    arr: &Arrangement,
+    p: &UmbrellaParams,
+    src: &Source,
+    cache: &Pyramid,
+    zooms: u32,
+    ident: &str,
+) -> Result<[f32; 3]> {
+    type Memo = Vec<(String, [f32; 3])>;
+    static MEMO: OnceLock<Mutex<Memo>> = OnceLock::new();
+    let key = format!("{ident}|{}", p.canonical());
+    let memo = MEMO.get_or_init(|| Mutex::new(Vec::new()));
+    if let Some(s) = memo.lock().ok().and_then(|m| m.iter().find(|(k, _)| *k == key).map(|(_, s)| *s)) {
+        return Ok(s);
+    }
+    let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
+    let bg = background(p, src, cache, view)?;
+    let umb = paint(el, arr, p, view, &bg);
+    let mut shift = [0f32; 3];
+    for (i, (a, b)) in umb.pixels.iter().zip(&bg.pixels).enumerate() {
+        shift[i % 3] += *a as f32 - *b as f32;
+    }
+    let n = (umb.pixels.len() / 3).max(1) as f32;
+    let shift = shift.map(|v| v / n);
+    if let Ok(mut m) = memo.lock() {
+        if m.len() >= 64 {
+            m.remove(0);
+        }
+        m.push((key, shift));
+    }
+    Ok(shift)
 }
 
 /// The background of a view: another mode's pixels (or the mean colour).
