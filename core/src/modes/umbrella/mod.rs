@@ -523,6 +523,7 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
         })
         .map(|(ax, ay)| probe(ax, ay, false).sig)
         .collect();
+    let step = 1i64 << view.zoom_out.min(40);
     let mut pixels = vec![0u8; 3 * w * h];
     pixels.par_chunks_mut(3 * w).enumerate().for_each(|(j, row)| {
         let y = rect.y0 + j as i64;
@@ -538,17 +539,19 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
             };
             let out = if uniform {
                 colour_of(probe((x as f64 + 0.5) * scale, (y as f64 + 0.5) * scale, true))
-            } else if let (0, Some(l)) = (view.zoom_out, &lists) {
-                // At native zoom a pixel lies in one cell (cells are whole texels): only the
-                // umbrellas whose disc meets the pixel, or the pixel moved by −ℓ, can matter to
-                // its sub-samples; the same results as the whole list, with fewer tests.
-                let (cx, cy) = (x.div_euclid(arr.g), y.div_euclid(arr.g));
-                let (x0, y0) = ((x - cx * arr.g) as f32, (y - cy * arr.g) as f32);
-                let lo = arr.shadow_offset;
+            } else if let (true, Some(l)) = (step <= arr.g, &lists) {
+                // A pixel lies in one cell (both are aligned powers of two, the pixel no wider):
+                // only the umbrellas whose disc meets the pixel, or the pixel moved by −ℓ, can
+                // matter to its sub-samples; the same results as the whole list (the same f32
+                // coordinates, exactly), with fewer tests.
+                let (tx, ty) = (x * step, y * step);
+                let (cx, cy) = (tx.div_euclid(arr.g), ty.div_euclid(arr.g));
+                let (x0, y0) = ((tx - cx * arr.g) as f32, (ty - cy * arr.g) as f32);
+                let (lo, sf) = (arr.shadow_offset, step as f32);
                 // Conservatively: the centre's distance to the pixel square moved by −(ox, oy).
                 let near = |u: &arrange::Placed, ox: f32, oy: f32| {
-                    let ddx = u.cx - u.cx.clamp(x0 - ox, x0 + 1.0 - ox);
-                    let ddy = u.cy - u.cy.clamp(y0 - oy, y0 + 1.0 - oy);
+                    let ddx = u.cx - u.cx.clamp(x0 - ox, x0 + sf - ox);
+                    let ddy = u.cy - u.cy.clamp(y0 - oy, y0 + sf - oy);
                     ddx * ddx + ddy * ddy <= u.reach2 * 1.001 + 1e-3
                 };
                 near_list.clear();
@@ -556,8 +559,8 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
                 let mut acc = [0f32; 3];
                 for sy in 0..AA {
                     for sx in 0..AA {
-                        let px = x0 + (sx as f32 + 0.5) / AA as f32;
-                        let py = y0 + (sy as f32 + 0.5) / AA as f32;
+                        let px = x0 + (sx as f32 + 0.5) / AA as f32 * sf;
+                        let py = y0 + (sy as f32 + 0.5) / AA as f32 * sf;
                         let c = colour_of(sample_in(el, arr, &tabs, near_list.iter().copied(), px, py, shadow, true));
                         for k in 0..3 {
                             acc[k] += c[k];
