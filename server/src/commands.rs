@@ -82,12 +82,7 @@ pub fn analyze(a: AnalyzeArgs) -> CliResult {
 /// `textile tileable EXEMPLAR --size N -o FILE`.
 pub fn tileable(a: TileableArgs) -> CliResult {
     use textile_core::tileable::{synthesize, Search, TileableOptions};
-    let format = a
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .and_then(Format::from_ext)
-        .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
+    let format = output_format(&a.output)?;
     let toroidal = toroidal_flag(&a.toroidal);
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
     let search = if a.exact { Search::Exact } else { Search::Tsvq { backtrack: a.backtrack } };
@@ -132,16 +127,7 @@ pub fn info(a: InfoArgs) -> CliResult {
     println!("levels:            {} (native zoom {})", h.levels + 1, h.levels);
     println!("candidate search:  {}", h.index.name());
     // The umbrella mode's extraction is a function of the exemplar the file holds.
-    let ex = Exemplar {
-        side: h.side,
-        pixels: an.exemplar.clone(),
-        toroidal: h.toroidal,
-        preparation: h.preparation.clone(),
-        hires: None,
-        randomness_mask: None,
-        lattice: h.lattice,
-    };
-    match textile_core::modes::umbrella::elements(&ex) {
+    match textile_core::modes::umbrella::elements(&an.exemplar()) {
         Ok((el, _)) => println!(
             "umbrella elements: {} found, {} bases, mean area {:.0} texels, sizes {:.2}–{:.2} of the mean, foreground {:.0} % ({})",
             el.found,
@@ -161,17 +147,22 @@ pub fn info(a: InfoArgs) -> CliResult {
     Ok(())
 }
 
+/// The image format an output file's extension names.
+fn output_format(output: &Path) -> Result<Format, &'static str> {
+    output
+        .extension()
+        .and_then(|e| e.to_str())
+        .and_then(Format::from_ext)
+        .ok_or("output must end in .png, .jpg, .jpeg or .webp")
+}
+
 /// `textile render --mode umbrella --debug-umbrellas`: the extraction's sheet.
 fn debug_umbrellas(tex: &Texture, params: &ModeParams, output: &Path) -> CliResult {
     use textile_core::modes::umbrella::{arrange::Arrangement, elements, sheet::debug_sheet};
     let ModeParams::Umbrella(p) = params else {
         return Err("--debug-umbrellas needs --mode umbrella".into());
     };
-    let format = output
-        .extension()
-        .and_then(|e| e.to_str())
-        .and_then(Format::from_ext)
-        .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
+    let format = output_format(output)?;
     let (el, id) = elements(&tex.exemplar)?;
     let img = debug_sheet(&el, &Arrangement::new(&el, p, &id));
     write_atomic(output, &encode(&img.pixels, img.width, img.height, format, Effort::Tight)?)?;
@@ -257,11 +248,7 @@ pub fn render(a: RenderArgs) -> CliResult {
     if let Some(cam) = &a.camera {
         return render_camera(&tex, &params, cam, &a.at, &a.size, &output);
     }
-    let format = output
-        .extension()
-        .and_then(|e| e.to_str())
-        .and_then(Format::from_ext)
-        .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
+    let format = output_format(&output)?;
     let target = if let Some(win) = &a.window {
         let v: Vec<i64> = win
             .split(',')
@@ -401,11 +388,7 @@ fn render_camera(tex: &Texture, params: &ModeParams, cam: &str, at: &str, size: 
     let camera =
         GroundCamera { x: p[0], y: p[1], height: c[0], pitch: c[1], yaw: c[2], fov: c[3], width: w, height_px: h };
     camera.check()?;
-    let format = output
-        .extension()
-        .and_then(|e| e.to_str())
-        .and_then(Format::from_ext)
-        .ok_or("output must end in .png, .jpg, .jpeg or .webp")?;
+    let format = output_format(output)?;
     let started = std::time::Instant::now();
     let view = camera.footprints();
     let ground: Vec<Footprint> = view.iter().flatten().copied().collect();

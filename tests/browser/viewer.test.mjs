@@ -192,6 +192,14 @@ async function tilesCarry(page, value) {
 
 const controlsValue = (hash) => { const m = hash.match(/controls=([A-Za-z0-9_-]+)/); return m ? m[1] : null; };
 
+/** Press the mouse at `from`, move it to `to` in `steps` steps, release. */
+async function drag(page, from, to, steps) {
+  await page.mouse.move(from.x, from.y);
+  await page.mouse.down();
+  await page.mouse.move(to.x, to.y, { steps });
+  await page.mouse.up();
+}
+
 /** Where texel (x, y) is on the page, at the map's current view. */
 function screenOf(page, x, y) {
   return page.evaluate(([x, y]) => {
@@ -214,10 +222,7 @@ test('a feature dragged from the thumbnail shows the exemplar under it, strokes 
   // Drag the centre of the thumbnail (exemplar texel 64, 64) onto texel (100, 60).
   const thumb = await page.locator('#thumb').boundingBox();
   const target = await screenOf(page, 100, 60);
-  await page.mouse.move(thumb.x + thumb.width / 2, thumb.y + thumb.height / 2);
-  await page.mouse.down();
-  await page.mouse.move(target.x, target.y, { steps: 8 });
-  await page.mouse.up();
+  await drag(page, { x: thumb.x + thumb.width / 2, y: thumb.y + thumb.height / 2 }, target, 8);
   const placed = await waitControls(page, (c) => c && c.features);
   await tilesCarry(page, controlsValue(await page.evaluate(() => location.hash)));
   assert.equal(placed.features.length, 1, JSON.stringify(placed));
@@ -255,10 +260,7 @@ test('a feature dragged from the thumbnail shows the exemplar under it, strokes 
   // Paint a calm stroke across tile 7/1/0.
   await page.check('#p-controls-brush');
   const from = await screenOf(page, 300, 100), to = await screenOf(page, 480, 140);
-  await page.mouse.move(from.x, from.y);
-  await page.mouse.down();
-  await page.mouse.move(to.x, to.y, { steps: 12 });
-  await page.mouse.up();
+  await drag(page, from, to, 12);
   const painted = await waitControls(page, (c) => c && c.strokes);
   assert.ok(painted.strokes.length >= 2 && painted.strokes.every((s) => s.value === 0), JSON.stringify(painted.strokes));
   assert.equal(painted.features.length, 1);
@@ -277,10 +279,7 @@ test('a feature dragged from the thumbnail shows the exemplar under it, strokes 
   // Move the feature by its handle, then delete it; clearing removes the controls altogether.
   const handle = await page.locator('.feature-handle').boundingBox();
   const dest = await screenOf(page, 150, 90);
-  await page.mouse.move(handle.x + handle.width / 2, handle.y + handle.height / 2);
-  await page.mouse.down();
-  await page.mouse.move(dest.x, dest.y, { steps: 8 });
-  await page.mouse.up();
+  await drag(page, { x: handle.x + handle.width / 2, y: handle.y + handle.height / 2 }, dest, 8);
   const moved = await waitControls(page, (c) => Math.abs(c.features[0].at[0] - 150) <= 2);
   assert.ok(Math.abs(moved.features[0].at[1] - 90) <= 2, JSON.stringify(moved.features));
   await page.click('#p-controls-f0-delete');

@@ -247,6 +247,21 @@ impl Analysis {
         analysis_id(ex, index.resolve(ex.side))
     }
 
+    /// The exemplar as the analysis holds it (pixels, side, flags, lattice; not the
+    /// high-resolution image or randomness mask, which stay with the texture).
+    pub fn exemplar(&self) -> Exemplar {
+        let h = &self.header;
+        Exemplar {
+            side: h.side,
+            pixels: self.exemplar.clone(),
+            toroidal: h.toroidal,
+            preparation: h.preparation.clone(),
+            hires: None,
+            randomness_mask: None,
+            lattice: h.lattice,
+        }
+    }
+
     /// Exemplar side `m`.
     pub fn side(&self) -> u32 {
         self.header.side

@@ -103,6 +103,18 @@ impl View {
     }
 }
 
+/// Refuse a window that is empty or has more than `max` pixels (what a mode renders in one call).
+pub(crate) fn check_window(rect: Rect, max: i64) -> Result<()> {
+    if rect.is_empty() || rect.area() > max {
+        return Err(CoreError::Window {
+            width: rect.width(),
+            height: rect.height(),
+            message: format!("must be non-empty with at most {max} pixels"),
+        });
+    }
+    Ok(())
+}
+
 /// An engine: its name, version, parameters and rendering of any window.
 pub trait Mode {
     /// Name as the API spells it (`mode=NAME`).

@@ -8,10 +8,10 @@
 use serde_json::{json, Map, Value};
 
 use crate::cache::Pyramid;
-use crate::error::{CoreError, Result};
+use crate::error::Result;
 use crate::image::{box_mip, Rendered, RgbWindow};
 use crate::modes::params::{check_period, Common, ParamReader, ParamSpec};
-use crate::modes::{Cost, Mode, Needs, Source, View};
+use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
 /// Largest window, in pixels, one call may render (2^26).
 pub const MAX_PIXELS: i64 = 1 << 26;
@@ -63,13 +63,7 @@ impl Mode for Tiling {
 
     fn render(_: &TilingParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
         let rect = view.rect;
-        if rect.is_empty() || rect.area() > MAX_PIXELS {
-            return Err(CoreError::Window {
-                width: rect.width(),
-                height: rect.height(),
-                message: format!("must be non-empty with at most {MAX_PIXELS} pixels"),
-            });
-        }
+        check_window(rect, MAX_PIXELS)?;
         let ex = src.exemplar;
         let n = ex.side as usize;
         let lvl = view.zoom_out.min(src.levels()) as usize;

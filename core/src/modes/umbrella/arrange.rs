@@ -183,6 +183,12 @@ impl Arrangement {
         }
     }
 
+    /// The identity of this arrangement (texture and canonical parameters), which keys what is
+    /// cached of it.
+    pub fn key(&self) -> u64 {
+        self.key
+    }
+
     /// The umbrellas spawn cell `(sx, sy)` places: centres `(x, y)` in 1/256 texels (absolute),
     /// and the umbrella (its centre not yet relative to a cell).
     pub fn spawn(&self, sx: i64, sy: i64) -> Vec<(i64, i64, Placed)> {

@@ -13,20 +13,23 @@ pub mod extract;
 pub mod shape;
 pub mod sheet;
 
+use std::num::NonZeroUsize;
 use std::sync::{Arc, Mutex, OnceLock};
+
+use lru::LruCache;
 
 use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
 use crate::cache::Pyramid;
-use crate::error::{CoreError, Result};
+use crate::error::Result;
 use crate::exemplar::Exemplar;
 use crate::image::{Rendered, RgbWindow};
 use crate::modes::mosaic::{self, MosaicParams};
 use crate::modes::params::{check_period, Common, Kind, ParamReader, ParamSpec, Scope, ONE_Q16};
 use crate::modes::synth::{Synth, SynthParams};
 use crate::modes::tiling::{Tiling, TilingParams};
-use crate::modes::{Cost, Mode, Needs, Source, View};
+use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
 use arrange::Arrangement;
 use extract::{ray, Elements, RAYS};
@@ -258,13 +261,7 @@ impl Mode for Umbrella {
 
     fn render(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
         let rect = view.rect;
-        if rect.is_empty() || rect.area() > MAX_PIXELS {
-            return Err(CoreError::Window {
-                width: rect.width(),
-                height: rect.height(),
-                message: format!("must be non-empty with at most {MAX_PIXELS} pixels"),
-            });
-        }
+        check_window(rect, MAX_PIXELS)?;
         let (elements, ident) = elements(src.exemplar)?;
         let arr = Arrangement::new(&elements, p, &ident);
         let background = background(p, src, cache, view)?;
@@ -275,7 +272,7 @@ impl Mode for Umbrella {
         if view.zoom_out > zooms {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
-            let shift = colour_shift(&elements, &arr, p, src, cache, zooms, &ident)?;
+            let shift = colour_shift(&elements, &arr, p, src, cache, zooms)?;
             let mut image = background;
             for (i, v) in image.pixels.iter_mut().enumerate() {
                 *v = (*v as f32 + shift[i % 3]).round().clamp(0.0, 255.0) as u8;
@@ -298,20 +295,10 @@ pub fn umbrella_zooms(arr: &Arrangement) -> u32 {
 /// Mean colour of the umbrellas' view minus the background's, per channel, at the last zoom
 /// where umbrellas are drawn, over a fixed 128² window at the origin (memoised per texture and
 /// parameters): what the background is shifted by further out.
-fn colour_shift(
-    el: &Elements,
-    arr: &Arrangement,
-    p: &UmbrellaParams,
-    src: &Source,
-    cache: &Pyramid,
-    zooms: u32,
-    ident: &str,
-) -> Result<[f32; 3]> {
-    type Memo = Vec<(String, [f32; 3])>;
-    static MEMO: OnceLock<Mutex<Memo>> = OnceLock::new();
-    let key = format!("{ident}|{}", p.canonical());
-    let memo = MEMO.get_or_init(|| Mutex::new(Vec::new()));
-    if let Some(s) = memo.lock().ok().and_then(|m| m.iter().find(|(k, _)| *k == key).map(|(_, s)| *s)) {
+fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source, cache: &Pyramid, zooms: u32) -> Result<[f32; 3]> {
+    static MEMO: OnceLock<Mutex<LruCache<u64, [f32; 3]>>> = OnceLock::new();
+    let memo = MEMO.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(64).unwrap_or(NonZeroUsize::MIN))));
+    if let Some(s) = memo.lock().ok().and_then(|mut m| m.get(&arr.key()).copied()) {
         return Ok(s);
     }
     let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
@@ -324,10 +311,7 @@ fn colour_shift(
     let n = (umb.pixels.len() / 3).max(1) as f32;
     let shift = shift.map(|v| v / n);
     if let Ok(mut m) = memo.lock() {
-        if m.len() >= 64 {
-            m.remove(0);
-        }
-        m.push((key, shift));
+        m.put(arr.key(), shift);
     }
     Ok(shift)
 }
@@ -370,22 +354,18 @@ fn mean_colour(ex: &Exemplar) -> [u8; 3] {
 /// The extraction of an exemplar, memoised by its content hash (deterministic, so computing it
 /// twice gives the same; kept for the textures in use), with that hash.
 pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
-    type Memo = Vec<(String, Arc<Elements>)>;
-    static MEMO: OnceLock<Mutex<Memo>> = OnceLock::new();
+    static MEMO: OnceLock<Mutex<LruCache<String, Arc<Elements>>>> = OnceLock::new();
     let mut h = blake3::Hasher::new();
     h.update(b"textile-umbrella-elements");
     ex.hash_content(&mut h);
     let id = h.finalize().to_hex()[..16].to_string();
-    let memo = MEMO.get_or_init(|| Mutex::new(Vec::new()));
-    if let Some(e) = memo.lock().ok().and_then(|m| m.iter().find(|(k, _)| *k == id).map(|(_, e)| e.clone())) {
+    let memo = MEMO.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(32).unwrap_or(NonZeroUsize::MIN))));
+    if let Some(e) = memo.lock().ok().and_then(|mut m| m.get(&id).cloned()) {
         return Ok((e, id));
     }
     let e = Arc::new(extract::extract(&ex.pixels, ex.side as usize, ex.toroidal)?);
     if let Ok(mut m) = memo.lock() {
-        if m.len() >= 32 {
-            m.remove(0);
-        }
-        m.push((id.clone(), e.clone()));
+        m.put(id.clone(), e.clone());
     }
     Ok((e, id))
 }
