@@ -87,9 +87,8 @@ fn no_morph_folds_and_lists_equal_a_brute_force_search() {
             for sx in cx - 12..=cx + 12 {
                 for (px, py, u) in arr.spawn(sx, sy) {
                     let (x, y) = (px as f64 / 256.0, py as f64 / 256.0);
-                    let rim = arr.rim(&u, x, y);
-                    let covers = arr.meets(&u, &rim, x, y, x0, y0, gf);
-                    if covers || arr.meets(&u, &rim, x, y, x0 - l, y0 - l, gf) {
+                    let covers = arr.meets(&u, x, y, x0, y0, gf);
+                    if covers || arr.meets(&u, x, y, x0 - l, y0 - l, gf) {
                         all.push((u.depth, u.id, (x - x0) as f32, (y - y0) as f32, covers));
                     }
                 }
@@ -167,13 +166,14 @@ fn a_zoomed_out_tile_is_close_to_its_children_box_filtered() {
     let zooms = umbrella_zooms(&Arrangement::new(&el, &p, &id));
     assert!(zooms >= 1, "gravel's elements are drawn at least one step out");
     // Each step out with umbrellas drawn: the parent (4×4 sub-samples per pixel over a 2×2
-    // texel footprint) against the box filter of the children (each anti-aliased itself).
-    // The difference is the sub-sampling's: 16 samples for 4 texels of detail, and texture
-    // looked up at the finest scale. Bound: mean absolute difference ≤ 4/255 per channel (1.6
-    // and 2.4 measured), and the mean colours within 1/255 (no drift from zoom to zoom). One
-    // step further out the background's own zoomed-out pixels take over (no merged levels of
-    // detail yet), shifted to the umbrellas' mean colour: there only the drift is bounded (≤ 1.5;
-    // 0.46 measured, 5.46 before the shift), the detail changes (mean difference 12.1).
+    // texel footprint, each umbrella's colour looked up once per pixel in its mipmapped base
+    // texture) against the box filter of the children (each anti-aliased itself). The
+    // difference is the sub-sampling's and the mipmap's: 16 coverage samples and one filtered
+    // colour for 4 texels of detail. Bound: mean absolute difference ≤ 4/255 per channel (2.5
+    // and 2.8 measured), and the mean colours within 1/255 (0.07 and 0.23: no drift from zoom
+    // to zoom). One step further out the background's own zoomed-out pixels take over (no merged
+    // levels of detail yet), shifted to the umbrellas' mean colour: there only the drift is
+    // bounded (≤ 1.5; 0.44 measured), the detail changes (mean difference 11.9).
     for k in 1..=zooms + 1 {
         let parent = render(&ex, &p, View::out(k, Rect::new(40, -30, 64, 64)));
         let children = render(&ex, &p, View::out(k - 1, Rect::new(80, -60, 128, 128))).box_down(2);

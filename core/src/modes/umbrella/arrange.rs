@@ -10,6 +10,7 @@ use std::num::NonZeroUsize;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use lru::LruCache;
+use rayon::prelude::*;
 
 use super::extract::{ray, Elements, RAYS};
 use super::shape::{fold_free, Rim};
@@ -248,17 +249,33 @@ impl Arrangement {
         })
     }
 
-    /// Whether umbrella `u`, centred at `(x, y)` with rim `rim` ([`Arrangement::rim`]), covers
-    /// part of the square of side `g` at `(x0, y0)`: its centre or a rim vertex inside the
-    /// square, a rim edge crossing it, or the square inside the umbrella.
+    /// Whether umbrella `u`, centred at `(x, y)`, covers part of the square of side `g` at
+    /// `(x0, y0)`: its centre or a rim vertex ([`Arrangement::rim`]) inside the square, a rim
+    /// edge crossing it, or the square inside the umbrella.
     #[allow(clippy::too_many_arguments)]
-    pub fn meets(&self, u: &Placed, rim: &[(f64, f64); RAYS], x: f64, y: f64, x0: f64, y0: f64, g: f64) -> bool {
+    pub fn meets(&self, u: &Placed, x: f64, y: f64, x0: f64, y0: f64, g: f64) -> bool {
+        // The discs first: the square's nearest point to the centre beyond the reach (with a
+        // margin for rounding) → apart; within the inner disc, which the rim encloses → met.
+        let (dx, dy) = (x - x.clamp(x0, x0 + g), y - y.clamp(y0, y0 + g));
+        let d2 = dx * dx + dy * dy;
+        let reach = u.reach as f64 * (1.0 + 1e-5) + 1e-6;
+        if d2 > reach * reach {
+            return false;
+        }
+        if d2 < u.inner2 as f64 {
+            return true;
+        }
+        let rim = self.rim(u, x, y);
         let inside_sq = |(px, py): (f64, f64)| px >= x0 && px <= x0 + g && py >= y0 && py <= y0 + g;
         if inside_sq((x, y)) || rim.iter().any(|&v| inside_sq(v)) {
             return true;
         }
         // A rim edge crossing the square: Liang–Barsky clipping of each edge.
         let crosses = |(ax, ay): (f64, f64), (bx, by): (f64, f64)| {
+            // An edge whose box misses the square cannot cross it.
+            if ax.max(bx) < x0 || ax.min(bx) > x0 + g || ay.max(by) < y0 || ay.min(by) > y0 + g {
+                return false;
+            }
             let (dx, dy) = (bx - ax, by - ay);
             let (mut t0, mut t1) = (0.0f64, 1.0f64);
             for (p, q) in [(-dx, ax - x0), (dx, x0 + g - ax), (-dy, ay - y0), (dy, y0 + g - ay)] {
@@ -299,8 +316,8 @@ impl Arrangement {
     }
 
     /// The lists of cells `cx0..cx1 × cy0..cy1`, row by row: from the LRU where it has them,
-    /// the others computed together — each spawn cell around them placed once and its
-    /// umbrellas binned into the cells they meet.
+    /// the others computed in bands of rows, in parallel — each band places the spawn cells
+    /// around it once and bins their umbrellas into the cells they meet.
     pub fn lists(&self, cx0: i64, cy0: i64, cx1: i64, cy1: i64) -> Vec<Arc<Vec<Placed>>> {
         let (w, h) = ((cx1 - cx0).max(0) as usize, (cy1 - cy0).max(0) as usize);
         let mut out: Vec<Option<Arc<Vec<Placed>>>> = vec![None; w * h];
@@ -312,6 +329,35 @@ impl Arrangement {
         if out.iter().all(Option::is_some) {
             return out.into_iter().flatten().collect();
         }
+        // Bands tall enough that placing the spawn cells around each (`spawn_reach` rows above
+        // and below) adds little, and enough of them to share out.
+        let band = h.div_ceil(2 * rayon::current_num_threads()).max(4 * self.spawn_reach as usize).max(1);
+        let built: Vec<Vec<Arc<Vec<Placed>>>> = out
+            .par_chunks(band * w.max(1))
+            .enumerate()
+            .map(|(b, have)| {
+                let y0 = cy0 + (b * band) as i64;
+                self.build(cx0, y0, cx1, y0 + (have.len() / w.max(1)) as i64, have)
+            })
+            .collect();
+        let mut cache = lists().lock().ok();
+        out.into_iter()
+            .zip(built.into_iter().flatten())
+            .enumerate()
+            .map(|(n, (have, new))| {
+                have.unwrap_or_else(|| {
+                    if let Some(c) = cache.as_mut() {
+                        c.put((self.key, cx0 + (n % w) as i64, cy0 + (n / w) as i64), new.clone());
+                    }
+                    new
+                })
+            })
+            .collect()
+    }
+
+    /// The lists of cells `cx0..cx1 × cy0..cy1` not in `have` (those are returned empty).
+    fn build(&self, cx0: i64, cy0: i64, cx1: i64, cy1: i64, have: &[Option<Arc<Vec<Placed>>>]) -> Vec<Arc<Vec<Placed>>> {
+        let (w, h) = ((cx1 - cx0).max(0) as usize, (cy1 - cy0).max(0) as usize);
         let g = self.g as f64;
         let grow = 1.5 * self.shadow_offset as f64;
         let mut bins: Vec<Vec<(Placed, bool)>> = vec![Vec::new(); w * h];
@@ -323,13 +369,12 @@ impl Arrangement {
                     let (ax0, ax1) = (((x - r) / g).floor() as i64, ((x + r) / g).floor() as i64);
                     let (ay0, ay1) = (((y - r) / g).floor() as i64, ((y + r) / g).floor() as i64);
                     let ur = u.reach as f64;
-                    let rim = self.rim(&u, x, y);
                     let (bx0, bx1) = (((x - ur) / g).floor() as i64, ((x + ur) / g).floor() as i64);
                     let (by0, by1) = (((y - ur) / g).floor() as i64, ((y + ur) / g).floor() as i64);
                     for cy in ay0.max(cy0)..=ay1.min(cy1 - 1) {
                         for cx in ax0.max(cx0)..=ax1.min(cx1 - 1) {
                             let n = (cy - cy0) as usize * w + (cx - cx0) as usize;
-                            if out[n].is_some() {
+                            if have[n].is_some() {
                                 continue;
                             }
                             let g256 = self.g * 256;
@@ -339,10 +384,10 @@ impl Arrangement {
                             let (x0, y0) = (cx as f64 * g, cy as f64 * g);
                             let covers = (bx0..=bx1).contains(&cx)
                                 && (by0..=by1).contains(&cy)
-                                && self.meets(&u, &rim, x, y, x0, y0, g);
+                                && self.meets(&u, x, y, x0, y0, g);
                             // Or it may shade the cell: it covers part of the cell moved by −ℓ.
                             let l = self.shadow_offset as f64;
-                            if covers || (l > 0.0 && self.meets(&u, &rim, x, y, x0 - l, y0 - l, g)) {
+                            if covers || (l > 0.0 && self.meets(&u, x, y, x0 - l, y0 - l, g)) {
                                 bins[n].push((v, covers));
                             }
                         }
@@ -350,29 +395,20 @@ impl Arrangement {
                 }
             }
         }
-        let mut cache = lists().lock().ok();
-        out.into_iter()
-            .zip(bins)
-            .enumerate()
-            .map(|(n, (have, mut bin))| {
-                have.unwrap_or_else(|| {
-                    bin.sort_by(|a, b| b.0.depth.cmp(&a.0.depth).then(a.0.id.cmp(&b.0.id)));
-                    // Up to the k-th umbrella that covers part of the cell; those in front of it
-                    // that only cast shadows into it stay too.
-                    let mut covering = 0;
-                    let end = bin
-                        .iter()
-                        .position(|(_, covers)| {
-                            covering += *covers as usize;
-                            covering == self.k
-                        })
-                        .map_or(bin.len(), |i| i + 1);
-                    let l = Arc::new(bin[..end].iter().map(|(u, _)| *u).collect::<Vec<_>>());
-                    if let Some(c) = cache.as_mut() {
-                        c.put((self.key, cx0 + (n % w) as i64, cy0 + (n / w) as i64), l.clone());
-                    }
-                    l
-                })
+        bins.into_iter()
+            .map(|mut bin| {
+                bin.sort_by(|a, b| b.0.depth.cmp(&a.0.depth).then(a.0.id.cmp(&b.0.id)));
+                // Up to the k-th umbrella that covers part of the cell; those in front of it
+                // that only cast shadows into it stay too.
+                let mut covering = 0;
+                let end = bin
+                    .iter()
+                    .position(|(_, covers)| {
+                        covering += *covers as usize;
+                        covering == self.k
+                    })
+                    .map_or(bin.len(), |i| i + 1);
+                Arc::new(bin[..end].iter().map(|(u, _)| *u).collect::<Vec<_>>())
             })
             .collect()
     }

@@ -27,6 +27,9 @@ pub struct BaseUmbrella {
     pub texture: Vec<[f32; 3]>,
     /// The element's mask over the crop (its alpha: true on the element's texels).
     pub alpha: Vec<bool>,
+    /// The texture box-filtered by halves (levels 1, 2, … down to one texel), for lookups
+    /// whose footprint spans several texels.
+    pub mips: Vec<Mip>,
     /// Centre in crop coordinates (the texture coordinate of the centre vertex).
     pub centre: [f32; 2],
     /// Rim radius along each of the [`RAYS`] rays (texels): vertex `i` is at
@@ -37,6 +40,52 @@ pub struct BaseUmbrella {
     pub variants: Vec<Variant>,
     /// Where the element was in the exemplar (its centre), for inspection.
     pub source: [u32; 2],
+}
+
+/// One level of a base texture's mipmap.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mip {
+    /// Width.
+    pub w: u32,
+    /// Height.
+    pub h: u32,
+    /// Texels, RGB in `[0, 1]`, row-major.
+    pub texels: Vec<[f32; 3]>,
+}
+
+/// The mipmap of a `w × h` texture whose element texels are `alpha`: each level the mean of
+/// (up to) 2×2 texels of the one before weighted by their share of element texels (so that the
+/// margin around the element does not bleed into its colour), until one texel is left.
+pub fn mipmap(w: u32, h: u32, texture: &[[f32; 3]], alpha: &[bool]) -> Vec<Mip> {
+    let mut levels: Vec<Mip> = Vec::new();
+    let (mut w, mut h) = (w as usize, h as usize);
+    let mut prev: Vec<([f32; 3], f32)> = texture.iter().zip(alpha).map(|(&c, &a)| (c, a as u8 as f32)).collect();
+    while w > 1 || h > 1 {
+        let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
+        let mut next = Vec::with_capacity(nw * nh);
+        for y in 0..nh {
+            for x in 0..nw {
+                let (mut sum, mut wsum, mut plain, mut n) = ([0f32; 3], 0f32, [0f32; 3], 0f32);
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let (sx, sy) = (2 * x + dx, 2 * y + dy);
+                    if sx < w && sy < h {
+                        let (c, a) = prev[sy * w + sx];
+                        for k in 0..3 {
+                            sum[k] += a * c[k];
+                            plain[k] += c[k];
+                        }
+                        wsum += a;
+                        n += 1.0;
+                    }
+                }
+                let c = if wsum > 0.0 { sum.map(|v| v / wsum) } else { plain.map(|v| v / n) };
+                next.push((c, wsum / n));
+            }
+        }
+        levels.push(Mip { w: nw as u32, h: nh as u32, texels: next.iter().map(|t| t.0).collect() });
+        (w, h, prev) = (nw, nh, next);
+    }
+    levels
 }
 
 /// A variant of a base: another element of its cluster.
@@ -461,6 +510,7 @@ fn base(px: &[[u8; 3]], m: usize, elements: &[Element], group: &[usize]) -> Base
     BaseUmbrella {
         w: w as u32,
         h: h as u32,
+        mips: mipmap(w as u32, h as u32, &texture, &alpha),
         texture,
         alpha,
         centre,

@@ -4,12 +4,13 @@
 //! every sample point is evaluated at request time ([`shape`]): the front-most umbrella that
 //! contains it gives its colour, umbrellas in front of it that contain the point moved towards
 //! the light shade it, and where none covers it another mode's output (the background) shows.
-//! A pixel whose four corners see the same thing is sampled once; the others take a fixed 4×4
-//! pattern of sub-samples. Everything is a function of absolute coordinates, so windows are the
+//! Coverage is rasterised with a fixed 4×4 pattern of sub-samples per pixel ([`raster`]); the
+//! colour of what a pixel's sub-samples see is evaluated once per umbrella. Everything is a function of absolute coordinates, so windows are the
 //! same pixels cut from larger ones.
 
 pub mod arrange;
 pub mod extract;
+pub mod raster;
 pub mod shape;
 pub mod sheet;
 
@@ -31,7 +32,7 @@ use crate::modes::synth::{Synth, SynthParams};
 use crate::modes::tiling::{Tiling, TilingParams};
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
-use arrange::Arrangement;
+use arrange::{Arrangement, Placed};
 use extract::{ray, Elements, RAYS};
 
 /// Largest window, in pixels, one call may render (2^24: sub-sampling makes pixels dear).
@@ -193,7 +194,7 @@ const SPECS: &[ParamSpec] = &[DENSITY, SCALE, SHAPE, COLOUR, SHADOW, SHADOW_OFFS
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 2;
+    const VERSION: u32 = 3;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -370,204 +371,125 @@ pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
     Ok((e, id))
 }
 
-/// What a sample point sees: a signature (the hit umbrella's id, or none, and how many
-/// umbrellas shade it) and, when asked for, its colour (hits) or shade (background).
-struct Sample {
-    sig: u64,
-    hit: Option<[f32; 3]>,
-    shade: f32,
-}
-
-/// Evaluate one sample point at absolute texel position `(x, y)` (f64 only to reach the cell;
-/// everything after is relative to it); the hit's colour only `if colour`.
-#[allow(clippy::too_many_arguments)]
-fn sample(el: &Elements, arr: &Arrangement, tabs: &Tabs, lists: &Lists, x: f64, y: f64, shadow: f32, colour: bool) -> Sample {
-    let g = arr.g as f64;
-    let (cx, cy) = ((x / g).floor() as i64, (y / g).floor() as i64);
-    let (px, py) = ((x - cx as f64 * g) as f32, (y - cy as f64 * g) as f32);
-    sample_in(el, arr, tabs, lists.get(cx, cy).iter(), px, py, shadow, colour)
-}
-
-/// [`sample`] at `(px, py)` relative to a cell, over `list` — the cell's list, or the part of
-/// it that can matter near the point (front to back either way).
-#[allow(clippy::too_many_arguments)]
-fn sample_in<'a>(
-    el: &Elements,
-    arr: &Arrangement,
-    tabs: &Tabs,
-    list: impl Iterator<Item = &'a arrange::Placed>,
-    px: f32,
-    py: f32,
-    shadow: f32,
-    colour: bool,
-) -> Sample {
-    let l = arr.shadow_offset;
-    let (mut shade, mut shaded) = (1.0f32, 0u64);
-    for u in list {
-        let m = &arr.table[u.modified as usize];
-        // Whether the point is inside, and where (only when `exact`: a point well inside the
-        // rim is known to be in without locating it).
-        let inside = |qx: f32, qy: f32, exact: bool| {
-            let (dx, dy) = (qx - u.cx, qy - u.cy);
-            let d2 = dx * dx + dy * dy;
-            if d2 > u.reach2 {
-                return None;
-            }
-            if !exact && d2 < u.inner2 {
-                return Some(None);
-            }
-            // Into the umbrella's frame: rotate back, unscale.
-            let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
-            let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
-            m.rim.locate(&tabs.sectors, lx, ly).map(Some)
-        };
-        if let Some(hit) = inside(px, py, colour) {
-            let sig = (u.depth | 0xFF) ^ shaded;
-            let c = hit.map(|hit| shape::colour(&el.bases[m.base], &tabs.rays, &m.colour, hit).map(|v| v * shade));
-            return Sample { sig, hit: c, shade };
-        }
-        // An umbrella in front that covers the point moved towards the light shades it.
-        if l > 0.0 && inside(px - l, py - l, false).is_some() {
-            shade *= 1.0 - shadow;
-            shaded += 1;
-        }
-    }
-    Sample { sig: shaded, hit: None, shade }
-}
-
-/// Per-ray constants.
-struct Tabs {
-    rays: [[f32; 2]; RAYS],
-    sectors: shape::SectorTable,
-}
-
-/// The cell lists covering a view, fetched once.
-struct Lists {
-    x0: i64,
-    y0: i64,
-    w: i64,
-    lists: Vec<Arc<Vec<arrange::Placed>>>,
-}
-
-impl Lists {
-    fn get(&self, cx: i64, cy: i64) -> &[arrange::Placed] {
-        let i = (cy - self.y0) * self.w + (cx - self.x0);
-        &self.lists[i as usize]
-    }
-}
-
-/// Render a view: every pixel's 4×4 sub-samples, hits coloured, misses from the background.
+/// Render a view (at most `log2(G/2)` steps out, so that a cell is at least two pixels wide):
+/// band by band — one row of cells each — the coverage of every pixel's fixed 4×4 sub-samples
+/// ([`raster`]), then per pixel the colour of each umbrella (or the background) its sub-samples
+/// see, evaluated once at their centroid and weighted by their number, darkened by their
+/// shadows: multisample anti-aliasing, with one colour evaluation for a pixel inside one
+/// umbrella.
 fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &RgbWindow) -> RgbWindow {
     let rect = view.rect;
-    let scale = (1u64 << view.zoom_out.min(40)) as f64;
-    let g = arr.g as f64;
-    // Cells covering the footprint of the view.
-    let (tx0, ty0) = (rect.x0 as f64 * scale, rect.y0 as f64 * scale);
-    let (tx1, ty1) = (rect.x1 as f64 * scale, rect.y1 as f64 * scale);
-    let (cx0, cy0) = ((tx0 / g).floor() as i64, (ty0 / g).floor() as i64);
-    // Inclusive of the far edge: pixel corners lie on it.
-    let (cx1, cy1) = ((tx1 / g).floor() as i64 + 1, (ty1 / g).floor() as i64 + 1);
-    let tabs = Tabs { rays: std::array::from_fn(ray), sectors: shape::SectorTable::default() };
-    let (w, h) = (rect.width() as usize, rect.height() as usize);
-    // Far zoomed out, a view covers more cells than is worth listing: sample the cells sparsely
-    // (the lists are fetched lazily per row band below).
-    let cells = (cx1 - cx0) as u64 * (cy1 - cy0) as u64;
-    let shadow = p.shadow as f32 / ONE_Q16 as f32;
-    let lists = if cells <= 1 << 16 {
-        Some(Lists {
-            x0: cx0,
-            y0: cy0,
-            w: cx1 - cx0,
-            lists: arr.lists(cx0, cy0, cx1, cy1),
-        })
-    } else {
-        None
-    };
-    let probe = |ax: f64, ay: f64, colour: bool| match &lists {
-        Some(l) => sample(el, arr, &tabs, l, ax, ay, shadow, colour),
-        None => {
-            let (cx, cy) = ((ax / g).floor() as i64, (ay / g).floor() as i64);
-            let one = Lists { x0: cx, y0: cy, w: 1, lists: vec![arr.list(cx, cy)] };
-            sample(el, arr, &tabs, &one, ax, ay, shadow, colour)
-        }
-    };
-    // Signatures at the pixel corners: where all four agree (same umbrella or none, same
-    // shadows), the pixel is taken as uniform and sampled once at its centre; elsewhere (edges)
-    // with the fixed 4×4 pattern. Corners are absolute positions, so this stays a function of
-    // position only.
-    let corners: Vec<u64> = (0..=h)
-        .into_par_iter()
-        .flat_map_iter(|j| {
-            let y = (rect.y0 + j as i64) as f64 * scale;
-            (0..=w).map(move |i| ((rect.x0 + i as i64) as f64 * scale, y)).collect::<Vec<_>>()
-        })
-        .map(|(ax, ay)| probe(ax, ay, false).sig)
-        .collect();
     let step = 1i64 << view.zoom_out.min(40);
-    let mut pixels = vec![0u8; 3 * w * h];
-    pixels.par_chunks_mut(3 * w).enumerate().for_each(|(j, row)| {
-        let y = rect.y0 + j as i64;
-        let mut near_list: Vec<&arrange::Placed> = Vec::new();
-        for i in 0..w {
-            let x = rect.x0 + i as i64;
-            let b = &bg.pixels[3 * (j * w + i)..3 * (j * w + i) + 3];
-            let c = &corners[j * (w + 1) + i..];
-            let uniform = c[0] == c[1] && c[0] == c[w + 1] && c[0] == c[w + 2];
-            let colour_of = |s: Sample| match s.hit {
-                Some(c) => c.map(|v| v * 255.0),
-                None => [0, 1, 2].map(|k| b[k] as f32 * s.shade),
-            };
-            let out = if uniform {
-                colour_of(probe((x as f64 + 0.5) * scale, (y as f64 + 0.5) * scale, true))
-            } else if let (true, Some(l)) = (step <= arr.g, &lists) {
-                // A pixel lies in one cell (both are aligned powers of two, the pixel no wider):
-                // only the umbrellas whose disc meets the pixel, or the pixel moved by −ℓ, can
-                // matter to its sub-samples; the same results as the whole list (the same f32
-                // coordinates, exactly), with fewer tests.
-                let (tx, ty) = (x * step, y * step);
-                let (cx, cy) = (tx.div_euclid(arr.g), ty.div_euclid(arr.g));
-                let (x0, y0) = ((tx - cx * arr.g) as f32, (ty - cy * arr.g) as f32);
-                let (lo, sf) = (arr.shadow_offset, step as f32);
-                // Conservatively: the centre's distance to the pixel square moved by −(ox, oy).
-                let near = |u: &arrange::Placed, ox: f32, oy: f32| {
-                    let ddx = u.cx - u.cx.clamp(x0 - ox, x0 + sf - ox);
-                    let ddy = u.cy - u.cy.clamp(y0 - oy, y0 + sf - oy);
-                    ddx * ddx + ddy * ddy <= u.reach2 * 1.001 + 1e-3
-                };
-                near_list.clear();
-                near_list.extend(l.get(cx, cy).iter().filter(|u| near(u, 0.0, 0.0) || (lo > 0.0 && near(u, lo, lo))));
-                let mut acc = [0f32; 3];
-                for sy in 0..AA {
-                    for sx in 0..AA {
-                        let px = x0 + (sx as f32 + 0.5) / AA as f32 * sf;
-                        let py = y0 + (sy as f32 + 0.5) / AA as f32 * sf;
-                        let c = colour_of(sample_in(el, arr, &tabs, near_list.iter().copied(), px, py, shadow, true));
-                        for k in 0..3 {
-                            acc[k] += c[k];
-                        }
-                    }
+    debug_assert!(2 * step <= arr.g, "umbrellas are drawn while a cell is two pixels wide");
+    // Pixels per cell side.
+    let ppc = (arr.g / step).max(1);
+    let (w, a) = (rect.width() as usize, AA as i64);
+    let sp = step as f32 / AA as f32;
+    let shadow = p.shadow as f32 / ONE_Q16 as f32;
+    let shadows = shadow > 0.0 && arr.shadow_offset > 0.0;
+    let mut darken = [1f32; 256];
+    for n in 1..256 {
+        darken[n] = darken[n - 1] * (1.0 - shadow);
+    }
+    let sectors = shape::SectorTable::default();
+    let rays: [[f32; 2]; RAYS] = std::array::from_fn(ray);
+    let (cx0, cx1) = (rect.x0.div_euclid(ppc), (rect.x1 - 1).div_euclid(ppc) + 1);
+    let (cy0, cy1) = (rect.y0.div_euclid(ppc), (rect.y1 - 1).div_euclid(ppc) + 1);
+    let row_cells = (cx1 - cx0) as usize;
+    // The lists of all cells at once (spawn cells placed once), unless a huge window has more
+    // than is worth holding: then a row of cells at a time.
+    let all = ((cx1 - cx0) as u64 * (cy1 - cy0) as u64 <= 1 << 16).then(|| arr.lists(cx0, cy0, cx1, cy1));
+    let bands: Vec<Vec<u8>> = (cy0..cy1)
+        .into_par_iter()
+        .map(|cy| {
+            let own;
+            let lists: &[Arc<Vec<Placed>>] = match &all {
+                Some(v) => &v[(cy - cy0) as usize * row_cells..][..row_cells],
+                None => {
+                    own = arr.lists(cx0, cy, cx1, cy + 1);
+                    &own
                 }
-                acc.map(|v| v / (AA * AA) as f32)
-            } else {
-                let mut acc = [0f32; 3];
-                for sy in 0..AA {
-                    for sx in 0..AA {
-                        let ax = (x as f64 + (sx as f64 + 0.5) / AA as f64) * scale;
-                        let ay = (y as f64 + (sy as f64 + 0.5) / AA as f64) * scale;
-                        let c = colour_of(probe(ax, ay, true));
-                        for k in 0..3 {
-                            acc[k] += c[k];
-                        }
-                    }
-                }
-                acc.map(|v| v / (AA * AA) as f32)
             };
-            for k in 0..3 {
-                row[3 * i + k] = out[k].round().clamp(0.0, 255.0) as u8;
+            let (j0, j1) = (rect.y0.max(cy * ppc), rect.y1.min((cy + 1) * ppc));
+            let rows_px = (j1 - j0) as usize;
+            let mut cov = raster::Coverage::new(w * AA, rows_px * AA);
+            let mut placed: Vec<&Placed> = Vec::new();
+            let rows = ((j0 - cy * ppc) * a, (j1 - cy * ppc) * a);
+            for (list, cx) in lists.iter().zip(cx0..cx1) {
+                let (i0, i1) = (rect.x0.max(cx * ppc), rect.x1.min((cx + 1) * ppc));
+                let cols = ((i0 - cx * ppc) * a, (i1 - cx * ppc) * a);
+                cov.cell(arr, list, placed.len() as u32, sp, rows, cols, 0, (i0 - rect.x0) * a, shadows);
+                placed.extend(list.iter());
             }
-        }
-    });
-    RgbWindow { width: w as u32, height: h as u32, pixels }
+            let mut out = vec![0u8; 3 * w * rows_px];
+            for (j, row) in out.chunks_exact_mut(3 * w).enumerate() {
+                let y = j0 + j as i64;
+                let oy = (y.rem_euclid(ppc) * step) as f32;
+                let bg_row = &bg.pixels[3 * (y - rect.y0) as usize * w..][..3 * w];
+                for i in 0..w {
+                    let ox = ((rect.x0 + i as i64).rem_euclid(ppc) * step) as f32;
+                    let b = &bg_row[3 * i..3 * i + 3];
+                    // What a group of sub-samples sees, at `(qx, qy)` in the cell.
+                    let eval = |key: u64, qx: f32, qy: f32| -> [f32; 3] {
+                        let (id, f) = ((key >> 8) as u32, darken[(key & 0xFF) as usize]);
+                        if id == raster::NONE {
+                            return [0, 1, 2].map(|k| b[k] as f32 * f);
+                        }
+                        let u = placed[id as usize];
+                        let m = &arr.table[u.modified as usize];
+                        let (dx, dy) = (qx - u.cx, qy - u.cy);
+                        let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
+                        let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
+                        let hit = m.rim.locate_clamped(&sectors, lx, ly);
+                        shape::colour(&el.bases[m.base], &rays, &m.colour, hit, step as f32 * u.inv_scale).map(|v| v * f * 255.0)
+                    };
+                    let mut keys = [0u64; AA * AA];
+                    for sy in 0..AA {
+                        let k = (j * AA + sy) * cov.width + i * AA;
+                        for sx in 0..AA {
+                            keys[sy * AA + sx] = (cov.hit[k + sx] as u64) << 8 | cov.shade[k + sx] as u64;
+                        }
+                    }
+                    let out = if keys.iter().all(|&k| k == keys[0]) {
+                        eval(keys[0], ox + 0.5 * step as f32, oy + 0.5 * step as f32)
+                    } else {
+                        // Groups of equal sub-samples: key, count, sum of positions.
+                        let mut groups = [(0u64, 0u32, 0f32, 0f32); AA * AA];
+                        let mut ng = 0;
+                        for (n, &key) in keys.iter().enumerate() {
+                            let qx = ox + ((n % AA) as f32 + 0.5) * sp;
+                            let qy = oy + ((n / AA) as f32 + 0.5) * sp;
+                            match groups[..ng].iter_mut().find(|g| g.0 == key) {
+                                Some(g) => {
+                                    g.1 += 1;
+                                    g.2 += qx;
+                                    g.3 += qy;
+                                }
+                                None => {
+                                    groups[ng] = (key, 1, qx, qy);
+                                    ng += 1;
+                                }
+                            }
+                        }
+                        let mut acc = [0f32; 3];
+                        for &(key, n, sx, sy) in &groups[..ng] {
+                            let c = eval(key, sx / n as f32, sy / n as f32);
+                            for k in 0..3 {
+                                acc[k] += c[k] * n as f32;
+                            }
+                        }
+                        acc.map(|v| v / (AA * AA) as f32)
+                    };
+                    for k in 0..3 {
+                        // Rounded half up (non-negative; `f32::round` is a call without SSE4.1).
+                        row[3 * i + k] = (out[k].clamp(0.0, 255.0) + 0.5) as u8;
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    RgbWindow { width: w as u32, height: rect.height() as u32, pixels: bands.concat() }
 }
 
 /// Words of storage of the paper's Table 1, `J = b·w·h + 2·b·v + n·(1 + 3v) + k·W·H`, for a
@@ -587,40 +509,57 @@ mod tests {
     use crate::exemplar::ExemplarOptions;
 
     #[test]
-    fn shadows_come_only_from_umbrellas_in_front_of_the_hit_one() {
+    fn coverage_sees_the_first_umbrella_and_shadows_come_only_from_those_in_front_of_it() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png");
         let ex = Exemplar::from_bytes(&std::fs::read(path).unwrap(), &ExemplarOptions::default()).unwrap();
         let (el, id) = elements(&ex).unwrap();
         let p = UmbrellaParams { shadow_offset: 4, shadow: ONE_Q16 / 2, ..UmbrellaParams::default() };
         let arr = Arrangement::new(&el, &p, &id);
-        let tabs = Tabs { rays: std::array::from_fn(ray), sectors: shape::SectorTable::default() };
-        let lists = Lists { x0: -2, y0: -2, w: 6, lists: arr.lists(-2, -2, 4, 4) };
-        let (mut shaded, mut hits) = (0, 0);
-        for i in 0..4000 {
-            let (x, y) = ((i % 61) as f64 * 0.37 - 5.0, (i / 61) as f64 * 0.41 - 6.0);
-            let s = sample(&el, &arr, &tabs, &lists, x, y, 0.5, true);
-            // Independently: the first umbrella of the cell's list containing the point is hit;
-            // only those before it that contain the point moved by −ℓ shade it.
-            let g = arr.g as f64;
-            let (cx, cy) = ((x / g).floor() as i64, (y / g).floor() as i64);
-            let (px, py) = ((x - cx as f64 * g) as f32, (y - cy as f64 * g) as f32);
-            let contains = |u: &arrange::Placed, qx: f32, qy: f32| {
-                let (dx, dy) = (qx - u.cx, qy - u.cy);
-                let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
-                let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
-                dx * dx + dy * dy <= u.reach2
-                    && shape::locate(&shape::ray_angles(), &tabs.rays, &arr.table[u.modified as usize].radii, lx, ly).is_some()
-            };
-            let list = lists.get(cx, cy);
-            let hit = list.iter().position(|u| contains(u, px, py));
-            let front = &list[..hit.unwrap_or(list.len())];
-            let n = front.iter().filter(|u| contains(u, px - 4.0, py - 4.0)).count();
-            assert_eq!(s.shade, 0.5f32.powi(n as i32), "point {x},{y}");
-            assert_eq!(s.hit.is_some(), hit.is_some());
-            shaded += (n > 0) as u32;
-            hits += hit.is_some() as u32;
+        let (angles, rays) = (shape::ray_angles(), std::array::from_fn(ray));
+        // Independently, per point: inside by the barycentric test in the umbrella's frame.
+        let contains = |u: &Placed, qx: f32, qy: f32| {
+            let (dx, dy) = (qx - u.cx, qy - u.cy);
+            let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
+            let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
+            shape::locate(&angles, &rays, &arr.table[u.modified as usize].radii, lx, ly).is_some()
+        };
+        // Whether a rim passes within 0.01 texels of the point (where the two tests may round
+        // differently).
+        let on_rim = |u: &Placed, qx: f32, qy: f32| {
+            let c = contains(u, qx, qy);
+            [(0.01, 0.0), (-0.01, 0.0), (0.0, 0.01), (0.0, -0.01)].iter().any(|&(ex, ey)| contains(u, qx + ex, qy + ey) != c)
+        };
+        let (sp, n) = (0.25f32, arr.g * 4);
+        let (mut shaded, mut hits, mut total, mut borderline) = (0, 0, 0, 0);
+        for cy in -2..3 {
+            for cx in -2..3 {
+                let list = arr.list(cx, cy);
+                let mut cov = raster::Coverage::new(n as usize, n as usize);
+                cov.cell(&arr, &list, 0, sp, (0, n), (0, n), 0, 0, true);
+                for r in 0..n {
+                    for c in 0..n {
+                        let (qx, qy) = ((c as f32 + 0.5) * sp, (r as f32 + 0.5) * sp);
+                        // The first umbrella of the list containing the point is hit; only those
+                        // before it containing the point moved by −ℓ shade it.
+                        let hit = list.iter().position(|u| contains(u, qx, qy));
+                        let front = &list[..hit.unwrap_or(list.len())];
+                        let shade = front.iter().filter(|u| contains(u, qx - 4.0, qy - 4.0)).count();
+                        let k = (r * n + c) as usize;
+                        let got = ((cov.hit[k] != raster::NONE).then_some(cov.hit[k] as usize), cov.shade[k] as usize);
+                        if got != (hit, shade) {
+                            let near = list.iter().any(|u| on_rim(u, qx, qy) || on_rim(u, qx - 4.0, qy - 4.0));
+                            assert!(near, "cell {cx},{cy} sample {c},{r}: coverage {got:?}, walk {:?}", (hit, shade));
+                            borderline += 1;
+                        }
+                        total += 1;
+                        shaded += (shade > 0) as u32;
+                        hits += hit.is_some() as u32;
+                    }
+                }
+            }
         }
-        eprintln!("{hits} of 4000 points hit an umbrella, {shaded} shaded");
+        eprintln!("{hits} of {total} samples hit an umbrella, {shaded} shaded, {borderline} differ on a rim");
+        assert!(borderline * 1000 <= total, "{borderline} of {total} samples differ");
         assert!(shaded > 100 && hits > 1000, "the test saw shadows ({shaded}) and hits ({hits})");
     }
 }

@@ -150,6 +150,26 @@ impl Rim {
         let alpha = 1.0 - beta - gamma;
         (alpha >= 0.0).then_some(Hit { sector: i, alpha, beta, gamma })
     }
+
+    /// Where a point the coverage says is inside falls, for its colour: [`Rim::locate`], and a
+    /// point just past the rim (a sub-sample centroid in a concave part, or rounding at the
+    /// edge) taken onto it.
+    #[inline]
+    pub fn locate_clamped(&self, table: &SectorTable, x: f32, y: f32) -> Hit {
+        if x == 0.0 && y == 0.0 {
+            return Hit { sector: 0, alpha: 1.0, beta: 0.0, gamma: 0.0 };
+        }
+        let i = table.sector(x, y);
+        let [a0, a1, b0, b1, det] = self.tri[i];
+        let mut beta = ((x * b1 - y * b0) / det).max(0.0);
+        let mut gamma = ((a0 * y - a1 * x) / det).max(0.0);
+        let s = beta + gamma;
+        if s > 1.0 {
+            beta /= s;
+            gamma /= s;
+        }
+        Hit { sector: i, alpha: (1.0 - beta - gamma).max(0.0), beta, gamma }
+    }
 }
 
 /// Whether every sector of a rim keeps positive orientation (no fold).
@@ -161,30 +181,67 @@ pub fn fold_free(rays: &[[f32; 2]; RAYS], radii: &[f32; RAYS]) -> bool {
     })
 }
 
-/// The colour at a hit: the base texture (bilinear) at the base vertices' texture coordinates,
-/// plus `offsets` (centre first, then the rim; already scaled by the colour strength)
-/// interpolated over the sector's triangle, clamped to `[0, 1]`.
+/// The colour at a hit: the base texture at the base vertices' texture coordinates (bilinear,
+/// and between mipmap levels when a lookup spans `footprint` > 1 texels of the base), plus
+/// `offsets` (centre first, then the rim; already scaled by the colour strength) interpolated
+/// over the sector's triangle, clamped to `[0, 1]`.
 #[inline]
-pub fn colour(base: &BaseUmbrella, rays: &[[f32; 2]; RAYS], offsets: &[[f32; 3]; RAYS + 1], hit: Hit) -> [f32; 3] {
+pub fn colour(base: &BaseUmbrella, rays: &[[f32; 2]; RAYS], offsets: &[[f32; 3]; RAYS + 1], hit: Hit, footprint: f32) -> [f32; 3] {
     let (i, j) = (hit.sector, (hit.sector + 1) % RAYS);
     let (ri, rj) = (base.radii[i], base.radii[j]);
     let u = base.centre[0] + hit.beta * ri * rays[i][0] + hit.gamma * rj * rays[j][0];
     let v = base.centre[1] + hit.beta * ri * rays[i][1] + hit.gamma * rj * rays[j][1];
-    let t = bilinear(base, u, v);
+    let t = texture(base, u, v, footprint);
     let (o0, oi, oj) = (offsets[0], offsets[i + 1], offsets[j + 1]);
     [0, 1, 2].map(|k| (t[k] + hit.alpha * o0[k] + hit.beta * oi[k] + hit.gamma * oj[k]).clamp(0.0, 1.0))
 }
 
-/// Bilinear sample of a base texture at crop coordinates `(u, v)` (texel centres at `+0.5`),
-/// clamped to the crop.
+/// `log2 v` for `v ≥ 1`, piecewise linear between powers of two (exact at them; plain
+/// arithmetic on the bits, so the same on every machine).
 #[inline]
-fn bilinear(base: &BaseUmbrella, u: f32, v: f32) -> [f32; 3] {
-    let (w, h) = (base.w as i32, base.h as i32);
+fn log2_linear(v: f32) -> f32 {
+    let b = v.max(1.0).to_bits();
+    let e = ((b >> 23) & 0xFF) as i32 - 127;
+    let m = f32::from_bits((b & 0x7F_FFFF) | 0x3F80_0000);
+    e as f32 + (m - 1.0)
+}
+
+/// The base texture at crop coordinates `(u, v)` for a lookup spanning `footprint` texels:
+/// bilinear on the level whose texels are that wide, blended with the next (trilinear).
+#[inline]
+fn texture(base: &BaseUmbrella, u: f32, v: f32, footprint: f32) -> [f32; 3] {
+    let lod = log2_linear(footprint).min(base.mips.len() as f32);
+    let l = lod as usize;
+    let level = |l: usize| -> [f32; 3] {
+        if l == 0 {
+            return bilinear(base.w, base.h, &base.texture, u, v);
+        }
+        let m = &base.mips[l - 1];
+        let s = 1.0 / (1u32 << l) as f32;
+        bilinear(m.w, m.h, &m.texels, u * s, v * s)
+    };
+    let a = level(l);
+    let f = lod - l as f32;
+    if f <= 0.0 || l >= base.mips.len() {
+        return a;
+    }
+    let b = level(l + 1);
+    [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * f)
+}
+
+/// Bilinear sample of a `w × h` texture at `(u, v)` (texel centres at `+0.5`), clamped to it.
+#[inline]
+fn bilinear(w: u32, h: u32, texels: &[[f32; 3]], u: f32, v: f32) -> [f32; 3] {
+    let (w, h) = (w as i32, h as i32);
     let (fx, fy) = (u - 0.5, v - 0.5);
-    let (x0, y0) = (fx.floor(), fy.floor());
-    let (tx, ty) = (fx - x0, fy - y0);
-    let at = |x: i32, y: i32| base.texture[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize];
-    let (x0, y0) = (x0 as i32, y0 as i32);
+    // ⌊·⌋ by conversion (crop coordinates are small; `f32::floor` is a call without SSE4.1).
+    let floor = |v: f32| {
+        let t = v as i32;
+        t - ((t as f32) > v) as i32
+    };
+    let (x0, y0) = (floor(fx), floor(fy));
+    let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
+    let at = |x: i32, y: i32| texels[(y.clamp(0, h - 1) * w + x.clamp(0, w - 1)) as usize];
     let (a, b, c, d) = (at(x0, y0), at(x0 + 1, y0), at(x0, y0 + 1), at(x0 + 1, y0 + 1));
     [0, 1, 2].map(|k| (a[k] * (1.0 - tx) + b[k] * tx) * (1.0 - ty) + (c[k] * (1.0 - tx) + d[k] * tx) * ty)
 }

@@ -64,7 +64,7 @@ pub fn debug_sheet(el: &Elements, arr: &Arrangement) -> RgbWindow {
                 for x in 0..cell - 2 {
                     let (lx, ly) = ((x as f32 - half) / ZOOM as f32, (y as f32 - half) / ZOOM as f32);
                     if let Some(hit) = shape::locate(&angles, &rays, &m.radii, lx, ly) {
-                        let c = shape::colour(base, &rays, &m.colour, hit);
+                        let c = shape::colour(base, &rays, &m.colour, hit, 1.0);
                         put(&mut px, (b * cell) as i64 + x as i64, oy + y as i64, c.map(|v| (v * 255.0).round() as u8));
                     }
                 }
