@@ -4,7 +4,7 @@
 //! the cell, and those in front that may shade it); windows are the same
 //! pixels cut from larger ones at every zoom (cell borders, far away, any thread count, any
 //! cache state); periods repeat exactly; a zoomed-out tile is close to its children
-//! box-filtered.
+//! box-filtered; the orientation spread is measured from the exemplar and bounds rotations.
 
 mod common;
 
@@ -192,4 +192,55 @@ fn a_zoomed_out_tile_is_close_to_its_children_box_filtered() {
             assert!(drift <= 1.5, "zoom-out {k} (background): drift {drift:.2}");
         }
     }
+}
+
+/// A 128² exemplar of 25 ellipses (semi-axes 7 and 3) on a grid, each turned by `angle(i)`
+/// radians, light on dark.
+fn ellipses(angle: impl Fn(usize) -> f64) -> Exemplar {
+    let m = 128usize;
+    let mut img = image::RgbImage::from_pixel(m as u32, m as u32, image::Rgb([30, 30, 40]));
+    for i in 0..25 {
+        let (cx, cy) = (13.0 + 25.0 * (i % 5) as f64, 13.0 + 25.0 * (i / 5) as f64);
+        let (c, s) = (angle(i).cos(), angle(i).sin());
+        for y in 0..m {
+            for x in 0..m {
+                let (dx, dy) = (x as f64 + 0.5 - cx, y as f64 + 0.5 - cy);
+                let (u, v) = (c * dx + s * dy, -s * dx + c * dy);
+                if (u / 7.0).powi(2) + (v / 3.0).powi(2) <= 1.0 {
+                    let shade = 180 + (i * 3) as u8;
+                    img.put_pixel(x as u32, y as u32, image::Rgb([shade, shade - 20, 90]));
+                }
+            }
+        }
+    }
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+    Exemplar::from_bytes(&png, &ExemplarOptions::default()).unwrap()
+}
+
+#[test]
+fn the_orientation_spread_comes_from_the_exemplar_and_bounds_the_rotations() {
+    // Aligned ellipses (within ±5°) → a narrow spread; ellipses pointing every way → about
+    // the full circle; round gravel → any rotation.
+    let aligned = ellipses(|i| ((i * 7 % 11) as f64 - 5.0).to_radians());
+    let every_way = ellipses(|i| (i as f64 * 36.0 + 7.0).to_radians());
+    let (a, _) = elements(&aligned).unwrap();
+    let (e, _) = elements(&every_way).unwrap();
+    eprintln!("orientation spread: aligned ±{}°, every way ±{}°", a.orientation_spread, e.orientation_spread);
+    assert!(a.orientation_spread <= 15, "aligned: ±{}°", a.orientation_spread);
+    assert!(e.orientation_spread >= 90, "every way: ±{}°", e.orientation_spread);
+    // Every placed umbrella of the aligned texture turns by at most the spread.
+    let (el, id) = elements(&aligned).unwrap();
+    let arr = Arrangement::new(&el, &UmbrellaParams::default(), &id);
+    let mut seen = 0;
+    for sy in -20..20 {
+        for sx in -20..20 {
+            for (_, _, u) in arr.spawn(sx, sy) {
+                let turn = (u.sin as f64).atan2(u.cos as f64).to_degrees().abs();
+                assert!(turn <= el.orientation_spread as f64 + 1e-3, "turned {turn}°");
+                seen += 1;
+            }
+        }
+    }
+    assert!(seen > 100, "{seen} umbrellas placed");
 }

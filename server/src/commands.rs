@@ -129,12 +129,13 @@ pub fn info(a: InfoArgs) -> CliResult {
     // The umbrella mode's extraction is a function of the exemplar the file holds.
     match textile_core::modes::umbrella::elements(&an.exemplar()) {
         Ok((el, _)) => println!(
-            "umbrella elements: {} found, {} bases, mean area {:.0} texels, sizes {:.2}–{:.2} of the mean, foreground {:.0} % ({})",
+            "umbrella elements: {} found, {} bases, mean area {:.0} texels, sizes {:.2}–{:.2} of the mean, orientations ±{}°, foreground {:.0} % ({})",
             el.found,
             el.bases.len(),
             el.mean_area,
             el.scale_spread.0,
             el.scale_spread.1,
+            el.orientation_spread,
             100.0 * el.foreground,
             el.segmentation
         ),

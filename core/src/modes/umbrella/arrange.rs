@@ -95,6 +95,8 @@ pub struct Arrangement {
     pub shadow_offset: f32,
     /// At most this many umbrellas per cell list.
     pub k: usize,
+    /// Rotations are drawn within ± this (radians): the exemplar's orientation spread.
+    pub spread: f64,
     seed: u64,
     period_cells: Option<i64>,
     /// Identity of this arrangement for the list cache.
@@ -175,6 +177,7 @@ impl Arrangement {
             scale,
             shadow_offset,
             k: p.k as usize,
+            spread: (el.orientation_spread as f64).to_radians(),
             seed: p.seed,
             period_cells: p.period.map(|n| (n / g).max(1)),
             key,
@@ -213,7 +216,7 @@ impl Arrangement {
                 let z2 = hash(TAG_PLACE, self.seed, hx, hy, i as i64 + (1 << 32));
                 let px = sx * g256 + (z & 0xFFFF) as i64 * g256 / 65536;
                 let py = sy * g256 + ((z >> 16) & 0xFFFF) as i64 * g256 / 65536;
-                let angle = std::f64::consts::TAU * ((z >> 32) & 0xFFFF) as f64 / 65536.0;
+                let angle = self.spread * (2.0 * ((z >> 32) & 0xFFFF) as f64 / 65536.0 - 1.0);
                 let s = self.scale.0 + (self.scale.1 - self.scale.0) * ((z >> 48) & 0xFFFF) as f64 / 65535.0;
                 let modified = (z2 % self.table.len() as u64) as u32;
                 let reach = self.table[modified as usize].reach * s as f32;

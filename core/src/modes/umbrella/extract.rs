@@ -115,6 +115,10 @@ pub struct Elements {
     /// Fraction of the exemplar in the elements' class (the foreground): how much of the plane
     /// elements should cover.
     pub foreground: f64,
+    /// How far the elements' orientations spread, in whole degrees (0–180): placed umbrellas
+    /// are rotated by at most this either way from the orientation they were cut in. 180 (any
+    /// rotation) for round elements or elements pointing every way.
+    pub orientation_spread: u32,
 }
 
 /// One connected component of the foreground.
@@ -402,7 +406,44 @@ pub fn extract(px: &[[u8; 3]], m: usize, toroidal: bool) -> Result<Elements> {
         }
     }
     mean_colour = mean_colour.map(|v| v / (m * m) as f32);
-    Ok(Elements { bases, found: elements.len(), mean_area, scale_spread, mean_colour, segmentation, foreground })
+    let orientation_spread = orientation_spread(&elements, m);
+    Ok(Elements { bases, found: elements.len(), mean_area, scale_spread, mean_colour, segmentation, foreground, orientation_spread })
+}
+
+/// Mean elongation below which elements count as round (their orientation is noise).
+const ROUND: f64 = 0.15;
+
+/// The elements' orientation spread (§5.6 arrangement statistics), in whole degrees: each
+/// element's principal axis from its second moments, weighted by its elongation
+/// (`√((μ20 − μ02)² + 4μ11²) / (μ20 + μ02)`); the axial circular spread of the doubled angles
+/// (`½√(−2 ln R)`) doubled to cover most of them. Round elements, or elements whose axes point
+/// every way, give 180.
+fn orientation_spread(elements: &[Element], m: usize) -> u32 {
+    let (mut sx, mut sy, mut wsum, mut elong) = (0f64, 0f64, 0f64, 0f64);
+    for e in elements {
+        let n = e.texels.len() as f64;
+        let (mx, my) = e.texels.iter().fold((0.0, 0.0), |a, &i| (a.0 + (i % m) as f64 / n, a.1 + (i / m) as f64 / n));
+        let (mut m20, mut m02, mut m11) = (0f64, 0f64, 0f64);
+        for &i in &e.texels {
+            let (dx, dy) = ((i % m) as f64 - mx, (i / m) as f64 - my);
+            m20 += dx * dx;
+            m02 += dy * dy;
+            m11 += dx * dy;
+        }
+        let a = ((m20 - m02).powi(2) + 4.0 * m11 * m11).sqrt() / (m20 + m02).max(1e-9);
+        // The doubled angle's direction is (μ20 − μ02, 2μ11); weight a.
+        let len = ((m20 - m02).powi(2) + 4.0 * m11 * m11).sqrt().max(1e-12);
+        sx += a * (m20 - m02) / len;
+        sy += a * 2.0 * m11 / len;
+        wsum += a;
+        elong += a / elements.len().max(1) as f64;
+    }
+    if elong < ROUND || wsum <= 0.0 {
+        return 180;
+    }
+    let r = ((sx * sx + sy * sy).sqrt() / wsum).clamp(1e-9, 1.0);
+    let sigma = 0.5 * (-2.0 * r.ln()).sqrt();
+    ((2.0 * sigma).to_degrees().round() as u32).min(180)
 }
 
 /// An element's descriptor for clustering: size, colour and normalised radial profile.
