@@ -91,4 +91,38 @@ fn the_extraction_is_drawn_and_reported() {
     let run = std::process::Command::new(binary()).arg("info").arg(&file).output().unwrap();
     let text = String::from_utf8_lossy(&run.stdout);
     assert!(text.contains("umbrella elements:") && text.contains("bases"), "{text}");
+    // The extraction is stored beside the analysis, and info reads it from there.
+    let beside = dir.path().join("gravel.umbrella");
+    assert!(text.contains(&format!("umbrella source:   stored in {}", beside.display())), "{text}");
+    // A damaged one is named and the extraction computed instead — same report, no panic.
+    let mut bytes = std::fs::read(&beside).unwrap();
+    let n = bytes.len();
+    bytes[n / 2] ^= 0x55;
+    std::fs::write(&beside, &bytes).unwrap();
+    let run = std::process::Command::new(binary()).arg("info").arg(&file).output().unwrap();
+    let damaged = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success() && damaged.contains("checksum mismatch"), "{damaged}");
+    let elements = |t: &str| t.lines().find(|l| l.starts_with("umbrella elements:")).map(str::to_string);
+    assert_eq!(elements(&damaged), elements(&text));
+}
+
+#[test]
+fn the_server_stores_each_textures_extraction_and_reads_it_back() {
+    // First start: extracted and stored beside the analyses; second start: loaded from there.
+    let data = tempfile::tempdir().unwrap();
+    for (round, word) in [(1, "stored"), (2, "loaded umbrella extraction")] {
+        let server = Server::builder().data_dir(data.path()).start();
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+        let line = loop {
+            let log = server.log_text();
+            if let Some(l) = log.lines().find(|l| l.contains("texture 'gravel'") && l.contains("umbrella")) {
+                break l.to_string();
+            }
+            assert!(std::time::Instant::now() < deadline, "start {round}: no umbrella line in {log}");
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        };
+        assert!(line.contains(word), "start {round}: {line}");
+        assert!(data.path().join("gravel.umbrella").exists(), "start {round}");
+        server.terminate();
+    }
 }

@@ -244,3 +244,49 @@ fn the_orientation_spread_comes_from_the_exemplar_and_bounds_the_rotations() {
     }
     assert!(seen > 100, "{seen} umbrellas placed");
 }
+
+#[test]
+fn the_stored_extraction_reads_back_as_extracted_and_damage_is_named() {
+    use textile_core::modes::umbrella::{extraction_id, store};
+    use textile_core::AnalysisFileProblem;
+    let ex = fixture("smallstone.png");
+    let (el, id) = elements(&ex).unwrap();
+    assert_eq!(id, extraction_id(&ex));
+    let bytes = store::to_bytes(&id, &Ok(el.clone()));
+    let (read_id, outcome) = store::from_bytes(&bytes).unwrap();
+    assert_eq!((read_id.as_str(), &*outcome.unwrap()), (id.as_str(), &*el), "exactly what extraction gave");
+    // "No elements" is kept too.
+    let none: store::Outcome = Err("found 0 separate elements".into());
+    assert_eq!(store::from_bytes(&store::to_bytes("x", &none)).unwrap().1, none);
+    // Damage of every kind is a typed problem, never a panic.
+    assert!(matches!(store::from_bytes(b"PNG\0...."), Err(AnalysisFileProblem::BadMagic)));
+    assert!(matches!(store::from_bytes(&bytes[..20]), Err(AnalysisFileProblem::Truncated { .. })));
+    for cut in [bytes.len() / 3, bytes.len() - 1] {
+        assert!(store::from_bytes(&bytes[..cut]).is_err());
+    }
+    let mut flipped = bytes.clone();
+    flipped[bytes.len() / 2] ^= 1;
+    assert!(matches!(store::from_bytes(&flipped), Err(AnalysisFileProblem::ChecksumMismatch)));
+    let mut version = bytes.clone();
+    version[8] = 9;
+    assert!(matches!(store::from_bytes(&version), Err(AnalysisFileProblem::UnsupportedVersion { found: 9, .. })));
+    // load_or_extract: a missing file is written, a current one read, a stale or damaged one
+    // replaced; rendering is the same bytes whichever way the extraction came.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("smallstone.umbrella");
+    let (a, s1) = store::load_or_extract(&ex, &path, true);
+    assert_eq!(s1, store::Source::Stored);
+    let (b, s2) = store::load_or_extract(&ex, &path, true);
+    assert_eq!(s2, store::Source::Loaded);
+    assert_eq!(a.unwrap(), b.unwrap());
+    std::fs::write(&path, store::to_bytes("another exemplar", &Ok(el.clone()))).unwrap();
+    assert_eq!(store::load_or_extract(&ex, &path, true).1, store::Source::Stored);
+    std::fs::write(&path, &flipped).unwrap();
+    assert_eq!(store::load_or_extract(&ex, &path, true).1, store::Source::Stored);
+    assert_eq!(store::load_or_extract(&ex, &path, false).1, store::Source::Loaded);
+    let view = View::native(Rect::new(-40, 17, 96, 64));
+    let before = render(&ex, &UmbrellaParams::default(), view);
+    let (_, read) = store::from_bytes(&std::fs::read(&path).unwrap()).unwrap();
+    assert_eq!(*read.unwrap(), *el);
+    assert_eq!(render(&ex, &UmbrellaParams::default(), view), before);
+}

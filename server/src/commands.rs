@@ -63,6 +63,14 @@ pub fn analyze(a: AnalyzeArgs) -> CliResult {
     let t = std::time::Instant::now();
     let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"))?;
     an.save(&a.output)?;
+    // The umbrella mode's extraction beside it (`FILE.umbrella`), for `textile info` and for
+    // a server whose data directory holds both.
+    let beside = a.output.with_extension("umbrella");
+    if let (_, textile_core::modes::umbrella::store::Source::Computed(Some(e))) =
+        textile_core::modes::umbrella::store::load_or_extract(&ex, &beside, true)
+    {
+        return Err(e.into());
+    }
     println!(
         "analysed {} ({}x{} → {}x{}, toroidal {}, {} search) in {:.2}s → {} (id {})",
         a.exemplar.display(),
@@ -126,9 +134,24 @@ pub fn info(a: InfoArgs) -> CliResult {
     );
     println!("levels:            {} (native zoom {})", h.levels + 1, h.levels);
     println!("candidate search:  {}", h.index.name());
-    // The umbrella mode's extraction is a function of the exemplar the file holds.
-    match textile_core::modes::umbrella::elements(&an.exemplar()) {
-        Ok((el, _)) => println!(
+    // The umbrella mode's extraction: stored beside the file (`FILE.umbrella`) when there is
+    // one for this exemplar, else computed from the exemplar the file holds.
+    let beside = a.file.with_extension("umbrella");
+    let ex = an.exemplar();
+    let (stored, from) = match textile_core::modes::umbrella::store::read(&beside) {
+        Ok((id, outcome)) if id == textile_core::modes::umbrella::extraction_id(&ex) => {
+            (Some(outcome), format!("stored in {}", beside.display()))
+        }
+        Ok(_) => (None, format!("computed ({} is of another exemplar or extraction version)", beside.display())),
+        Err(textile_core::CoreError::Io { .. }) => (None, "computed".to_string()),
+        Err(e) => (None, format!("computed ({e})")),
+    };
+    let outcome = match stored {
+        Some(outcome) => outcome.map_err(|m| textile_core::CoreError::Param { name: "umbrella", message: m }),
+        None => textile_core::modes::umbrella::elements(&ex).map(|(el, _)| el),
+    };
+    match outcome {
+        Ok(el) => println!(
             "umbrella elements: {} found, {} bases, mean area {:.0} texels, sizes {:.2}–{:.2} of the mean, orientations ±{}°, foreground {:.0} % ({})",
             el.found,
             el.bases.len(),
@@ -141,6 +164,10 @@ pub fn info(a: InfoArgs) -> CliResult {
         ),
         Err(e) => println!("umbrella elements: none ({e})"),
     }
+    println!(
+        "umbrella source:   {from} (extraction version {})",
+        textile_core::modes::umbrella::extract::EXTRACTION_VERSION
+    );
     if let Some(l) = h.lattice {
         let (cw, ch) = l.cell(h.side);
         println!("lattice:           {}x{} cells of {cw}x{ch} texels (near-regular)", l.nx, l.ny);

@@ -292,7 +292,7 @@ fn remove_stale_temp_files(dir: &std::path::Path, log: &dyn Fn(String)) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        if !(name.starts_with('.') && name.contains(".tex.tmp-")) {
+        if !(name.starts_with('.') && (name.contains(".tex.tmp-") || name.contains(".umbrella.tmp-"))) {
             continue;
         }
         if crate::files::writer_alive(&name) != Some(true) && std::fs::remove_file(e.path()).is_ok() {
@@ -482,6 +482,36 @@ pub fn analyse_texture(
         }
     };
     tex.set_analysis(analysis)?;
+    // The umbrella mode's extraction, beside the analysis: read when current, else computed
+    // (and stored) now rather than on the first umbrella request.
+    let path = data_dir.join(format!("{}.umbrella", t.id));
+    let store = storable && !tex.removed.is_set();
+    let started = std::time::Instant::now();
+    let (outcome, source) = textile_core::modes::umbrella::store::load_or_extract(ex, &path, store);
+    let what = match &outcome {
+        Ok(el) => format!("{} bases", el.bases.len()),
+        Err(_) => "no elements".to_string(),
+    };
+    use textile_core::modes::umbrella::store::Source;
+    match source {
+        Source::Loaded => {
+            log(format!("texture '{}': loaded umbrella extraction ({what}) from {}", t.id, path.display()))
+        }
+        Source::Stored => log(format!(
+            "texture '{}': extracted umbrellas ({what}) in {:.2}s, stored {}",
+            t.id,
+            started.elapsed().as_secs_f64(),
+            path.display()
+        )),
+        Source::Computed(why) => log(format!(
+            "texture '{}': extracted umbrellas ({what}) in {:.2}s, {}",
+            t.id,
+            started.elapsed().as_secs_f64(),
+            why.map_or("kept in memory only".to_string(), |e| format!(
+                "warning: not stored ({e}); kept in memory only"
+            ))
+        )),
+    }
     Ok(())
 }
 

@@ -13,6 +13,9 @@ pub const RAYS: usize = 24;
 pub const MIN_BASES: usize = 4;
 /// Most bases kept.
 pub const MAX_BASES: usize = 10;
+/// Version of what extraction computes: bump it whenever an exemplar's extraction changes, so
+/// that stored extractions of earlier versions are recomputed.
+pub const EXTRACTION_VERSION: u32 = 2;
 /// Variants (colour offsets and morph targets) kept per base at most.
 pub const MAX_VARIANTS: usize = 4;
 

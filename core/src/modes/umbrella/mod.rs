@@ -13,6 +13,7 @@ pub mod extract;
 pub mod raster;
 pub mod shape;
 pub mod sheet;
+pub mod store;
 
 use std::num::NonZeroUsize;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -23,7 +24,7 @@ use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
 use crate::cache::Pyramid;
-use crate::error::Result;
+use crate::error::{CoreError, Result};
 use crate::exemplar::Exemplar;
 use crate::image::{Rendered, RgbWindow};
 use crate::modes::mosaic::{self, MosaicParams};
@@ -352,23 +353,51 @@ fn mean_colour(ex: &Exemplar) -> [u8; 3] {
     s.map(|v| ((v + n / 2) / n) as u8)
 }
 
-/// The extraction of an exemplar, memoised by its content hash (deterministic, so computing it
-/// twice gives the same; kept for the textures in use), with that hash.
-pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
-    static MEMO: OnceLock<Mutex<LruCache<String, Arc<Elements>>>> = OnceLock::new();
+/// The extraction id of an exemplar: a hash of its content and [`extract::EXTRACTION_VERSION`]
+/// (what a stored extraction must match).
+pub fn extraction_id(ex: &Exemplar) -> String {
     let mut h = blake3::Hasher::new();
     h.update(b"textile-umbrella-elements");
+    h.update(&extract::EXTRACTION_VERSION.to_le_bytes());
     ex.hash_content(&mut h);
-    let id = h.finalize().to_hex()[..16].to_string();
-    let memo = MEMO.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(32).unwrap_or(NonZeroUsize::MIN))));
-    if let Some(e) = memo.lock().ok().and_then(|mut m| m.get(&id).cloned()) {
-        return Ok((e, id));
+    h.finalize().to_hex()[..16].to_string()
+}
+
+/// Extractions in use, by extraction id — elements or why there are none (deterministic, so
+/// computing one twice gives the same).
+fn memo() -> &'static Mutex<LruCache<String, store::Outcome>> {
+    static MEMO: OnceLock<Mutex<LruCache<String, store::Outcome>>> = OnceLock::new();
+    MEMO.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(32).unwrap_or(NonZeroUsize::MIN))))
+}
+
+/// Keep an extraction (read from a file) for the process.
+fn remember(id: &str, outcome: store::Outcome) {
+    if let Ok(mut m) = memo().lock() {
+        m.put(id.to_string(), outcome);
     }
-    let e = Arc::new(extract::extract(&ex.pixels, ex.side as usize, ex.toroidal)?);
-    if let Ok(mut m) = memo.lock() {
-        m.put(id.clone(), e.clone());
+}
+
+/// Extract `ex` (id `id`) and remember the outcome.
+fn extracted(ex: &Exemplar, id: &str) -> store::Outcome {
+    let outcome = match extract::extract(&ex.pixels, ex.side as usize, ex.toroidal) {
+        Ok(e) => Ok(Arc::new(e)),
+        Err(CoreError::Param { message, .. }) => Err(message),
+        Err(e) => Err(e.to_string()),
+    };
+    remember(id, outcome.clone());
+    outcome
+}
+
+/// The extraction of an exemplar — remembered, read from its stored file by
+/// [`store::load_or_extract`], or computed now — with its id. No elements → a parameter error
+/// naming the mode.
+pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
+    let id = extraction_id(ex);
+    let known = memo().lock().ok().and_then(|mut m| m.get(&id).cloned());
+    match known.unwrap_or_else(|| extracted(ex, &id)) {
+        Ok(e) => Ok((e, id)),
+        Err(message) => Err(CoreError::Param { name: "umbrella", message }),
     }
-    Ok((e, id))
 }
 
 /// Render a view (at most `log2(G/2)` steps out, so that a cell is at least two pixels wide):
