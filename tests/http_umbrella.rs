@@ -1,7 +1,8 @@
 //! `mode=umbrella` through the real binary: tiles are the same pixels as windows over them, at
 //! native zoom, zoomed out and magnified; bytes are identical across processes and thread
 //! counts and equal `textile render`'s; parameters are validated with 400s naming them;
-//! `textile render --debug-umbrellas` draws the extraction and `textile info` reports it.
+//! `textile render --debug-umbrellas` draws the extraction and `textile info` reports it; the
+//! extraction is stored beside the analysis; a hand-made set in the configuration is served.
 
 mod support;
 
@@ -125,4 +126,73 @@ fn the_server_stores_each_textures_extraction_and_reads_it_back() {
         assert!(data.path().join("gravel.umbrella").exists(), "start {round}");
         server.terminate();
     }
+}
+
+/// A PNG element image with alpha: a disc of colour `rgb` on a transparent `side²` canvas.
+fn disc_png(side: u32, rgb: [u8; 3]) -> Vec<u8> {
+    let r = side as f64 / 2.0 - 1.0;
+    let img = image::RgbaImage::from_fn(side, side, |x, y| {
+        let (dx, dy) = (x as f64 + 0.5 - side as f64 / 2.0, y as f64 + 0.5 - side as f64 / 2.0);
+        if dx * dx + dy * dy <= r * r {
+            image::Rgba([rgb[0], rgb[1].saturating_add((x % 7) as u8 * 4), rgb[2], 255])
+        } else {
+            image::Rgba([0, 0, 0, 0])
+        }
+    });
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+    png
+}
+
+#[tokio::test]
+async fn a_hand_made_umbrella_set_is_configured_and_served() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = dir.path().join("set");
+    std::fs::create_dir_all(&set).unwrap();
+    std::fs::write(set.join("red.png"), disc_png(18, [220, 30, 30])).unwrap();
+    std::fs::write(set.join("red2.png"), disc_png(14, [190, 50, 40])).unwrap();
+    std::fs::write(set.join("yellow.png"), disc_png(12, [230, 210, 40])).unwrap();
+    std::fs::write(
+        set.join("set.json"),
+        r#"{"bases": [{"image": "red.png", "variants": ["red2.png"]}, {"image": "yellow.png"}], "foreground": 0.8}"#,
+    )
+    .unwrap();
+    let cfg = support::gravel_textures_config(dir.path(), &[("plain", ""), ("made", "umbrellas = \"set/set.json\"")]);
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    let made = s.image("/tiles/made/7/2/3.png?mode=umbrella").await;
+    let plain = s.image("/tiles/plain/7/2/3.png?mode=umbrella").await;
+    assert!(made != plain);
+    // The set's red and yellow discs cover much of the tile; gravel has neither colour.
+    let vivid = |img: &image::RgbImage| img.pixels().filter(|p| p[0] > 160 && p[2] < 90).count();
+    assert!(vivid(&made) > 256 * 256 / 4 && vivid(&plain) < 256 * 256 / 100, "{} / {}", vivid(&made), vivid(&plain));
+    // The same bytes as textile render with that configuration.
+    let out = dir.path().join("made.png");
+    let run = std::process::Command::new(binary())
+        .args(["render", "--config", cfg.to_str().unwrap(), "--texture", "made", "--mode", "umbrella"])
+        .args(["--z", "7", "--x", "2", "--y", "3", "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(image::open(&out).unwrap().to_rgb8() == made);
+    // A set whose image has no alpha: a clear error naming the key and the image, nothing written.
+    std::fs::write(set.join("flat.png"), {
+        let mut png = Vec::new();
+        image::RgbImage::new(16, 16).write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+        png
+    })
+    .unwrap();
+    std::fs::write(set.join("bad.json"), r#"{"bases": [{"image": "flat.png"}]}"#).unwrap();
+    let bad = support::gravel_textures_config(dir.path(), &[("bad", "umbrellas = \"set/bad.json\"")]);
+    let out = dir.path().join("bad.png");
+    let run = std::process::Command::new(binary())
+        .args(["render", "--config", bad.to_str().unwrap(), "--texture", "bad", "--mode", "umbrella"])
+        .args(["--x", "0", "--y", "0", "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && err.contains("umbrellas") && err.contains("flat.png") && err.contains("alpha"),
+        "{err}"
+    );
+    assert!(!out.exists());
 }

@@ -290,3 +290,88 @@ fn the_stored_extraction_reads_back_as_extracted_and_damage_is_named() {
     assert_eq!(*read.unwrap(), *el);
     assert_eq!(render(&ex, &UmbrellaParams::default(), view), before);
 }
+
+/// An element image with alpha: an ellipse of semi-axes `(a, b)` in colour `rgb` on a
+/// transparent `w × h` canvas, encoded as PNG.
+fn element_png(w: u32, h: u32, a: f64, b: f64, rgb: [u8; 3]) -> Vec<u8> {
+    let img = image::RgbaImage::from_fn(w, h, |x, y| {
+        let (dx, dy) = ((x as f64 + 0.5 - w as f64 / 2.0) / a, (y as f64 + 0.5 - h as f64 / 2.0) / b);
+        let shade = (x * 3 % 17) as u8;
+        if dx * dx + dy * dy <= 1.0 {
+            image::Rgba([rgb[0].saturating_sub(shade), rgb[1], rgb[2], 255])
+        } else {
+            image::Rgba([0, 0, 0, 0])
+        }
+    });
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+    png
+}
+
+#[test]
+fn a_hand_made_set_gives_its_bases_and_variants_and_bad_sets_are_named() {
+    use textile_core::modes::umbrella::handmade;
+    let images: std::collections::HashMap<&str, Vec<u8>> = [
+        ("red.png", element_png(24, 16, 11.0, 7.0, [230, 40, 40])),
+        ("red2.png", element_png(20, 20, 9.0, 9.0, [200, 60, 40])),
+        ("blue.png", element_png(16, 16, 7.0, 7.0, [40, 60, 220])),
+        ("green.png", element_png(30, 12, 14.0, 5.0, [40, 200, 60])),
+        ("opaque.png", {
+            let mut png = Vec::new();
+            image::RgbImage::new(8, 8).write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+            png
+        }),
+        ("speck.png", element_png(8, 8, 1.5, 1.5, [0, 0, 0])),
+    ]
+    .into_iter()
+    .collect();
+    let read = |name: &str| {
+        images
+            .get(name)
+            .cloned()
+            .ok_or_else(|| textile_core::CoreError::Param { name: "umbrellas", message: format!("no {name}") })
+    };
+    let json =
+        br#"{"bases": [{"image": "red.png", "variants": ["red2.png"]}, {"image": "blue.png"}, {"image": "green.png"}],
+                    "foreground": 0.5}"#;
+    let el = handmade::load(json, &read).unwrap();
+    assert_eq!(el.bases.len(), 3);
+    assert_eq!(el.bases[0].variants.len(), 2, "the base itself and its variant");
+    assert_eq!((el.found, el.foreground), (4, 0.5));
+    for (i, b) in el.bases.iter().enumerate() {
+        // The rim encloses the element: every spoke up to just inside it is on the alpha.
+        let w = b.w as usize;
+        for (r, radius) in b.radii.iter().enumerate() {
+            let d = ray(r);
+            let t = (radius - 0.26).max(0.0);
+            let (x, y) = ((b.centre[0] + d[0] * t).floor() as usize, (b.centre[1] + d[1] * t).floor() as usize);
+            assert!(b.alpha[y * w + x], "base {i} ray {r}");
+        }
+    }
+    // The base's colour is its image's: red stays red.
+    let c =
+        el.bases[0].texture[(el.bases[0].centre[1] as usize) * el.bases[0].w as usize + el.bases[0].centre[0] as usize];
+    assert!(c[0] > 0.7 && c[1] < 0.3, "{c:?}");
+    // An exemplar with the set renders its elements (deterministically), not gravel's.
+    let ex = gravel().with_umbrella_set(el.clone());
+    let view = View::native(Rect::new(-64, 100, 128, 96));
+    let img = render(&ex, &UmbrellaParams::default(), view);
+    assert_eq!(img, render(&ex, &UmbrellaParams::default(), view));
+    let reddish = img.pixels.chunks_exact(3).filter(|p| p[0] > 150 && p[1] < 90 && p[2] < 90).count();
+    assert!(reddish * 20 > img.pixels.len() / 3, "{reddish} red pixels");
+    assert_ne!(img, render(&gravel(), &UmbrellaParams::default(), view));
+    // Bad sets name their problem.
+    for (json, words) in [
+        (&br#"{"bases": []}"#[..], "0 bases"),
+        (br#"{"bases": [{"image": "opaque.png"}]}"#, "no alpha"),
+        (br#"{"bases": [{"image": "speck.png"}]}"#, "at least 16"),
+        (br#"{"bases": [{"image": "missing.png"}]}"#, "no missing.png"),
+        (br#"{"bases": [{"image": "red.png", "colour": 1}]}"#, "unknown field"),
+        (br#"{"bases": [{"image": "red.png"}], "foreground": 2}"#, "foreground 2"),
+        (br#"{"bases": [{"image": "red.png", "variants": ["red.png", "red.png", "red.png", "red.png"]}]}"#, "variants"),
+        (b"not json", "set file"),
+    ] {
+        let e = handmade::load(json, &read).unwrap_err().to_string();
+        assert!(e.contains("umbrellas") && e.contains(words), "{e}");
+    }
+}

@@ -94,6 +94,11 @@ pub struct TextureConfig {
     /// output keeps the exemplar's grid while the cells vary. Makes the exemplar toroidal.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lattice: Option<[u32; 2]>,
+    /// A hand-made umbrella set (JSON naming element images with alpha, relative to the set
+    /// file; path relative to the config file) for the umbrella mode, instead of elements
+    /// extracted from the exemplar.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub umbrellas: Option<String>,
     /// Toroidal flag.
     #[serde(default = "default_toroidal")]
     pub toroidal: Toroidal,
@@ -132,6 +137,7 @@ impl TextureConfig {
             exemplar_hires: None,
             randomness_mask: None,
             lattice: None,
+            umbrellas: None,
             toroidal: Toroidal::Auto,
             index: IndexChoice::Auto,
             default_mode: default_mode(),

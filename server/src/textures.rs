@@ -349,6 +349,18 @@ pub fn prepare_texture(
     if let Some(mask) = &mask {
         ex = ex.with_randomness_mask(mask).map_err(core)?;
     }
+    if let Some(set) = &t.umbrellas {
+        let json = image_bytes(cfg, t, set)?;
+        // The set's images are named relative to the set file.
+        let dir = std::path::Path::new(set).parent().unwrap_or(std::path::Path::new(""));
+        let read = |name: &str| {
+            image_bytes(cfg, t, &dir.join(name).to_string_lossy())
+                .map_err(|e| textile_core::CoreError::Param { name: "umbrellas", message: e.to_string() })
+        };
+        let set_elements = textile_core::modes::umbrella::handmade::load(&json, &read).map_err(core)?;
+        log(format!("texture '{}': hand-made umbrella set {set} ({} bases)", t.id, set_elements.bases.len()));
+        ex = ex.with_umbrella_set(set_elements);
+    }
     let prep = &ex.preparation;
     if prep.input_width != prep.input_height || prep.crop_side != ex.side {
         log(format!(
@@ -494,6 +506,8 @@ pub fn analyse_texture(
     };
     use textile_core::modes::umbrella::store::Source;
     match source {
+        // Logged when the set was read.
+        Source::HandMade => {}
         Source::Loaded => {
             log(format!("texture '{}': loaded umbrella extraction ({what}) from {}", t.id, path.display()))
         }

@@ -259,6 +259,7 @@ impl Analysis {
             hires: None,
             randomness_mask: None,
             lattice: h.lattice,
+            umbrella_set: None,
         }
     }
 

@@ -240,8 +240,8 @@ fn regrow(c: &Component, fg: &[bool], m: usize, r: usize, taken: &[bool]) -> Vec
 }
 
 /// A segmented element: its texels (a mask over the exemplar), centre and rim.
-struct Element {
-    texels: Vec<usize>,
+pub(super) struct Element {
+    pub(super) texels: Vec<usize>,
     centre: (usize, usize),
     radii: [f32; RAYS],
     area: usize,
@@ -371,7 +371,30 @@ pub fn extract(px: &[[u8; 3]], m: usize, toroidal: bool) -> Result<Elements> {
             ),
         });
     }
-    let elements: Vec<Element> = kept
+    let elements = elements_of(px, m, kept);
+    let groups = cluster(&elements);
+    let mut mean_colour = [0f32; 3];
+    for p in px {
+        for k in 0..3 {
+            mean_colour[k] += p[k] as f32 / 255.0;
+        }
+    }
+    mean_colour = mean_colour.map(|v| v / (m * m) as f32);
+    let spread = orientation_spread(&elements, m);
+    Ok(assemble(px, m, &elements, &groups, Summary { mean_colour, segmentation, foreground, orientation_spread: spread }))
+}
+
+/// What [`assemble`] takes as given: the statistics not computed from the elements.
+pub(super) struct Summary {
+    pub mean_colour: [f32; 3],
+    pub segmentation: String,
+    pub foreground: f64,
+    pub orientation_spread: u32,
+}
+
+/// The elements of an `m × m` image from their texels' masks: centre, rim, area, mean colour.
+pub(super) fn elements_of(px: &[[u8; 3]], m: usize, masks: Vec<Vec<usize>>) -> Vec<Element> {
+    masks
         .into_iter()
         .map(|texels| {
             let mut inside = vec![false; m * m];
@@ -394,23 +417,28 @@ pub fn extract(px: &[[u8; 3]], m: usize, toroidal: bool) -> Result<Elements> {
             mean = mean.map(|v| v / area as f32);
             Element { texels, centre, radii, area, mean }
         })
-        .collect();
-    let mean_area = elements.iter().map(|e| e.area as f64).sum::<f64>() / elements.len() as f64;
+        .collect()
+}
+
+/// The bases of `groups` of `elements` (each group's first is the base, the others its
+/// variants) with the size statistics.
+pub(super) fn assemble(px: &[[u8; 3]], m: usize, elements: &[Element], groups: &[Vec<usize>], s: Summary) -> Elements {
+    let mean_area = elements.iter().map(|e| e.area as f64).sum::<f64>() / elements.len().max(1) as f64;
     let mut scales: Vec<f64> = elements.iter().map(|e| (e.area as f64 / mean_area).sqrt()).collect();
     scales.sort_by(f64::total_cmp);
-    let pick = |q: usize| scales[(scales.len() - 1) * q / 100];
+    let pick = |q: usize| scales.get(scales.len().saturating_sub(1) * q / 100).copied().unwrap_or(1.0);
     let scale_spread = (pick(10), pick(90));
-    let groups = cluster(&elements);
-    let bases = groups.iter().map(|g| base(px, m, &elements, g)).collect();
-    let mut mean_colour = [0f32; 3];
-    for p in px {
-        for k in 0..3 {
-            mean_colour[k] += p[k] as f32 / 255.0;
-        }
+    let bases = groups.iter().map(|g| base(px, m, elements, g)).collect();
+    Elements {
+        bases,
+        found: elements.len(),
+        mean_area,
+        scale_spread,
+        mean_colour: s.mean_colour,
+        segmentation: s.segmentation,
+        foreground: s.foreground,
+        orientation_spread: s.orientation_spread,
     }
-    mean_colour = mean_colour.map(|v| v / (m * m) as f32);
-    let orientation_spread = orientation_spread(&elements, m);
-    Ok(Elements { bases, found: elements.len(), mean_area, scale_spread, mean_colour, segmentation, foreground, orientation_spread })
 }
 
 /// Mean elongation below which elements count as round (their orientation is noise).
@@ -421,7 +449,7 @@ const ROUND: f64 = 0.15;
 /// (`√((μ20 − μ02)² + 4μ11²) / (μ20 + μ02)`); the axial circular spread of the doubled angles
 /// (`½√(−2 ln R)`) doubled to cover most of them. Round elements, or elements whose axes point
 /// every way, give 180.
-fn orientation_spread(elements: &[Element], m: usize) -> u32 {
+pub(super) fn orientation_spread(elements: &[Element], m: usize) -> u32 {
     let (mut sx, mut sy, mut wsum, mut elong) = (0f64, 0f64, 0f64, 0f64);
     for e in elements {
         let n = e.texels.len() as f64;

@@ -10,6 +10,7 @@
 
 pub mod arrange;
 pub mod extract;
+pub mod handmade;
 pub mod raster;
 pub mod shape;
 pub mod sheet;
@@ -388,11 +389,14 @@ fn extracted(ex: &Exemplar, id: &str) -> store::Outcome {
     outcome
 }
 
-/// The extraction of an exemplar — remembered, read from its stored file by
+/// The extraction of an exemplar — its hand-made set if it has one, else remembered, read from its stored file by
 /// [`store::load_or_extract`], or computed now — with its id. No elements → a parameter error
 /// naming the mode.
 pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
     let id = extraction_id(ex);
+    if let Some(set) = &ex.umbrella_set {
+        return Ok((set.elements.clone(), id));
+    }
     let known = memo().lock().ok().and_then(|mut m| m.get(&id).cloned());
     match known.unwrap_or_else(|| extracted(ex, &id)) {
         Ok(e) => Ok((e, id)),

@@ -206,14 +206,19 @@ pub enum Source {
     Stored,
     /// Computed; not written (not asked to, or the write failed: the message).
     Computed(Option<String>),
+    /// The exemplar's hand-made set (nothing extracted, nothing written).
+    HandMade,
 }
 
-/// The extraction of `ex`: from the file at `path` when it holds this exemplar's (current
+/// The extraction of `ex`: its hand-made set if it has one; else from the file at `path` when it holds this exemplar's (current
 /// extraction version), else computed and, if `store`, written there. Either way remembered
 /// for the process ([`super::elements`] then finds it). A missing, stale or damaged file is
 /// replaced; the outcome may be "no elements" (kept too, so it is not recomputed).
 pub fn load_or_extract(ex: &Exemplar, path: &Path, store: bool) -> (Outcome, Source) {
     let id = super::extraction_id(ex);
+    if let Some(set) = &ex.umbrella_set {
+        return (Ok(set.elements.clone()), Source::HandMade);
+    }
     if let Ok(bytes) = std::fs::read(path) {
         if let Ok((found, outcome)) = from_bytes(&bytes) {
             if found == id {
