@@ -156,24 +156,50 @@ fn threads_and_periods() {
     let b = render(&ex, &periodic, View::native(Rect::new(-20 + 256, -20 - 512, 100, 60)));
     assert_eq!(a, b);
     assert_ne!(a, render(&ex, &p, View::native(Rect::new(-20, -20, 100, 60))));
+    // The same at the merged levels of detail (gravel: levels 1 and 2 one and two steps out).
+    for k in [1u32, 2] {
+        let view = View::out(k, Rect::new(-70, 33, 90, 70));
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(|| render(&ex, &p, view));
+        assert_eq!(one, render(&ex, &p, view), "zoom-out {k}: thread count changed pixels");
+        let shift = 256 >> k;
+        let a = render(&ex, &periodic, View::out(k, Rect::new(-20, -20, 60, 40)));
+        let b = render(&ex, &periodic, View::out(k, Rect::new(-20 - shift, -20 + 3 * shift, 60, 40)));
+        assert_eq!(a, b, "zoom-out {k}: period");
+    }
 }
 
 #[test]
 fn a_zoomed_out_tile_is_close_to_its_children_box_filtered() {
-    let ex = gravel();
+    // Gravel's small elements (cells of 8 texels) go to merged levels from one step out;
+    // smallstone's larger ones (cells of 16) are all drawn one step out.
+    let mut failures = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for ex in [gravel(), fixture("smallstone.png")] {
+        check_zoom_consistency(&ex, &mut failures, &mut seen);
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+    assert_eq!(seen.len(), 4, "level 0, merged levels 1 and 2 and the background all checked: {seen:?}");
+}
+
+fn check_zoom_consistency(
+    ex: &Exemplar,
+    failures: &mut Vec<String>,
+    seen: &mut std::collections::BTreeSet<Option<u32>>,
+) {
+    let ex = ex.clone();
     let p = UmbrellaParams::default();
     let (el, id) = elements(&ex).unwrap();
     let zooms = umbrella_zooms(&Arrangement::new(&el, &p, &id));
-    assert!(zooms >= 1, "gravel's elements are drawn at least one step out");
-    // Each step out with umbrellas drawn: the parent (4×4 sub-samples per pixel over a 2×2
-    // texel footprint, each umbrella's colour looked up once per pixel in its mipmapped base
-    // texture) against the box filter of the children (each anti-aliased itself). The
-    // difference is the sub-sampling's and the mipmap's: 16 coverage samples and one filtered
-    // colour for 4 texels of detail. Bound: mean absolute difference ≤ 4/255 per channel (2.5
-    // and 2.8 measured), and the mean colours within 1/255 (0.07 and 0.23: no drift from zoom
-    // to zoom). One step further out the background's own zoomed-out pixels take over (no merged
-    // levels of detail yet), shifted to the umbrellas' mean colour: there only the drift is
-    // bounded (≤ 1.5; 0.44 measured), the detail changes (mean difference 11.9).
+    // Each step out with every umbrella drawn (level 0: a cell at least 8 pixels wide): the
+    // parent (4×4 sub-samples per pixel over a 2×2 texel footprint, each umbrella's colour
+    // looked up once per pixel in its mipmapped base texture) against the box filter of the
+    // children (each anti-aliased itself): the sub-sampling's and the mipmap's difference.
+    // Bound: mean absolute difference ≤ 4/255 per channel, mean colours within 1/255 (no drift).
+    // At the merged levels of detail (design note §5.5) elements keep their rims but only
+    // vertex colours — the texture inside an element is gone, by design — and clusters take
+    // their convex hull: bound ≤ 10/255 mean difference, ≤ 1.5 drift. One step further out
+    // the background's own zoomed-out pixels take over, shifted to the umbrellas' mean colour:
+    // there only the drift is bounded (≤ 1.5), the detail changes. Measured figures are printed.
     for k in 1..=zooms + 1 {
         let parent = render(&ex, &p, View::out(k, Rect::new(40, -30, 64, 64)));
         let children = render(&ex, &p, View::out(k - 1, Rect::new(80, -60, 128, 128))).box_down(2);
@@ -185,11 +211,17 @@ fn a_zoomed_out_tile_is_close_to_its_children_box_filtered() {
         }
         let n = parent.pixels.len() as f64;
         let (diff, drift) = (diff / n, (mp - mc).abs() / n);
-        eprintln!("zoom-out {k}: mean |parent − children box-filtered| {diff:.2}, mean drift {drift:.2}");
-        if k <= zooms {
-            assert!(diff <= 4.0 && drift <= 1.0, "zoom-out {k}: {diff:.2} / {drift:.2}");
-        } else {
-            assert!(drift <= 1.5, "zoom-out {k} (background): drift {drift:.2}");
+        let arr = Arrangement::new(&el, &p, &id);
+        let (g, level) = (arr.g, textile_core::modes::umbrella::lod::level(&arr, k));
+        seen.insert(level);
+        eprintln!("G {g} zoom-out {k} (level {level:?}): mean |parent − children box-filtered| {diff:.2}, mean drift {drift:.2}");
+        let ok = match level {
+            Some(0) => diff <= 4.0 && drift <= 1.0,
+            Some(_) => diff <= 10.0 && drift <= 1.5,
+            None => drift <= 1.5,
+        };
+        if !ok {
+            failures.push(format!("G {g} zoom-out {k}: {diff:.2} / {drift:.2}"));
         }
     }
 }

@@ -143,6 +143,25 @@ pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
     Ok(sampled(ex, &layout, zoom_out, rect))
 }
 
+/// `rect` of the mosaic `zoom_out` steps out by the far zoom-out method at every zoom (each
+/// pixel one lookup of the box-filtered exemplar; see [`sampled`]): cheaper than [`render`]'s
+/// exact box filter of the native pixels for zoom-outs 1–3, for callers to whom an approximate
+/// view will do (the umbrella mode's background at its merged levels of detail).
+pub fn render_sampled(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    if zoom_out == 0 || zoom_out > 3 {
+        return render(ex, p, zoom_out, rect);
+    }
+    p.validate(ex.side)?;
+    if rect.is_empty() || rect.area() > MAX_PIXELS {
+        return Err(CoreError::Window {
+            width: rect.width(),
+            height: rect.height(),
+            message: format!("must be non-empty with at most {MAX_PIXELS} pixels"),
+        });
+    }
+    Ok(sampled(ex, &Layout::new(ex.side as i64, p), zoom_out, rect))
+}
+
 /// Far zoom-out (`2^k` texels per pixel, k > 3): label each pixel by its centre texel and colour
 /// it from the box-filtered exemplar at that scale (the mean colour once a pixel covers the
 /// whole exemplar). Approximate, like the paper's reduced-scale rendering.

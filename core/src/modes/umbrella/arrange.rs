@@ -97,6 +97,8 @@ pub struct Arrangement {
     pub k: usize,
     /// Rotations are drawn within ± this (radians): the exemplar's orientation spread.
     pub spread: f64,
+    /// Largest placed radius of any umbrella (texels).
+    pub max_reach: f64,
     seed: u64,
     period_cells: Option<i64>,
     /// Identity of this arrangement for the list cache.
@@ -178,6 +180,7 @@ impl Arrangement {
             shadow_offset,
             k: p.k as usize,
             spread: (el.orientation_spread as f64).to_radians(),
+            max_reach,
             seed: p.seed,
             period_cells: p.period.map(|n| (n / g).max(1)),
             key,

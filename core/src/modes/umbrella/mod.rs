@@ -5,12 +5,14 @@
 //! contains it gives its colour, umbrellas in front of it that contain the point moved towards
 //! the light shade it, and where none covers it another mode's output (the background) shows.
 //! Coverage is rasterised with a fixed 4×4 pattern of sub-samples per pixel ([`raster`]); the
-//! colour of what a pixel's sub-samples see is evaluated once per umbrella. Everything is a function of absolute coordinates, so windows are the
-//! same pixels cut from larger ones.
+//! colour of what a pixel's sub-samples see is evaluated once per umbrella. Zoomed out, merged
+//! levels of detail stand for clusters of umbrellas ([`lod`]). Everything is a function of
+//! absolute coordinates, so windows are the same pixels cut from larger ones.
 
 pub mod arrange;
 pub mod extract;
 pub mod handmade;
+pub mod lod;
 pub mod raster;
 pub mod shape;
 pub mod sheet;
@@ -196,7 +198,7 @@ const SPECS: &[ParamSpec] = &[DENSITY, SCALE, SHAPE, COLOUR, SHADOW, SHADOW_OFFS
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 4;
+    const VERSION: u32 = 5;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -267,32 +269,30 @@ impl Mode for Umbrella {
         check_window(rect, MAX_PIXELS)?;
         let (elements, ident) = elements(src.exemplar)?;
         let arr = Arrangement::new(&elements, p, &ident);
-        let background = background(p, src, cache, view)?;
-        // Zoomed out until elements are about two pixels across, and beyond: the background's
-        // own zoomed-out pixels (the design note's merged levels of detail are not built; see
-        // `umbrella_zooms`).
-        let zooms = umbrella_zooms(&arr);
-        if view.zoom_out > zooms {
+        // Level 0 (every umbrella) while a cell is at least `lod::LOD_PIXELS` wide, then the
+        // merged levels of detail, then the background's own zoomed-out pixels.
+        let level = lod::level(&arr, view.zoom_out);
+        let background = background(p, src, cache, view, level == Some(0))?;
+        let Some(level) = level else {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
-            let shift = colour_shift(&elements, &arr, p, src, cache, zooms)?;
+            let shift = colour_shift(&elements, &arr, p, src, cache, umbrella_zooms(&arr))?;
             let mut image = background;
             for (i, v) in image.pixels.iter_mut().enumerate() {
                 *v = (*v as f32 + shift[i % 3]).round().clamp(0.0, 255.0) as u8;
             }
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
-        }
-        let image = paint(&elements, &arr, p, view, &background);
+        };
+        let image = paint(&elements, &arr, p, view, &background, level);
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
     }
 }
 
-/// Zoom-out steps at which umbrellas are drawn: while a grid cell (about an element's
-/// diameter) is at least two pixels wide. Further out, elements are too small for sub-samples
-/// to resolve and a tile would need the lists of more cells than it has pixels; the view is then
-/// the background's zoomed-out pixels.
+/// Zoom-out steps at which umbrellas are drawn: every one of them while a grid cell (about an
+/// element's diameter) is at least [`lod::LOD_PIXELS`] wide, merged ones down to
+/// [`lod::MAX_LEVEL`]. Further out the view is the background's zoomed-out pixels.
 pub fn umbrella_zooms(arr: &Arrangement) -> u32 {
-    (arr.g as u64 / 2).max(1).trailing_zeros()
+    (0..64).take_while(|&z| lod::level(arr, z).is_some()).last().unwrap_or(0)
 }
 
 /// Mean colour of the umbrellas' view minus the background's, per channel, at the last zoom
@@ -305,8 +305,9 @@ fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Sour
         return Ok(s);
     }
     let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
-    let bg = background(p, src, cache, view)?;
-    let umb = paint(el, arr, p, view, &bg);
+    let level = lod::level(arr, zooms).unwrap_or(0);
+    let bg = background(p, src, cache, view, level == 0)?;
+    let umb = paint(el, arr, p, view, &bg, level);
     let mut shift = [0f32; 3];
     for (i, (a, b)) in umb.pixels.iter().zip(&bg.pixels).enumerate() {
         shift[i % 3] += *a as f32 - *b as f32;
@@ -319,13 +320,18 @@ fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Sour
     Ok(shift)
 }
 
-/// The background of a view: another mode's pixels (or the mean colour).
-fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> Result<RgbWindow> {
+/// The background of a view: another mode's pixels (or the mean colour); the mosaic's exact
+/// zoomed-out pixels only if `exact` (where every umbrella is drawn), else its approximate ones.
+fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View, exact: bool) -> Result<RgbWindow> {
     let ex = src.exemplar;
     Ok(match p.background {
         Background::Mosaic => {
             let mp = MosaicParams { seed: p.seed, period: p.period, ..MosaicParams::default() };
-            mosaic::render(ex, &mp, view.zoom_out, view.rect)?
+            if exact {
+                mosaic::render(ex, &mp, view.zoom_out, view.rect)?
+            } else {
+                mosaic::render_sampled(ex, &mp, view.zoom_out, view.rect)?
+            }
         }
         Background::Synth => {
             let sp = SynthParams { seed: p.seed, period: p.period, ..SynthParams::default() };
@@ -404,22 +410,24 @@ pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
     }
 }
 
-/// Render a view (at most `log2(G/2)` steps out, so that a cell is at least two pixels wide):
-/// band by band — one row of cells each — the coverage of every pixel's fixed 4×4 sub-samples
-/// ([`raster`]), then per pixel the colour of each umbrella (or the background) its sub-samples
-/// see, evaluated once at their centroid and weighted by their number, darkened by their
-/// shadows: multisample anti-aliasing, with one colour evaluation for a pixel inside one
-/// umbrella.
-fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &RgbWindow) -> RgbWindow {
+/// Render a view at level of detail `level` (whose cells are at least two pixels wide): band by
+/// band — one row of cells each — the coverage of every pixel's fixed 4×4 sub-samples
+/// ([`raster`]) by the cells' umbrellas (level 0: each cell's list; merged levels: the merged
+/// umbrellas around it, [`lod`]), then per pixel the colour of each umbrella (or the
+/// background) its sub-samples see, evaluated once at their centroid and weighted by their
+/// number, darkened by their shadows: multisample anti-aliasing, with one colour evaluation
+/// for a pixel inside one umbrella.
+fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &RgbWindow, level: u32) -> RgbWindow {
     let rect = view.rect;
     let step = 1i64 << view.zoom_out.min(40);
-    debug_assert!(2 * step <= arr.g, "umbrellas are drawn while a cell is two pixels wide");
+    let side = arr.g << level;
+    debug_assert!(2 * step <= side, "umbrellas are drawn while a cell is two pixels wide");
     // Pixels per cell side.
-    let ppc = (arr.g / step).max(1);
+    let ppc = (side / step).max(1);
     let (w, a) = (rect.width() as usize, AA as i64);
     let sp = step as f32 / AA as f32;
     let shadow = p.shadow as f32 / ONE_Q16 as f32;
-    let shadows = shadow > 0.0 && arr.shadow_offset > 0.0;
+    let shadows = (shadow > 0.0 && arr.shadow_offset > 0.0).then_some(arr.shadow_offset);
     let mut darken = [1f32; 256];
     for n in 1..256 {
         darken[n] = darken[n - 1] * (1.0 - shadow);
@@ -429,30 +437,65 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
     let (cx0, cx1) = (rect.x0.div_euclid(ppc), (rect.x1 - 1).div_euclid(ppc) + 1);
     let (cy0, cy1) = (rect.y0.div_euclid(ppc), (rect.y1 - 1).div_euclid(ppc) + 1);
     let row_cells = (cx1 - cx0) as usize;
-    // The lists of all cells at once (spawn cells placed once), unless a huge window has more
-    // than is worth holding: then a row of cells at a time.
-    let all = ((cx1 - cx0) as u64 * (cy1 - cy0) as u64 <= 1 << 16).then(|| arr.lists(cx0, cy0, cx1, cy1));
+    // Level 0: the lists of all cells at once (spawn cells placed once), unless a huge window
+    // has more than is worth holding: then a row of cells at a time.
+    let all = (level == 0 && (cx1 - cx0) as u64 * (cy1 - cy0) as u64 <= 1 << 16).then(|| arr.lists(cx0, cy0, cx1, cy1));
+    // Merged levels: the merged cells around the view, computed in parallel.
+    let reach = if level > 0 { lod::around(arr, level) } else { 0 };
+    let (mx0, my0, mw) = (cx0 - reach, cy0 - reach, (cx1 - cx0 + 2 * reach) as usize);
+    let merged: Vec<(i64, i64, Arc<Vec<lod::Merged>>)> = if level > 0 {
+        let mh = (cy1 - cy0 + 2 * reach) as usize;
+        (0..mw * mh)
+            .into_par_iter()
+            .map(|n| {
+                let (x, y) = (mx0 + (n % mw) as i64, my0 + (n / mw) as i64);
+                (x, y, lod::cell(el, arr, &sectors, level, x, y))
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     let bands: Vec<Vec<u8>> = (cy0..cy1)
         .into_par_iter()
         .map(|cy| {
-            let own;
-            let lists: &[Arc<Vec<Placed>>] = match &all {
-                Some(v) => &v[(cy - cy0) as usize * row_cells..][..row_cells],
-                None => {
-                    own = arr.lists(cx0, cy, cx1, cy + 1);
-                    &own
-                }
-            };
             let (j0, j1) = (rect.y0.max(cy * ppc), rect.y1.min((cy + 1) * ppc));
             let rows_px = (j1 - j0) as usize;
             let mut cov = raster::Coverage::new(w * AA, rows_px * AA);
-            let mut placed: Vec<&Placed> = Vec::new();
             let rows = ((j0 - cy * ppc) * a, (j1 - cy * ppc) * a);
-            for (list, cx) in lists.iter().zip(cx0..cx1) {
-                let (i0, i1) = (rect.x0.max(cx * ppc), rect.x1.min((cx + 1) * ppc));
-                let cols = ((i0 - cx * ppc) * a, (i1 - cx * ppc) * a);
-                cov.cell(arr, list, placed.len() as u32, sp, rows, cols, 0, (i0 - rect.x0) * a, shadows);
-                placed.extend(list.iter());
+            let own;
+            let mut placed: Vec<&Placed> = Vec::new();
+            let mut locals: Vec<lod::Local> = Vec::new();
+            if level == 0 {
+                let lists: &[Arc<Vec<Placed>>] = match &all {
+                    Some(v) => &v[(cy - cy0) as usize * row_cells..][..row_cells],
+                    None => {
+                        own = arr.lists(cx0, cy, cx1, cy + 1);
+                        &own
+                    }
+                };
+                for (list, cx) in lists.iter().zip(cx0..cx1) {
+                    let (i0, i1) = (rect.x0.max(cx * ppc), rect.x1.min((cx + 1) * ppc));
+                    let cols = ((i0 - cx * ppc) * a, (i1 - cx * ppc) * a);
+                    let shape = raster::placed_shape(arr, list);
+                    cov.cell(list.len(), shape, placed.len() as u32, sp, rows, cols, (0, (i0 - rect.x0) * a), shadows);
+                    placed.extend(list.iter());
+                }
+            } else {
+                for cx in cx0..cx1 {
+                    let (i0, i1) = (rect.x0.max(cx * ppc), rect.x1.min((cx + 1) * ppc));
+                    let cols = ((i0 - cx * ppc) * a, (i1 - cx * ppc) * a);
+                    // The merged cells within `reach` of this one.
+                    let near = (cy - reach..=cy + reach)
+                        .flat_map(|y| (cx - reach..=cx + reach).map(move |x| (x, y)))
+                        .map(|(x, y)| &*merged[(y - my0) as usize * mw + (x - mx0) as usize].2);
+                    let list = lod::list(near, arr, level, cx, cy);
+                    let shape = |n: usize, o: f32, extent: [f32; 4]| {
+                        let l = &list[n];
+                        raster::disc_reaches(l.o[0] + o, l.o[1] + o, l.reach2, extent).then(|| l.rim.shifted(o))
+                    };
+                    cov.cell(list.len(), shape, locals.len() as u32, sp, rows, cols, (0, (i0 - rect.x0) * a), shadows);
+                    locals.extend(list);
+                }
             }
             let mut out = vec![0u8; 3 * w * rows_px];
             for (j, row) in out.chunks_exact_mut(3 * w).enumerate() {
@@ -467,6 +510,9 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
                         let (id, f) = ((key >> 8) as u32, darken[(key & 0xFF) as usize]);
                         if id == raster::NONE {
                             return [0, 1, 2].map(|k| b[k] as f32 * f);
+                        }
+                        if level > 0 {
+                            return lod::colour_at(&locals[id as usize], [qx, qy]).map(|v| v * f * 255.0);
                         }
                         let u = placed[id as usize];
                         let m = &arr.table[u.modified as usize];
@@ -568,7 +614,7 @@ mod tests {
             for cx in -2..3 {
                 let list = arr.list(cx, cy);
                 let mut cov = raster::Coverage::new(n as usize, n as usize);
-                cov.cell(&arr, &list, 0, sp, (0, n), (0, n), 0, 0, true);
+                cov.cell(list.len(), raster::placed_shape(&arr, &list), 0, sp, (0, n), (0, n), (0, 0), Some(4.0));
                 for r in 0..n {
                     for c in 0..n {
                         let (qx, qy) = ((c as f32 + 0.5) * sp, (r as f32 + 0.5) * sp);

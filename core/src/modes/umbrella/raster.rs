@@ -35,7 +35,7 @@ pub fn polygon(arr: &Arrangement, u: &Placed, ox: f32, oy: f32) -> [[f32; 2]; RA
 /// within `cols` (sample indices relative to the cell, centres at `(i + ½)·sp`); rows for which
 /// `skip(r)` holds are passed over.
 pub fn fill(
-    poly: &[[f32; 2]; RAYS],
+    poly: &[[f32; 2]],
     sp: f32,
     rows: (i64, i64),
     cols: (i64, i64),
@@ -48,8 +48,8 @@ pub fn fill(
     // Per edge: its ends' y, and x at the first end with the slope dx/dy.
     let mut edges = [[0f32; 4]; RAYS];
     let (mut ne, mut ymin, mut ymax) = (0, f32::MAX, f32::MIN);
-    for i in 0..RAYS {
-        let (a, b) = (poly[i], poly[(i + 1) % RAYS]);
+    for i in 0..poly.len().min(RAYS) {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
         let (lo, hi) = (a[1].min(b[1]), a[1].max(b[1]));
         if hi >= top && lo <= bottom && a[1] != b[1] {
             edges[ne] = [a[1], b[1], a[0], (b[0] - a[0]) / (b[1] - a[1])];
@@ -115,13 +115,25 @@ impl Coverage {
         Coverage { width, hit: vec![NONE; width * rows], shade: vec![0; width * rows] }
     }
 
-    /// Fill one cell's list into the band: the cell's samples are rows `rows` and columns
-    /// `cols` relative to the cell, which start at band row `row0` and band column `col0`;
-    /// umbrella `n` of `list` is recorded as `first + n`. `shadows`: whether to count them.
+    /// Fill one cell's list of `count` shapes, front to back, into the band: the cell's samples
+    /// are rows `rows` and columns `cols` relative to the cell, which start at band row `row0`
+    /// and band column `col0`; shape `n` is recorded as `first + n`. `shape(n, o, extent)` is
+    /// the polygon of shape `n` moved by `(o, o)` in the cell's coordinates, or `None` when its
+    /// disc does not reach `extent` (the cell's samples: `x0, x1, y0, y1`). `shadow`: the offset
+    /// ℓ at which shapes shade what is behind them, if they do.
     /// Rows whose samples are all taken are passed over, and the list is left once all are.
     #[allow(clippy::too_many_arguments)]
-    pub fn cell(&mut self, arr: &Arrangement, list: &[Placed], first: u32, sp: f32, rows: (i64, i64), cols: (i64, i64), row0: i64, col0: i64, shadows: bool) {
-        let l = arr.shadow_offset;
+    pub fn cell(
+        &mut self,
+        count: usize,
+        shape: impl Fn(usize, f32, [f32; 4]) -> Option<Poly>,
+        first: u32,
+        sp: f32,
+        rows: (i64, i64),
+        cols: (i64, i64),
+        (row0, col0): (i64, i64),
+        shadow: Option<f32>,
+    ) {
         let width = self.width as i64;
         let at = |r: i64, c: i64| ((r - rows.0 + row0) * width + (c - cols.0 + col0)) as usize;
         // Samples still free per row of the cell, and in all.
@@ -129,21 +141,15 @@ impl Coverage {
         let full = |r: i64| free[(r - rows.0) as usize].get() == 0;
         let mut left: u64 = free.iter().map(|f| f.get() as u64).sum();
         let (hit, shade) = (&mut self.hit, &mut self.shade);
-        // Whether the disc of `u` moved by `o` reaches the cell's samples.
-        let (x0, x1) = (cols.0 as f32 * sp, cols.1 as f32 * sp);
-        let (y0, y1) = (rows.0 as f32 * sp, rows.1 as f32 * sp);
-        let reaches = |u: &Placed, o: f32| {
-            let (dx, dy) = (u.cx + o - (u.cx + o).clamp(x0, x1), u.cy + o - (u.cy + o).clamp(y0, y1));
-            dx * dx + dy * dy <= u.reach2 * 1.001 + 1e-3
-        };
-        for (n, u) in list.iter().enumerate() {
+        let extent = [cols.0 as f32 * sp, cols.1 as f32 * sp, rows.0 as f32 * sp, rows.1 as f32 * sp];
+        for n in 0..count {
             if left == 0 {
                 break;
             }
             let id = first + n as u32;
-            // (An umbrella listed only for its shadow takes no sample here.)
-            if reaches(u, 0.0) {
-                fill(&polygon(arr, u, 0.0, 0.0), sp, rows, cols, full, |r, c0, c1| {
+            // (A shape listed only for its shadow takes no sample here.)
+            if let Some(p) = shape(n, 0.0, extent) {
+                fill(p.vertices(), sp, rows, cols, full, |r, c0, c1| {
                     let k = at(r, c0);
                     let mut taken = 0;
                     for h in &mut hit[k..k + (c1 - c0) as usize] {
@@ -156,8 +162,8 @@ impl Coverage {
                     left -= taken as u64;
                 });
             }
-            if shadows && l > 0.0 && reaches(u, l) {
-                fill(&polygon(arr, u, l, l), sp, rows, cols, full, |r, c0, c1| {
+            if let Some(p) = shadow.and_then(|l| shape(n, l, extent)) {
+                fill(p.vertices(), sp, rows, cols, full, |r, c0, c1| {
                     let k = at(r, c0);
                     let n = (c1 - c0) as usize;
                     for (h, s) in hit[k..k + n].iter().zip(&mut shade[k..k + n]) {
@@ -166,6 +172,45 @@ impl Coverage {
                 });
             }
         }
+    }
+}
+
+/// A polygon of at most [`RAYS`] vertices.
+#[derive(Debug, Clone, Copy)]
+pub struct Poly {
+    v: [[f32; 2]; RAYS],
+    n: usize,
+}
+
+impl Poly {
+    /// The first `n` (≤ [`RAYS`]) of `v`.
+    pub fn new(v: [[f32; 2]; RAYS], n: usize) -> Poly {
+        Poly { v, n: n.min(RAYS) }
+    }
+
+    /// Its vertices.
+    pub fn vertices(&self) -> &[[f32; 2]] {
+        &self.v[..self.n]
+    }
+
+    /// Moved by `(o, o)`.
+    pub fn shifted(&self, o: f32) -> Poly {
+        Poly { v: self.v.map(|p| [p[0] + o, p[1] + o]), n: self.n }
+    }
+}
+
+/// Whether a disc at `(cx, cy)` of squared radius `r2` reaches `extent` (`x0, x1, y0, y1`),
+/// with a margin for rounding.
+pub fn disc_reaches(cx: f32, cy: f32, r2: f32, extent: [f32; 4]) -> bool {
+    let (dx, dy) = (cx - cx.clamp(extent[0], extent[1]), cy - cy.clamp(extent[2], extent[3]));
+    dx * dx + dy * dy <= r2 * 1.001 + 1e-3
+}
+
+/// The shapes of a level-0 cell list for [`Coverage::cell`]: each umbrella's rim.
+pub fn placed_shape<'a>(arr: &'a Arrangement, list: &'a [Placed]) -> impl Fn(usize, f32, [f32; 4]) -> Option<Poly> + 'a {
+    move |n, o, extent| {
+        let u = &list[n];
+        disc_reaches(u.cx + o, u.cy + o, u.reach2, extent).then(|| Poly::new(polygon(arr, u, o, o), RAYS))
     }
 }
 
