@@ -2,8 +2,10 @@
 # Umbrella mode (issue 15): 512² outputs of the element-like development exemplars (leaves,
 # smallstone, gravel, granite) with mode=umbrella, synth and mosaic, scored by texq; texq
 # `streak` of 2048² umbrella renders; the storage table (cargo bench --bench umbrella_storage);
-# and docs/umbrella.jpg: per exemplar, the extraction sheet (bases with rims and centres, then
-# modified umbrellas) beside a 256² output.
+# docs/umbrella.jpg: per exemplar, the extraction sheet (bases with rims and centres, then
+# modified umbrellas) beside a 256² output; docs/umbrella_lod.jpg: the built-in gravel one and
+# two steps out (merged levels of detail, bottom) under its native render box-filtered to the
+# same scale (top).
 #   bench/out/umbrella/scores.md, bench/out/umbrella/streaks.md
 # Usage: bench/umbrella.sh
 set -euo pipefail
@@ -59,3 +61,24 @@ for r in rows:
 sheet.save("docs/umbrella.jpg", quality=85)
 PY
 cat "$OUT/scores.md" "$OUT/streaks.md" "$OUT/storage.md"
+
+# Levels of detail: the same 1024² texels of the built-in gravel (native zoom 7) at zoom-out 1
+# and 2, against the native render box-filtered.
+"$BIN" render --texture gravel --mode umbrella --z 7 --window=0,0,1024,1024 -o "$OUT/lod_native.png" >/dev/null
+"$BIN" render --texture gravel --mode umbrella --z 6 --window=0,0,512,512 -o "$OUT/lod_1.png" >/dev/null
+"$BIN" render --texture gravel --mode umbrella --z 5 --window=0,0,256,256 -o "$OUT/lod_2.png" >/dev/null
+python3 - "$OUT" <<'PY'
+import sys
+from PIL import Image, ImageChops, ImageStat
+out = sys.argv[1]
+native = Image.open(f"{out}/lod_native.png").convert("RGB")
+one, two = (Image.open(f"{out}/lod_{k}.png").convert("RGB") for k in (1, 2))
+ref1, ref2 = native.resize((512, 512), Image.BOX), native.resize((256, 256), Image.BOX)
+for k, (a, b) in enumerate([(one, ref1), (two, ref2)], 1):
+    print(f"zoom-out {k}: mean |merged − native box-filtered| {ImageStat.Stat(ImageChops.difference(a, b)).mean[0]:.2f}")
+# Shown at 512² each: zoom-out 1 as is, zoom-out 2 enlarged 2× (nearest).
+sheet = Image.new("RGB", (512 * 2 + 8, 512 * 2 + 8), (255, 255, 255))
+sheet.paste(ref1, (0, 0)); sheet.paste(ref2.resize((512, 512), Image.NEAREST), (520, 0))
+sheet.paste(one, (0, 520)); sheet.paste(two.resize((512, 512), Image.NEAREST), (520, 520))
+sheet.save("docs/umbrella_lod.jpg", quality=85)
+PY
