@@ -354,6 +354,8 @@ fn a_hand_made_set_gives_its_bases_and_variants_and_bad_sets_are_named() {
             png
         }),
         ("speck.png", element_png(8, 8, 1.5, 1.5, [0, 0, 0])),
+        ("huge.png", element_png(4000, 3, 1.0, 1.0, [0, 0, 0])),
+        ("garbage.png", b"\x89PNG\r\n\x1a\n not really".to_vec()),
     ]
     .into_iter()
     .collect();
@@ -402,6 +404,8 @@ fn a_hand_made_set_gives_its_bases_and_variants_and_bad_sets_are_named() {
         (br#"{"bases": [{"image": "red.png"}], "foreground": 2}"#, "foreground 2"),
         (br#"{"bases": [{"image": "red.png", "variants": ["red.png", "red.png", "red.png", "red.png"]}]}"#, "variants"),
         (b"not json", "set file"),
+        (br#"{"bases": [{"image": "huge.png"}]}"#, "4000x3"),
+        (br#"{"bases": [{"image": "garbage.png"}]}"#, "garbage.png"),
     ] {
         let e = handmade::load(json, &read).unwrap_err().to_string();
         assert!(e.contains("umbrellas") && e.contains(words), "{e}");

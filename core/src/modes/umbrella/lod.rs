@@ -370,8 +370,8 @@ pub fn around(arr: &Arrangement, j: u32) -> i64 {
     ((arr.max_reach + 1.5 * arr.shadow_offset as f64) / side).ceil() as i64
 }
 
-/// The colour of `l` at `q` relative to its cell (the rim's nearest fan triangle's when `q`
-/// falls just outside by rounding: its centre colour).
+/// The colour of `l` at `q` relative to its cell; its centre's colour for a point the
+/// coverage put inside but the fan test, by rounding, just outside.
 pub fn colour_at(l: &Local, q: [f32; 2]) -> [f32; 3] {
     merged_colour(l.m, [l.origin[0] + q[0] as f64, l.origin[1] + q[1] as f64]).unwrap_or(l.m.centre)
 }
