@@ -259,7 +259,8 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     assert_eq!(status, 204);
     support::assert_error(&s, "/textures/brick2", 404, "unknown_texture").await;
     support::assert_error(&s, "/tiles/brick2/7/0/0.png", 404, "unknown_texture").await;
-    assert!(!data.path().join("brick2.tex").exists());
+    assert!(!data.path().join("brick2.tex").exists() && !data.path().join("brick2.umbrella").exists());
+    assert!(data.path().join("mine.umbrella").exists(), "the kept uploads keep their extraction");
     assert_eq!(files_in(&uploads), ["mine.png", "mine.toml", "race.png", "race.toml"]);
     let ids = catalog_ids(&s).await;
     assert_eq!(ids, ["gravel", "grass", "brick", "corkboard", "mine", "race"]);

@@ -493,9 +493,9 @@ pub fn analyse_texture(
             a
         }
     };
-    tex.set_analysis(analysis)?;
     // The umbrella mode's extraction, beside the analysis: read when current, else computed
-    // (and stored) now rather than on the first umbrella request.
+    // (and stored) now rather than on the first umbrella request — before the texture is
+    // ready, so that a ready texture has both files.
     let path = data_dir.join(format!("{}.umbrella", t.id));
     let store = storable && !tex.removed.is_set();
     let started = std::time::Instant::now();
@@ -526,6 +526,7 @@ pub fn analyse_texture(
             ))
         )),
     }
+    tex.set_analysis(analysis)?;
     Ok(())
 }
 

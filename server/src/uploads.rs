@@ -135,7 +135,7 @@ pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> std::io:
 
 /// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
 /// orphan that start-up removes, never a half texture), then its exemplar, then its analysis
-/// in `data_dir`.
+/// and umbrella extraction in `data_dir`.
 pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
     match std::fs::remove_file(dir.join(format!("{id}.toml"))) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
@@ -144,7 +144,9 @@ pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
     for ext in ["png", "jpg", "webp"] {
         let _ = std::fs::remove_file(dir.join(format!("{id}.{ext}")));
     }
-    let _ = std::fs::remove_file(data_dir.join(format!("{id}.tex")));
+    for ext in ["tex", "umbrella"] {
+        let _ = std::fs::remove_file(data_dir.join(format!("{id}.{ext}")));
+    }
     Ok(())
 }
 
