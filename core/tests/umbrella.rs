@@ -195,9 +195,9 @@ fn check_zoom_consistency(
     // looked up once per pixel in its mipmapped base texture) against the box filter of the
     // children (each anti-aliased itself): the sub-sampling's and the mipmap's difference.
     // Bound: mean absolute difference ≤ 4/255 per channel, mean colours within 1/255 (no drift).
-    // At the merged levels of detail (design note §5.5) elements keep their rims but only
-    // vertex colours — the texture inside an element is gone, by design — and clusters take
-    // their convex hull: bound ≤ 10/255 mean difference, ≤ 1.5 drift. One step further out
+    // At the merged levels of detail (design note §5.5) a cluster of one stays the umbrella it
+    // is, but larger clusters take their convex hull and keep only vertex colours (the texture
+    // inside is gone, by design): bound ≤ 10/255 mean difference, ≤ 1.5 drift. One step further out
     // the background's own zoomed-out pixels take over, shifted to the umbrellas' mean colour:
     // there only the drift is bounded (≤ 1.5), the detail changes. Measured figures are printed.
     for k in 1..=zooms + 1 {

@@ -2,13 +2,13 @@
 //! cell's umbrellas — those its `2^j × 2^j` spawn cells place — are clustered by deterministic
 //! k-means on their centres into at most `k`; each cluster becomes one *merged* umbrella —
 //! centre the mean of its members', rim the convex hull of their rims simplified to
-//! [`MERGED_VERTICES`] by deleting the flattest vertex (a cluster of one keeps its member's
-//! rim), depth the front-most member's — coloured only at its centre and vertices, by sampling
-//! its members along each spoke (a single umbrella: along its own spokes, where the
-//! barycentrics are known). Merged cells are memoised. A zoom draws the level whose cells are
-//! about [`LOD_PIXELS`] pixels wide: tile zooms are powers of two, so each falls exactly on one
-//! level and there is nothing to blend between two. Everything is computed from absolute
-//! positions in a fixed order, so a cell is the same whichever window asks for it.
+//! [`MERGED_VERTICES`] by deleting the flattest vertex, depth the front-most member's — coloured
+//! only at its centre and vertices, by sampling its members along each spoke. A cluster of one
+//! stays the umbrella it is (its rim, its mipmapped base texture). Merged cells are memoised.
+//! A zoom draws the level whose cells are about [`LOD_PIXELS`] pixels wide: tile zooms are
+//! powers of two, so each falls exactly on one level and there is nothing to blend between
+//! two. Everything is computed from absolute positions in a fixed order, so a cell is the same
+//! whichever window asks for it.
 //!
 //! Deviation from the note: it builds level `j + 1` from level `j`'s merged umbrellas; here
 //! every level clusters the level-0 umbrellas directly. Building the levels between would cost
@@ -44,7 +44,7 @@ pub struct Merged {
     pub o: [f64; 2],
     /// Rim, absolute texels, convex, in angular order about `o`.
     pub rim: Vec<[f64; 2]>,
-    /// Colour at each rim vertex, RGB in `[0, 1]`.
+    /// Colour at each rim vertex, RGB in `[0, 1]` (none for a cluster of one).
     pub colour: Vec<[f32; 3]>,
     /// Colour at the centre.
     pub centre: [f32; 3],
@@ -54,6 +54,8 @@ pub struct Merged {
     pub depth: u64,
     /// Id (the front-most member's).
     pub id: (i64, i64, u32),
+    /// A cluster of one: its umbrella, still coloured from its (mipmapped) base texture.
+    pub single: Option<Placed>,
 }
 
 /// The level drawn `zoom_out` steps out: 0 while a grid cell is at least [`LOD_PIXELS`]
@@ -210,35 +212,18 @@ fn kmeans(members: &[Member], k: usize) -> Vec<Vec<usize>> {
     (0..k).map(|c| (0..pts.len()).filter(|&i| assign[i] == c).collect::<Vec<_>>()).filter(|g| !g.is_empty()).collect()
 }
 
-/// The colours along a level-0 umbrella's own spokes: at each rim vertex's spoke at `t` and at
-/// the centre (mixed with the spokes at `t / 2`), found without a point search (the spoke's
-/// barycentrics are known).
-fn spoke_colours(palette: &Palette, u: &Placed, t: f32) -> (Vec<[f32; 3]>, [f32; 3]) {
-    let m = &palette.arr.table[u.modified as usize];
-    let base = &palette.el.bases[m.base];
-    let fp = palette.footprint * u.inv_scale;
-    let at = |i: usize, t: f32| {
-        let hit = shape::Hit { sector: i, alpha: 1.0 - t, beta: t, gamma: 0.0 };
-        shape::colour(base, &palette.rays, &m.colour, hit, fp)
-    };
-    let rim: Vec<[f32; 3]> = (0..RAYS).map(|i| at(i, t)).collect();
-    let inner = (0..RAYS).step_by(3).map(|i| at(i, t / 2.0));
-    let n = (1 + RAYS.div_ceil(3)) as f32;
-    let centre = std::iter::once(at(0, 0.0)).chain(inner).fold([0f32; 3], |s, c| [s[0] + c[0], s[1] + c[1], s[2] + c[2]]);
-    (rim, centre.map(|v| v / n))
-}
-
 /// One merged umbrella from a cluster (members front to back).
 fn merge(members: &[&Member], palette: &Palette, background: [f32; 3]) -> Option<Merged> {
     let reach_of = |o: [f64; 2], rim: &[[f64; 2]]| rim.iter().map(|v| ((v[0] - o[0]).powi(2) + (v[1] - o[1]).powi(2)).sqrt()).fold(0.0, f64::max);
     if let [one] = members {
-        // A cluster of one keeps its umbrella's own (star-shaped) rim and the colours along its
-        // spokes.
+        // A cluster of one keeps its umbrella: its own (star-shaped) rim, coloured from its
+        // base texture when drawn (no vertex colours).
         let (depth, id) = one.key();
         let rim: Vec<[f64; 2]> = palette.arr.rim(&one.u, one.x, one.y).iter().map(|&(a, b)| [a, b]).collect();
-        let (colour, centre) = spoke_colours(palette, &one.u, 0.85);
         let o = one.centre();
-        return Some(Merged { reach: reach_of(o, &rim), o, rim, colour, centre, depth, id });
+        let centre = palette.colour(one, o).unwrap_or(background);
+        let single = Some(one.u);
+        return Some(Merged { reach: reach_of(o, &rim), o, rim, colour: Vec::new(), centre, depth, id, single });
     }
     let n = members.len() as f64;
     let mut o = [0f64; 2];
@@ -273,7 +258,7 @@ fn merge(members: &[&Member], palette: &Palette, background: [f32; 3]) -> Option
     let sum = spokes.iter().map(|&q| below(q)).fold([0f32; 3], |s, c| [s[0] + c[0], s[1] + c[1], s[2] + c[2]]);
     let centre = sum.map(|v| v / spokes.len() as f32);
     let (depth, id) = members[0].key();
-    Some(Merged { reach: reach_of(o, &rim), o, rim, colour, centre, depth, id })
+    Some(Merged { reach: reach_of(o, &rim), o, rim, colour, centre, depth, id, single: None })
 }
 
 type CellKey = (u64, u32, i64, i64);
@@ -370,8 +355,18 @@ pub fn around(arr: &Arrangement, j: u32) -> i64 {
     ((arr.max_reach + 1.5 * arr.shadow_offset as f64) / side).ceil() as i64
 }
 
-/// The colour of `l` at `q` relative to its cell; its centre's colour for a point the
-/// coverage put inside but the fan test, by rounding, just outside.
-pub fn colour_at(l: &Local, q: [f32; 2]) -> [f32; 3] {
+/// The colour of `l` at `q` relative to its cell, for a lookup spanning `footprint` texels: a
+/// single umbrella's from its base texture, a merged one's from its vertex colours (its
+/// centre's for a point the coverage put inside but the fan test, by rounding, just outside).
+pub fn colour_at(l: &Local, q: [f32; 2], el: &Elements, arr: &Arrangement, sectors: &SectorTable, footprint: f32) -> [f32; 3] {
+    if let Some(u) = &l.m.single {
+        let (dx, dy) = (q[0] - l.o[0], q[1] - l.o[1]);
+        let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
+        let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
+        let t = &arr.table[u.modified as usize];
+        let hit = t.rim.locate_clamped(sectors, lx, ly);
+        let rays: [[f32; 2]; RAYS] = std::array::from_fn(ray);
+        return shape::colour(&el.bases[t.base], &rays, &t.colour, hit, footprint * u.inv_scale);
+    }
     merged_colour(l.m, [l.origin[0] + q[0] as f64, l.origin[1] + q[1] as f64]).unwrap_or(l.m.centre)
 }

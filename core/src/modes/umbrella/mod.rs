@@ -198,7 +198,7 @@ const SPECS: &[ParamSpec] = &[DENSITY, SCALE, SHAPE, COLOUR, SHADOW, SHADOW_OFFS
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 5;
+    const VERSION: u32 = 6;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -512,7 +512,8 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
                             return [0, 1, 2].map(|k| b[k] as f32 * f);
                         }
                         if level > 0 {
-                            return lod::colour_at(&locals[id as usize], [qx, qy]).map(|v| v * f * 255.0);
+                            let c = lod::colour_at(&locals[id as usize], [qx, qy], el, arr, &sectors, step as f32);
+                            return c.map(|v| v * f * 255.0);
                         }
                         let u = placed[id as usize];
                         let m = &arr.table[u.modified as usize];
