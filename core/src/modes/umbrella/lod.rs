@@ -347,9 +347,9 @@ pub fn list<'a>(cells: impl Iterator<Item = &'a Vec<Merged>>, arr: &Arrangement,
     out
 }
 
-/// Cells around level-`j` cells `cx0..cx1 × cy0..cy1` that a merged umbrella of which can
-/// reach them: those cells grown by the rims' reach beyond their cell (at most the largest
-/// umbrella's plus the shadow offset).
+/// How many level-`j` cells away a merged umbrella may still cover or shade a cell: a rim
+/// reaches beyond its own cell by at most the largest umbrella's reach, and its shadow by the
+/// shadow offset more.
 pub fn around(arr: &Arrangement, j: u32) -> i64 {
     let side = (arr.g << j) as f64;
     ((arr.max_reach + 1.5 * arr.shadow_offset as f64) / side).ceil() as i64
