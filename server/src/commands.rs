@@ -147,7 +147,7 @@ pub fn info(a: InfoArgs) -> CliResult {
         Err(e) => (None, format!("computed ({e})")),
     };
     let outcome = match stored {
-        Some(outcome) => outcome.map_err(|m| textile_core::CoreError::Param { name: "umbrella", message: m }),
+        Some(outcome) => textile_core::modes::umbrella::outcome_result(outcome),
         None => textile_core::modes::umbrella::elements(&ex).map(|(el, _)| el),
     };
     match outcome {

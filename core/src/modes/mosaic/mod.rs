@@ -118,20 +118,35 @@ pub fn render_cost(zoom_out: u32, rect: Rect) -> u64 {
 
 /// Render `rect` of the mosaic viewed `zoom_out` steps coarser than native.
 pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    render_view(ex, p, zoom_out, rect, true)
+}
+
+/// `rect` of the mosaic `zoom_out` steps out by the far zoom-out method at every zoom (each
+/// pixel one lookup of the box-filtered exemplar; see [`sampled`]): cheaper than [`render`]'s
+/// exact box filter of the native pixels for zoom-outs 1–3, for callers to whom an approximate
+/// view will do (the umbrella mode's background at its merged levels of detail).
+pub fn render_sampled(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    render_view(ex, p, zoom_out, rect, false)
+}
+
+/// [`render`] (`exact`: zoom-outs 1–3 box-filter the native pixels) or [`render_sampled`].
+fn render_view(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect, exact: bool) -> Result<RgbWindow> {
     p.validate(ex.side)?;
     let scale = 1i64.checked_shl(zoom_out.min(62)).unwrap_or(i64::MAX);
-    if rect.is_empty() || rect.area() > MAX_PIXELS || (zoom_out <= 3 && rect.area() * scale * scale > MAX_PIXELS) {
+    let boxed = exact && (1..=3).contains(&zoom_out);
+    if rect.is_empty() || rect.area() > MAX_PIXELS || (boxed && rect.area() * scale * scale > MAX_PIXELS) {
+        let scale_note = if exact || !(1..=3).contains(&zoom_out) { " at native scale" } else { "" };
         return Err(CoreError::Window {
             width: rect.width(),
             height: rect.height(),
-            message: format!("must be non-empty with at most {MAX_PIXELS} pixels at native scale"),
+            message: format!("must be non-empty with at most {MAX_PIXELS} pixels{scale_note}"),
         });
     }
     let layout = Layout::new(ex.side as i64, p);
     if zoom_out == 0 {
         return Ok(native(ex, &layout, rect));
     }
-    if zoom_out <= 3 {
+    if boxed {
         // Exact: the box average of the native pixels.
         let big = native(
             ex,
@@ -141,25 +156,6 @@ pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
         return Ok(big.box_down(scale as usize));
     }
     Ok(sampled(ex, &layout, zoom_out, rect))
-}
-
-/// `rect` of the mosaic `zoom_out` steps out by the far zoom-out method at every zoom (each
-/// pixel one lookup of the box-filtered exemplar; see [`sampled`]): cheaper than [`render`]'s
-/// exact box filter of the native pixels for zoom-outs 1–3, for callers to whom an approximate
-/// view will do (the umbrella mode's background at its merged levels of detail).
-pub fn render_sampled(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
-    if zoom_out == 0 || zoom_out > 3 {
-        return render(ex, p, zoom_out, rect);
-    }
-    p.validate(ex.side)?;
-    if rect.is_empty() || rect.area() > MAX_PIXELS {
-        return Err(CoreError::Window {
-            width: rect.width(),
-            height: rect.height(),
-            message: format!("must be non-empty with at most {MAX_PIXELS} pixels"),
-        });
-    }
-    Ok(sampled(ex, &Layout::new(ex.side as i64, p), zoom_out, rect))
 }
 
 /// Far zoom-out (`2^k` texels per pixel, k > 3): label each pixel by its centre texel and colour

@@ -358,15 +358,23 @@ pub fn around(arr: &Arrangement, j: u32) -> i64 {
 /// The colour of `l` at `q` relative to its cell, for a lookup spanning `footprint` texels: a
 /// single umbrella's from its base texture, a merged one's from its vertex colours (its
 /// centre's for a point the coverage put inside but the fan test, by rounding, just outside).
-pub fn colour_at(l: &Local, q: [f32; 2], el: &Elements, arr: &Arrangement, sectors: &SectorTable, footprint: f32) -> [f32; 3] {
+#[allow(clippy::too_many_arguments)]
+pub fn colour_at(
+    l: &Local,
+    q: [f32; 2],
+    el: &Elements,
+    arr: &Arrangement,
+    sectors: &SectorTable,
+    rays: &[[f32; 2]; RAYS],
+    footprint: f32,
+) -> [f32; 3] {
     if let Some(u) = &l.m.single {
         let (dx, dy) = (q[0] - l.o[0], q[1] - l.o[1]);
         let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
         let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
         let t = &arr.table[u.modified as usize];
         let hit = t.rim.locate_clamped(sectors, lx, ly);
-        let rays: [[f32; 2]; RAYS] = std::array::from_fn(ray);
-        return shape::colour(&el.bases[t.base], &rays, &t.colour, hit, footprint * u.inv_scale);
+        return shape::colour(&el.bases[t.base], rays, &t.colour, hit, footprint * u.inv_scale);
     }
     merged_colour(l.m, [l.origin[0] + q[0] as f64, l.origin[1] + q[1] as f64]).unwrap_or(l.m.centre)
 }

@@ -404,10 +404,12 @@ pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
         return Ok((set.elements.clone(), id));
     }
     let known = memo().lock().ok().and_then(|mut m| m.get(&id).cloned());
-    match known.unwrap_or_else(|| extracted(ex, &id)) {
-        Ok(e) => Ok((e, id)),
-        Err(message) => Err(CoreError::Param { name: "umbrella", message }),
-    }
+    Ok((outcome_result(known.unwrap_or_else(|| extracted(ex, &id)))?, id))
+}
+
+/// An extraction outcome as a result: no elements → a parameter error naming the mode.
+pub fn outcome_result(outcome: store::Outcome) -> Result<Arc<Elements>> {
+    outcome.map_err(|message| CoreError::Param { name: "umbrella", message })
 }
 
 /// Render a view at level of detail `level` (whose cells are at least two pixels wide): band by
@@ -512,7 +514,7 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
                             return [0, 1, 2].map(|k| b[k] as f32 * f);
                         }
                         if level > 0 {
-                            let c = lod::colour_at(&locals[id as usize], [qx, qy], el, arr, &sectors, step as f32);
+                            let c = lod::colour_at(&locals[id as usize], [qx, qy], el, arr, &sectors, &rays, step as f32);
                             return c.map(|v| v * f * 255.0);
                         }
                         let u = placed[id as usize];
