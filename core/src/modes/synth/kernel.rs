@@ -117,10 +117,18 @@ impl Kernel<'_> {
         // zero), for the comparisons near an exemplar edge.
         let mut terms = [[_mm256_setzero_si256(); 6]; 6];
         let nb = Neighbours::new(self);
-        // The gathers below read `s[idx + offset]` unchecked and `cands` at texels below `m²`.
+        // The loads below read the 3×3 neighbours (`s[idx ± w ± 1]`, raster order) unchecked,
+        // and the gathers `cands` at texels below `m²`.
         let last = start + out.len().saturating_sub(1) * step;
         let (lo, hi) = self.nb_off[1..].iter().fold((0, 0), |(a, b), &(o, _, _)| (o.min(a), o.max(b)));
+        let rows = self.nb_off[0].0 == 0
+            && (1..9).all(|n| {
+                let r = if n <= 4 { n - 1 } else { n } as isize;
+                self.nb_off[n].0 == (r / 3 - 1) * nb.w as isize + r % 3 - 1
+            });
         if out.is_empty()
+            || !rows
+            || nb.w < 2
             || (start as isize + lo) < 0
             || last as isize + hi >= s.len() as isize
             || self.cands.len() < self.m * self.m
@@ -171,8 +179,23 @@ impl Kernel<'_> {
         let (mut texel, mut coord) = ([0u32; 9], [[0u32; 9]; 2]);
         let v = s[idx];
         texel[0] = (v >> 16) * self.m as u32 + (v & 0xFFFF);
-        // SAFETY: `row_avx2` checked that every `idx + offset` of its row lies inside `s`.
-        let v = unsafe { _mm256_i32gather_epi32::<4>(s.as_ptr().add(idx) as *const i32, nb.off) };
+        // The eight neighbours are three runs of the buffer: loaded as rows (a gather's
+        // latency was a tenth of the kernel's time) and put in raster order.
+        // SAFETY: `row_avx2` checked that `idx − w − 1` and `idx + w + 1` lie inside `s`, for
+        // every `idx` of its row; each load reads four texels between the two.
+        let (above, middle, below) = unsafe {
+            let p = s.as_ptr().add(idx);
+            (
+                _mm_loadu_si128(p.sub(nb.w + 1) as *const __m128i),
+                _mm_loadu_si128(p.sub(1) as *const __m128i),
+                _mm_loadu_si128(p.add(nb.w - 2) as *const __m128i),
+            )
+        };
+        // (nw, n, ne, w) and (e, sw, s, se).
+        let v = _mm256_set_m128i(
+            _mm_blend_epi32::<0b0001>(below, _mm_shuffle_epi32::<2>(middle)),
+            _mm_blend_epi32::<0b1000>(above, _mm_shuffle_epi32::<0>(middle)),
+        );
         let vx = _mm256_and_si256(_mm256_add_epi32(_mm256_and_si256(v, nb.low), nb.subx), nb.mask);
         let vy = _mm256_and_si256(_mm256_add_epi32(_mm256_srli_epi32(v, 16), nb.suby), nb.mask);
         let t = _mm256_or_si256(_mm256_sll_epi32(vy, nb.log2m), vx);
@@ -216,32 +239,28 @@ impl Kernel<'_> {
     ) -> u32 {
         use std::arch::x86_64::*;
         const N: usize = 18;
-        let mut sq = [[_mm256_setzero_si256(); 9]; 2];
+        // Features fit i16 and so do their differences (|Ñ| ≤ 255·√75·4·(1 + 2⁻¹²) < 8 900
+        // in quarter colour units, for any subset of taps too): both candidates of a
+        // neighbour are compared in one register, `vpmaddwd` squaring and pair-summing
+        // the differences (each pair sum < 2³¹), the same values as the scalar sum.
+        let ns16 = both_halves_i16(ns);
+        let mut sq = [_mm256_setzero_si256(); 9];
         for (n, &t) in texel.iter().enumerate() {
-            for (k, cand) in self.cands[t as usize].iter().enumerate() {
-                // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
-                let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
-                let e = _mm256_sub_epi32(ns, _mm256_cvtepi16_epi32(f));
-                sq[k][n] = _mm256_mullo_epi32(e, e);
-            }
+            let pair = &self.cands[t as usize];
+            // SAFETY: `feat` is 8 i16 = 128 bits; unaligned loads.
+            let f = unsafe {
+                _mm256_loadu2_m128i(pair[1].feat.as_ptr() as *const __m128i, pair[0].feat.as_ptr() as *const __m128i)
+            };
+            let e = _mm256_sub_epi16(ns16, f);
+            sq[n] = _mm256_madd_epi16(e, e);
         }
         let coord = coord.as_flattened();
         if edge == 0 {
             // All compared over every tap: the common scale can be left out, and within a rank
             // the first smallest distance is the first smallest scaled one; the first rank wins
             // a tie between the two, as in the scan of [`Kernel::best`].
-            let d = hsum18(&sq);
-            let first_min = |r: std::ops::Range<usize>| {
-                let mut b = r.start;
-                for i in r {
-                    if d[i] < d[b] {
-                        b = i;
-                    }
-                }
-                b
-            };
-            let (b0, b1) = (first_min(0..9), first_min(9..N));
-            let win = if d[b1] as u64 * self.phi[1] < d[b0] as u64 * self.phi[0] { b1 } else { b0 };
+            let (b0, m0, b1, m1) = first_minima(&sq);
+            let win = if m1 as u64 * self.phi[1] < m0 as u64 * self.phi[0] { b1 } else { b0 };
             return coord[win];
         }
         let mut weight = [FULL_WEIGHT; N];
@@ -287,7 +306,7 @@ impl Kernel<'_> {
         terms: &mut [[std::arch::x86_64::__m256i; 6]; 6],
         mut edge: u32,
         texel: &[u32; 9],
-        sq: &mut [[std::arch::x86_64::__m256i; 9]; 2],
+        sq: &mut [std::arch::x86_64::__m256i; 9],
         weight: &mut [u64; 18],
     ) {
         use std::arch::x86_64::*;
@@ -309,10 +328,13 @@ impl Kernel<'_> {
                 _mm256_add_epi32(pre[r1][c1], pre[r0][c0]),
                 _mm256_add_epi32(pre[r0][c1], pre[r1][c0]),
             );
+            let q = _mm256_srai_epi32(q, FEAT_SHIFT as i32);
+            let q16 = _mm_packs_epi32(_mm256_castsi256_si128(q), _mm256_extracti128_si256(q, 1));
             // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
             let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
-            let e = _mm256_sub_epi32(_mm256_srai_epi32(q, FEAT_SHIFT as i32), _mm256_cvtepi16_epi32(f));
-            sq[i / 9][i % 9] = _mm256_mullo_epi32(e, e);
+            let e = _mm_sub_epi16(q16, f);
+            let v = _mm_madd_epi16(e, e);
+            sq[i % 9] = if i < 9 { _mm256_inserti128_si256(sq[i % 9], v, 0) } else { _mm256_inserti128_si256(sq[i % 9], v, 1) };
         }
     }
 
@@ -402,7 +424,8 @@ impl Kernel<'_> {
 /// [`Kernel::candidates_avx2`].
 #[cfg(target_arch = "x86_64")]
 struct Neighbours {
-    off: std::arch::x86_64::__m256i,
+    /// The buffer's width: the neighbours are at `±1`, `±w`, `±w ± 1`.
+    w: usize,
     subx: std::arch::x86_64::__m256i,
     suby: std::arch::x86_64::__m256i,
     mask: std::arch::x86_64::__m256i,
@@ -421,7 +444,7 @@ impl Neighbours {
             unsafe { _mm256_loadu_si256(v.as_ptr() as *const __m256i) }
         };
         Neighbours {
-            off: lane(&|n| n.0 as i32),
+            w: k.nb_off[7].0.unsigned_abs(),
             subx: lane(&|n| n.1 as i32),
             suby: lane(&|n| n.2 as i32),
             mask: _mm256_set1_epi32(k.mask as i32),
@@ -449,28 +472,69 @@ fn sum_taps(
     q.map(|a| a >> FEAT_SHIFT)
 }
 
-/// The 18 sums of eight lanes of `sq`, by a horizontal-add tree with wrapping adds, like the
-/// scalar sum.
+/// A pixel's feature (eight i32 lanes, each within i16) as eight i16 lanes, in both halves.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn hsum18(sq: &[[std::arch::x86_64::__m256i; 9]; 2]) -> [u32; 18] {
+fn both_halves_i16(v: std::arch::x86_64::__m256i) -> std::arch::x86_64::__m256i {
     use std::arch::x86_64::*;
-    let sq = sq.as_flattened();
-    let mut d = [0u32; 18];
+    // Per half: (0–3, 0–3) and (4–7, 4–7); then 64-bit lanes (0, 2, 0, 2).
+    _mm256_permute4x64_epi64(_mm256_packs_epi32(v, v), 0b10_00_10_00)
+}
+
+/// The squared distances of `sq` (neighbour `n`'s rank-0 candidate in the low half of
+/// `sq[n]`, its rank-1 candidate in the high half; four partial sums each), summed by a
+/// horizontal-add tree: neighbours 0–3 of each rank (rank 0 in the low half, rank 1 in the
+/// high half), neighbours 4–7 likewise, and neighbour 8 in lane 0 of each half.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn hsum18_vectors(
+    sq: &[std::arch::x86_64::__m256i; 9],
+) -> (std::arch::x86_64::__m256i, std::arch::x86_64::__m256i, std::arch::x86_64::__m256i) {
+    use std::arch::x86_64::*;
     let h = |a: __m256i, b: __m256i| _mm256_hadd_epi32(a, b);
-    for (group, out) in sq.chunks_exact(8).zip(d.chunks_exact_mut(8)) {
-        let (u0, u1) = (h(h(group[0], group[1]), h(group[2], group[3])), h(h(group[4], group[5]), h(group[6], group[7])));
-        let sums = _mm256_add_epi32(_mm256_permute2x128_si256(u0, u1, 0x20), _mm256_permute2x128_si256(u0, u1, 0x31));
-        // SAFETY: `out` is 8 u32 = 256 bits; unaligned store.
-        unsafe { _mm256_storeu_si256(out.as_mut_ptr() as *mut __m256i, sums) };
-    }
-    // The last two: lanes `(a0+a1, a2+a3, b0+b1, b2+b3)` per half, twice more.
-    let u = h(h(sq[16], sq[17]), _mm256_setzero_si256());
-    let two = _mm_add_epi32(_mm256_castsi256_si128(u), _mm256_extracti128_si256(u, 1));
-    d[16] = _mm_cvtsi128_si32(two) as u32;
-    d[17] = _mm_extract_epi32(two, 1) as u32;
+    let zero = _mm256_setzero_si256();
+    (h(h(sq[0], sq[1]), h(sq[2], sq[3])), h(h(sq[4], sq[5]), h(sq[6], sq[7])), h(h(sq[8], zero), zero))
+}
+
+/// The 18 squared distances of `sq` ([`hsum18_vectors`]), rank-major: distance `k·9 + n` is
+/// that of candidate `k` of neighbour `n`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn hsum18(sq: &[std::arch::x86_64::__m256i; 9]) -> [u32; 18] {
+    use std::arch::x86_64::*;
+    let (x, y, z) = hsum18_vectors(sq);
+    let mut d = [0u32; 18];
+    // SAFETY (both): 8 u32 = 256 bits at `d[0..]` and `d[9..]`; unaligned stores.
+    unsafe { _mm256_storeu_si256(d.as_mut_ptr() as *mut __m256i, _mm256_permute2x128_si256(x, y, 0x20)) };
+    d[8] = _mm256_extract_epi32(z, 0) as u32;
+    unsafe { _mm256_storeu_si256(d[9..].as_mut_ptr() as *mut __m256i, _mm256_permute2x128_si256(x, y, 0x31)) };
+    d[17] = _mm256_extract_epi32(z, 4) as u32;
     d
+}
+
+/// Of the 18 squared distances of `sq` (as [`hsum18`]), the first smallest of rank 0 (0–8)
+/// and of rank 1 (9–17), with their values — both ranks at once by vector minima and compare
+/// masks (a scalar scan is a chain of loads and conditional moves).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn first_minima(sq: &[std::arch::x86_64::__m256i; 9]) -> (usize, u32, usize, u32) {
+    use std::arch::x86_64::*;
+    let (x, y, z) = hsum18_vectors(sq);
+    // Per half (rank), the minimum over neighbours 0–3, 4–7 and 8, then in every lane.
+    let m = _mm256_min_epu32(_mm256_min_epu32(x, y), _mm256_shuffle_epi32(z, 0));
+    let m = _mm256_min_epu32(m, _mm256_shuffle_epi32(m, 0b01_00_11_10));
+    let m = _mm256_min_epu32(m, _mm256_shuffle_epi32(m, 0b10_11_00_01));
+    let mask = |v: __m256i| _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(v, m))) as u32;
+    let (mx, my) = (mask(x), mask(y));
+    // Bit `n`: neighbour `n` (0–7) reaches the minimum; none — neighbour 8 does.
+    let first = |bits: u32| if bits != 0 { bits.trailing_zeros() as usize } else { 8 };
+    let b0 = first((mx & 0xF) | (my & 0xF) << 4);
+    let b1 = 9 + first(mx >> 4 | (my >> 4) << 4);
+    (b0, _mm256_extract_epi32(m, 0) as u32, b1, _mm256_extract_epi32(m, 4) as u32)
 }
 
 /// The multiply-add layout of a `[tap][channel][dim]` projection (see [`Kernel::pairs`]).
@@ -543,6 +607,59 @@ mod tests {
             let portable = synthesize(&an, &p, 6, r).unwrap();
             FORCE_PORTABLE.store(false, Ordering::Relaxed);
             assert_eq!(fast, portable, "{p:?}");
+        }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod minima_tests {
+    use super::*;
+
+    /// The vector minima equal the scalar scan's first smallest per rank, ties and the largest
+    /// values included.
+    #[test]
+    fn first_minima_equal_a_scalar_scan() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        use std::arch::x86_64::*;
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for round in 0..20_000 {
+            // Few distinct values (many ties), the extremes, or anything.
+            let value = |r: u64| match round % 3 {
+                0 => (r % 4) as u32,
+                1 => [0, 1, u32::MAX - 1, u32::MAX][(r % 4) as usize],
+                _ => r as u32,
+            };
+            // Each distance is one lane of its half (neighbour `i % 9`, rank `i / 9`), the other
+            // three zero, so the sum is that lane.
+            let mut d = [0u32; 18];
+            let mut halves = [[0u32; 8]; 9];
+            for (i, v) in d.iter_mut().enumerate() {
+                *v = value(next());
+                halves[i % 9][4 * (i / 9) + (next() % 4) as usize] = *v;
+            }
+            // SAFETY: 8 u32 = 256 bits; unaligned loads.
+            let sq = halves.map(|h| unsafe { _mm256_loadu_si256(h.as_ptr() as *const __m256i) });
+            let first_min = |r: std::ops::Range<usize>| {
+                let mut b = r.start;
+                for i in r {
+                    if d[i] < d[b] {
+                        b = i;
+                    }
+                }
+                b
+            };
+            let (b0, b1) = (first_min(0..9), first_min(9..18));
+            // SAFETY: the processor supports AVX2 (checked above).
+            assert_eq!(unsafe { first_minima(&sq) }, (b0, d[b0], b1, d[b1]), "{d:?}");
+            assert_eq!(unsafe { hsum18(&sq) }, d);
         }
     }
 }
