@@ -17,6 +17,9 @@ const WEIGHT_ONE: u64 = 3600;
 /// did while a band along an edge still reaches the output (1: more edge content, worse
 /// `nn_err`; 3: less; bench/README.md).
 const PARTIAL_FACTOR: u64 = 2;
+/// The largest `φ` whose product with every distance scale fits u32 (the largest scale is
+/// that of 9 taps compared); κ ≤ 1 keeps `φ` at most `4 · 2¹⁶`.
+const MAX_PHI_NARROW: u64 = u32::MAX as u64 / (PARTIAL_FACTOR * WEIGHT_ONE / 9);
 /// The distance scale of a candidate compared over all taps.
 const FULL_WEIGHT: u64 = WEIGHT_ONE / TAPS5 as u64;
 
@@ -265,8 +268,15 @@ impl Kernel<'_> {
         }
         let mut weight = [FULL_WEIGHT; N];
         self.edge_distances_avx2(terms, edge, texel, &mut sq, &mut weight);
+        let d = hsum18(&sq);
+        // `φ · scale` fits u32 when `κ ≤ 1` (φ ≤ 4·2¹⁶, scales ≤ 800): the 18 products then
+        // compare as vectors; otherwise one by one.
+        if self.phi[1].max(self.phi[0]) <= MAX_PHI_NARROW {
+            let scale: [u32; N] = std::array::from_fn(|i| (self.phi[i / 9] * weight[i]) as u32);
+            return coord[first_smallest_product(&d, &scale)];
+        }
         let mut best = (u64::MAX, own);
-        for (i, ((&d, &c), &w)) in hsum18(&sq).iter().zip(coord).zip(&weight).enumerate() {
+        for (i, ((&d, &c), &w)) in d.iter().zip(coord).zip(&weight).enumerate() {
             let dd = d as u64 * self.phi[i / 9] * w;
             if dd < best.0 {
                 best = (dd, c);
@@ -537,6 +547,31 @@ fn first_minima(sq: &[std::arch::x86_64::__m256i; 9]) -> (usize, u32, usize, u32
     (b0, _mm256_extract_epi32(m, 0) as u32, b1, _mm256_extract_epi32(m, 4) as u32)
 }
 
+/// The index of the first smallest of the 18 products `d[i] · scale[i]` (each below 2⁶², as
+/// distances are below 2³⁰): the same as a scan keeping the first strictly smaller one.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn first_smallest_product(d: &[u32; 18], scale: &[u32; 18]) -> usize {
+    use std::arch::x86_64::*;
+    // Padded to 20 with a product larger than any real one (2⁶³ − 2³¹, still positive).
+    let (mut dp, mut sp) = ([u32::MAX; 20], [1u32 << 31; 20]);
+    dp[..18].copy_from_slice(d);
+    sp[..18].copy_from_slice(scale);
+    // SAFETY: 4 u32 = 128 bits at `4j` for `j < 5`, inside the 20; unaligned loads.
+    let load = |a: &[u32; 20], j: usize| unsafe { _mm256_cvtepu32_epi64(_mm_loadu_si128(a[4 * j..].as_ptr() as *const __m128i)) };
+    let v: [__m256i; 5] = std::array::from_fn(|j| _mm256_mul_epu32(load(&dp, j), load(&sp, j)));
+    // Products are below 2⁶³: signed comparison is the unsigned one.
+    let min = |a: __m256i, b: __m256i| _mm256_blendv_epi8(b, a, _mm256_cmpgt_epi64(b, a));
+    let m = min(min(min(v[0], v[1]), min(v[2], v[3])), v[4]);
+    let m = min(m, _mm256_permute4x64_epi64(m, 0b01_00_11_10));
+    let m = min(m, _mm256_permute4x64_epi64(m, 0b10_11_00_01));
+    let bits = v.iter().enumerate().fold(0u32, |bits, (j, &x)| {
+        bits | (_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(x, m))) as u32) << (4 * j)
+    });
+    bits.trailing_zeros() as usize
+}
+
 /// The multiply-add layout of a `[tap][channel][dim]` projection (see [`Kernel::pairs`]).
 pub(crate) fn projection_pairs(proj: &[i16]) -> [[i16; 2 * RUNTIME_DIMS]; 2 * TAPS5] {
     let mut pairs = [[0i16; 2 * RUNTIME_DIMS]; 2 * TAPS5];
@@ -660,6 +695,22 @@ mod minima_tests {
             // SAFETY: the processor supports AVX2 (checked above).
             assert_eq!(unsafe { first_minima(&sq) }, (b0, d[b0], b1, d[b1]), "{d:?}");
             assert_eq!(unsafe { hsum18(&sq) }, d);
+            // Scaled as the kernel scales distances near an edge (κ = 1 at most).
+            let scale: [u32; 18] = std::array::from_fn(|_| match next() % 3 {
+                0 => 4 << 16,
+                1 => (1 << 16) * 800,
+                _ => (next() % (MAX_PHI_NARROW * 800)) as u32,
+            });
+            let d30 = d.map(|v| v >> 2);
+            let mut best = (u64::MAX, 18);
+            for i in 0..18 {
+                let p = d30[i] as u64 * scale[i] as u64;
+                if p < best.0 {
+                    best = (p, i);
+                }
+            }
+            // SAFETY: the processor supports AVX2 (checked above).
+            assert_eq!(unsafe { first_smallest_product(&d30, &scale) }, best.1, "{d30:?} {scale:?}");
         }
     }
 }
