@@ -94,8 +94,8 @@ impl Kernel<'_> {
     /// The AVX2 copy. The projection — most of the work — multiplies the 8-bit channels as
     /// 16-bit pairs with `vpmaddwd` (every product and pair sum exact in i32): for a pixel
     /// whose candidates are all away from an exemplar edge, one channel of two adjacent taps
-    /// per instruction, summing whole rows; otherwise two channels of one tap, keeping each
-    /// tap's term for [`Kernel::edge_distances_avx2`]. Both give the same sum.
+    /// per instruction, summing whole rows; otherwise two channels of one tap, keeping the
+    /// 2-D prefix sums of the taps' terms for [`Kernel::edge_distances_avx2`]. Both give the same sum.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn row_avx2(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
@@ -116,9 +116,9 @@ impl Kernel<'_> {
                 _mm256_madd_epi16(_mm256_shuffle_epi8(v, b0), wt[1]),
             )
         };
-        // Each tap's term of the projection at `[row + 1][column + 1]` (row and column 0 stay
-        // zero), for the comparisons near an exemplar edge.
-        let mut terms = [[_mm256_setzero_si256(); 6]; 6];
+        // For the comparisons near an exemplar edge: the sum of the projection's terms of the
+        // taps above and left of `[row][column]` (2-D prefix sums; row and column 0 stay zero).
+        let mut pre = [[_mm256_setzero_si256(); 6]; 6];
         let nb = Neighbours::new(self);
         // The loads below read the 3×3 neighbours (`s[idx ± w ± 1]`, raster order) unchecked,
         // and the gathers `cands` at texels below `m²`.
@@ -158,15 +158,17 @@ impl Kernel<'_> {
                     }
                     acc = _mm256_add_epi32(acc, single(run[4], &w[10 * r + 8..10 * r + 10]));
                 } else {
+                    // The 2-D prefix sums of the taps' terms, as they are computed.
+                    let mut run_sum = _mm256_setzero_si256();
                     for (c, &v) in run.iter().enumerate() {
-                        let t = single(v, &w[10 * r + 2 * c..10 * r + 2 * c + 2]);
-                        terms[r + 1][c + 1] = t;
-                        acc = _mm256_add_epi32(acc, t);
+                        run_sum = _mm256_add_epi32(run_sum, single(v, &w[10 * r + 2 * c..10 * r + 2 * c + 2]));
+                        pre[r + 1][c + 1] = _mm256_add_epi32(pre[r][c + 1], run_sum);
                     }
                 }
             }
+            let acc = if edge == 0 { acc } else { pre[5][5] };
             let ns = _mm256_srai_epi32(acc, FEAT_SHIFT as i32);
-            *o = self.best_avx2(s[idx], &texel, &coord, edge, &mut terms, ns);
+            *o = self.best_avx2(s[idx], &texel, &coord, edge, &pre, ns);
         }
     }
 
@@ -237,7 +239,7 @@ impl Kernel<'_> {
         texel: &[u32; 9],
         coord: &[[u32; 9]; 2],
         edge: u32,
-        terms: &mut [[std::arch::x86_64::__m256i; 6]; 6],
+        pre: &[[std::arch::x86_64::__m256i; 6]; 6],
         ns: std::arch::x86_64::__m256i,
     ) -> u32 {
         use std::arch::x86_64::*;
@@ -267,7 +269,7 @@ impl Kernel<'_> {
             return coord[win];
         }
         let mut weight = [FULL_WEIGHT; N];
-        self.edge_distances_avx2(terms, edge, texel, &mut sq, &mut weight);
+        self.edge_distances_avx2(pre, edge, texel, &mut sq, &mut weight);
         let d = hsum18(&sq);
         // `φ · scale` fits u32 when `κ ≤ 1` (φ ≤ 4·2¹⁶, scales ≤ 800): the 18 products then
         // compare as vectors; otherwise one by one.
@@ -305,28 +307,21 @@ impl Kernel<'_> {
 
     /// The squared feature differences and distance scales of the candidates flagged in
     /// `edge` (bit `k·9 + n`: candidate `k` of neighbour `n`, whose texel is `texel[n]`),
-    /// compared over their real texels only: the per-tap terms of the pixel's projection
-    /// (`terms`, made 2-D prefix sums here: any rectangle of taps in three operations) summed
-    /// over the taps inside the exemplar.
+    /// compared over their real texels only: the pixel's projection summed over the taps
+    /// inside the exemplar, from the 2-D prefix sums of its taps' terms (`pre`: any rectangle
+    /// of taps in three operations).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline(never)]
     fn edge_distances_avx2(
         &self,
-        terms: &mut [[std::arch::x86_64::__m256i; 6]; 6],
+        pre: &[[std::arch::x86_64::__m256i; 6]; 6],
         mut edge: u32,
         texel: &[u32; 9],
         sq: &mut [std::arch::x86_64::__m256i; 9],
         weight: &mut [u64; 18],
     ) {
         use std::arch::x86_64::*;
-        let pre = terms;
-        for r in 1..6 {
-            for c in 1..6 {
-                let up = _mm256_sub_epi32(pre[r - 1][c], pre[r - 1][c - 1]);
-                pre[r][c] = _mm256_add_epi32(_mm256_add_epi32(pre[r][c], pre[r][c - 1]), up);
-            }
-        }
         while edge != 0 {
             let i = edge.trailing_zeros() as usize;
             edge &= edge - 1;
