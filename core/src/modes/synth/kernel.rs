@@ -118,7 +118,8 @@ impl Kernel<'_> {
         };
         // For the comparisons near an exemplar edge: the sum of the projection's terms of the
         // taps above and left of `[row][column]` (2-D prefix sums; row and column 0 stay zero).
-        let mut pre = [[_mm256_setzero_si256(); 6]; 6];
+        // 8 × 8 so that indices masked by 7 need no bounds checks; rows and columns 6, 7 unused.
+        let mut pre = [[_mm256_setzero_si256(); 8]; 8];
         let nb = Neighbours::new(self);
         // The loads below read the 3×3 neighbours (`s[idx ± w ± 1]`, raster order) unchecked,
         // and the gathers `cands` at texels below `m²`.
@@ -239,7 +240,7 @@ impl Kernel<'_> {
         texel: &[u32; 9],
         coord: &[[u32; 9]; 2],
         edge: u32,
-        pre: &[[std::arch::x86_64::__m256i; 6]; 6],
+        pre: &[[std::arch::x86_64::__m256i; 8]; 8],
         ns: std::arch::x86_64::__m256i,
     ) -> u32 {
         use std::arch::x86_64::*;
@@ -315,31 +316,35 @@ impl Kernel<'_> {
     #[inline(never)]
     fn edge_distances_avx2(
         &self,
-        pre: &[[std::arch::x86_64::__m256i; 6]; 6],
-        mut edge: u32,
+        pre: &[[std::arch::x86_64::__m256i; 8]; 8],
+        edge: u32,
         texel: &[u32; 9],
         sq: &mut [std::arch::x86_64::__m256i; 9],
         weight: &mut [u64; 18],
     ) {
         use std::arch::x86_64::*;
-        while edge != 0 {
-            let i = edge.trailing_zeros() as usize;
-            edge &= edge - 1;
-            let cand = &self.cands[texel[i % 9] as usize][i / 9];
-            let t = self.inner_of(cand.coord);
-            weight[i] = partial_weight(&t);
-            let (r0, r1, c0, c1) = (t.r0 as usize, t.r1 as usize, t.c0 as usize, t.c1 as usize);
-            let q = _mm256_sub_epi32(
-                _mm256_add_epi32(pre[r1][c1], pre[r0][c0]),
-                _mm256_add_epi32(pre[r0][c1], pre[r1][c0]),
-            );
-            let q = _mm256_srai_epi32(q, FEAT_SHIFT as i32);
-            let q16 = _mm_packs_epi32(_mm256_castsi256_si128(q), _mm256_extracti128_si256(q, 1));
-            // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
-            let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
-            let e = _mm_sub_epi16(q16, f);
-            let v = _mm_madd_epi16(e, e);
-            sq[i % 9] = if i < 9 { _mm256_inserti128_si256(sq[i % 9], v, 0) } else { _mm256_inserti128_si256(sq[i % 9], v, 1) };
+        for k in 0..2 {
+            let mut bits = edge >> (9 * k) & 0x1FF;
+            while bits != 0 {
+                let n = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let cand = &self.cands[texel[n] as usize][k];
+                let t = self.inner_of(cand.coord);
+                weight[9 * k + n] = partial_weight(&t);
+                // Spans are at most 5 ([`InnerTaps::around`]): the masks only spare the checks.
+                let (r0, r1, c0, c1) = (t.r0 as usize & 7, t.r1 as usize & 7, t.c0 as usize & 7, t.c1 as usize & 7);
+                let q = _mm256_sub_epi32(
+                    _mm256_add_epi32(pre[r1][c1], pre[r0][c0]),
+                    _mm256_add_epi32(pre[r0][c1], pre[r1][c0]),
+                );
+                let q = _mm256_srai_epi32(q, FEAT_SHIFT as i32);
+                let q16 = _mm_packs_epi32(_mm256_castsi256_si128(q), _mm256_extracti128_si256(q, 1));
+                // SAFETY: `feat` is 8 i16 = 128 bits; unaligned load.
+                let f = unsafe { _mm_loadu_si128(cand.feat.as_ptr() as *const __m128i) };
+                let e = _mm_sub_epi16(q16, f);
+                let v = _mm_madd_epi16(e, e);
+                sq[n] = if k == 0 { _mm256_inserti128_si256(sq[n], v, 0) } else { _mm256_inserti128_si256(sq[n], v, 1) };
+            }
         }
     }
 
