@@ -628,21 +628,33 @@ mod tests {
 
     #[test]
     fn simd_and_portable_kernels_agree() {
-        let px: Vec<[u8; 4]> = (0..64 * 64u32)
+        let pattern: Vec<[u8; 4]> = (0..64 * 64u32)
             .map(|i| {
                 let (x, y) = (i % 64, i / 64);
                 [((x * 7 + y * 3) % 256) as u8, ((x * y) % 251) as u8, ((x ^ y) * 5 % 256) as u8, 255]
             })
             .collect();
-        let an = Analysis::build(&Exemplar::from_rgba(64, 64, &px, &ExemplarOptions::default()), &NoProgress);
+        // Black-and-white noise per channel: neighbourhoods of the largest energy, so features
+        // and their differences near the i16 bound the SIMD kernel relies on.
+        let noise: Vec<[u8; 4]> = (0..64 * 64u64)
+            .map(|i| {
+                let z = (i + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+                let bit = |k: u32| if (z >> (40 + k)) & 1 == 1 { 255 } else { 0 };
+                [bit(0), bit(1), bit(2), 255]
+            })
+            .collect();
         let other = SynthParams { seed: 9, passes: 3, subpasses: 1, kappa: 1 << 16, ..SynthParams::default() };
-        for p in [SynthParams::default(), other] {
-            let r = Rect::new(-70, 33, 150, 90);
-            let fast = synthesize(&an, &p, 6, r).unwrap();
-            FORCE_PORTABLE.store(true, Ordering::Relaxed);
-            let portable = synthesize(&an, &p, 6, r).unwrap();
-            FORCE_PORTABLE.store(false, Ordering::Relaxed);
-            assert_eq!(fast, portable, "{p:?}");
+        for (px, toroidal) in [(&pattern, None), (&noise, Some(false)), (&noise, Some(true))] {
+            let opts = ExemplarOptions { toroidal, ..ExemplarOptions::default() };
+            let an = Analysis::build(&Exemplar::from_rgba(64, 64, px, &opts), &NoProgress);
+            for p in [SynthParams::default(), other.clone()] {
+                let r = Rect::new(-70, 33, 150, 90);
+                let fast = synthesize(&an, &p, 6, r).unwrap();
+                FORCE_PORTABLE.store(true, Ordering::Relaxed);
+                let portable = synthesize(&an, &p, 6, r).unwrap();
+                FORCE_PORTABLE.store(false, Ordering::Relaxed);
+                assert_eq!(fast, portable, "{p:?} toroidal {toroidal:?}");
+            }
         }
     }
 }
