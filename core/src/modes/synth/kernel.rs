@@ -17,9 +17,10 @@ const WEIGHT_ONE: u64 = 3600;
 /// did while a band along an edge still reaches the output (1: more edge content, worse
 /// `nn_err`; 3: less; bench/README.md).
 const PARTIAL_FACTOR: u64 = 2;
-/// The largest `φ` whose product with every distance scale fits u32 (the largest scale is
-/// that of 9 taps compared); κ ≤ 1 keeps `φ` at most `4 · 2¹⁶`.
-const MAX_PHI_NARROW: u64 = u32::MAX as u64 / (PARTIAL_FACTOR * WEIGHT_ONE / 9);
+/// The largest `φ` whose product with every distance scale stays below 2³¹ (the largest
+/// scale is that of 9 taps compared), so that a u32 distance times it stays below 2⁶³;
+/// κ ≤ 1 keeps `φ` at most `4 · 2¹⁶`, far below.
+const MAX_PHI_NARROW: u64 = i32::MAX as u64 / (PARTIAL_FACTOR * WEIGHT_ONE / 9);
 /// The distance scale of a candidate compared over all taps.
 const FULL_WEIGHT: u64 = WEIGHT_ONE / TAPS5 as u64;
 
@@ -127,7 +128,8 @@ impl Kernel<'_> {
         let (lo, hi) = self.nb_off[1..].iter().fold((0, 0), |(a, b), &(o, _, _)| (o.min(a), o.max(b)));
         let rows = self.nb_off[0].0 == 0
             && (1..9).all(|n| {
-                let r = if n <= 4 { n - 1 } else { n } as isize;
+                // Raster position 0–8 of neighbour `n` (the centre, position 4, is `n = 0`).
+                let r = (if n <= 4 { n - 1 } else { n }) as isize;
                 self.nb_off[n].0 == (r / 3 - 1) * nb.w as isize + r % 3 - 1
             });
         if out.is_empty()
@@ -273,8 +275,8 @@ impl Kernel<'_> {
         let mut weight = [FULL_WEIGHT; N];
         self.edge_distances_avx2(pre, edge, texel, &mut sq, &mut weight);
         let d = hsum18(&sq);
-        // `φ · scale` fits u32 when `κ ≤ 1` (φ ≤ 4·2¹⁶, scales ≤ 800): the 18 products then
-        // compare as vectors; otherwise one by one.
+        // `φ · scale` stays below 2³¹ when `κ ≤ 1` (φ ≤ 4·2¹⁶, scales ≤ 800): the 18
+        // products then compare as vectors; otherwise one by one.
         if self.phi[1].max(self.phi[0]) <= MAX_PHI_NARROW {
             let scale: [u32; N] = std::array::from_fn(|i| (self.phi[i / 9] * weight[i]) as u32);
             return coord[first_smallest_product(&d, &scale)];
@@ -548,14 +550,14 @@ fn first_minima(sq: &[std::arch::x86_64::__m256i; 9]) -> (usize, u32, usize, u32
     (b0, _mm256_extract_epi32(m, 0) as u32, b1, _mm256_extract_epi32(m, 4) as u32)
 }
 
-/// The index of the first smallest of the 18 products `d[i] · scale[i]` (each below 2⁶², as
-/// distances are below 2³⁰): the same as a scan keeping the first strictly smaller one.
+/// The index of the first smallest of the 18 products `d[i] · scale[i]`, for scales below 2³¹
+/// (so every product is below 2⁶³): the same as a scan keeping the first strictly smaller one.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
 fn first_smallest_product(d: &[u32; 18], scale: &[u32; 18]) -> usize {
     use std::arch::x86_64::*;
-    // Padded to 20 with a product larger than any real one (2⁶³ − 2³¹, still positive).
+    // Padded to 20 with a product no real one exceeds ((2³² − 1) · 2³¹ < 2⁶³).
     let (mut dp, mut sp) = ([u32::MAX; 20], [1u32 << 31; 20]);
     dp[..18].copy_from_slice(d);
     sp[..18].copy_from_slice(scale);
@@ -708,22 +710,21 @@ mod minima_tests {
             // SAFETY: the processor supports AVX2 (checked above).
             assert_eq!(unsafe { first_minima(&sq) }, (b0, d[b0], b1, d[b1]), "{d:?}");
             assert_eq!(unsafe { hsum18(&sq) }, d);
-            // Scaled as the kernel scales distances near an edge (κ = 1 at most).
+            // Scales as near an edge: κ = 1 at most (φ ≤ 4·2¹⁶) and up to the bound of the vector path.
             let scale: [u32; 18] = std::array::from_fn(|_| match next() % 3 {
                 0 => 4 << 16,
-                1 => (1 << 16) * 800,
+                1 => (MAX_PHI_NARROW * 800) as u32,
                 _ => (next() % (MAX_PHI_NARROW * 800)) as u32,
             });
-            let d30 = d.map(|v| v >> 2);
             let mut best = (u64::MAX, 18);
             for i in 0..18 {
-                let p = d30[i] as u64 * scale[i] as u64;
+                let p = d[i] as u64 * scale[i] as u64;
                 if p < best.0 {
                     best = (p, i);
                 }
             }
             // SAFETY: the processor supports AVX2 (checked above).
-            assert_eq!(unsafe { first_smallest_product(&d30, &scale) }, best.1, "{d30:?} {scale:?}");
+            assert_eq!(unsafe { first_smallest_product(&d, &scale) }, best.1, "{d:?} {scale:?}");
         }
     }
 }
