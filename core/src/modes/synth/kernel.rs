@@ -2,8 +2,9 @@
 //! the runtime feature space, compared with the 18 k-coherence candidates of its 3×3 neighbours
 //! — a candidate within `2h` of a non-toroidal exemplar's edge over the taps inside the exemplar
 //! only; written twice — portable, and with AVX2 intrinsics (candidates found by vector gathers,
-//! a 16-bit multiply-add projection, a horizontal-add tree for the 18 distances), chosen at run
-//! time — in integer arithmetic, so both give identical results.
+//! a 16-bit multiply-add projection, both candidates of a neighbour compared in one register by
+//! a 16-bit multiply-add, the first minima by vector compares), chosen at run time — in integer
+//! arithmetic, so both give identical results.
 
 use crate::analysis::Candidate;
 use crate::analysis::features::{InnerTaps, FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
