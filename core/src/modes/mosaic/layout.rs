@@ -81,6 +81,15 @@ impl Layout {
 
     /// Every block whose destination meets `r`, in ascending priority.
     pub(super) fn blocks_meeting(&self, r: Rect) -> Vec<Block> {
+        let mut out = self.blocks_meeting_unordered(r);
+        // Priorities are distinct (they end with the block's tile), so an unstable sort gives
+        // the one order there is.
+        out.sort_unstable_by_key(|b| b.prio);
+        out
+    }
+
+    /// Every block whose destination meets `r`, in no particular order.
+    pub(super) fn blocks_meeting_unordered(&self, r: Rect) -> Vec<Block> {
         // A block lies within its super-tile or spills at most n−1 texels right/down.
         let lo = |v: i64| (v - self.n).div_euclid(self.span);
         let hi = |v: i64| (v - 1).div_euclid(self.span);
@@ -97,7 +106,6 @@ impl Layout {
                 }
             }
         }
-        out.sort_by_key(|b| b.prio);
         out
     }
 }

@@ -22,7 +22,7 @@ use crate::modes::{Cost, Mode, Needs, Source, View};
 pub use params::{MosaicParams, MAX_ITERATIONS, MAX_SMOOTHING};
 
 use layout::Layout;
-use paint::paint;
+use paint::sources;
 use smooth::native;
 
 /// Largest native window, in pixels, one call may evaluate (2^26).
@@ -169,8 +169,7 @@ fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let mip = box_mip(&ex.pixels, n, lvl);
     let mut pixels = Vec::with_capacity(3 * w * h);
     let step = 1i64 << k.min(40);
-    let pt = paint(layout, rect, ex.toroidal, step, step / 2);
-    for v in &pt.src {
+    for v in &sources(layout, rect, ex.toroidal, step, step / 2) {
         let (x, y) = ((v & 0xFFFF) as usize >> lvl, (v >> 16) as usize >> lvl);
         pixels.extend_from_slice(&mip[y.min(side - 1) * side + x.min(side - 1)]);
     }

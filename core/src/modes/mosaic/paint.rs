@@ -3,7 +3,7 @@
 
 use crate::geom::Rect;
 
-use super::layout::Layout;
+use super::layout::{Block, Layout};
 
 /// Labels (which block or background tile shows) and source texels over a rect, on a grid of
 /// sample points `step·(i, j) + offset`. Background labels have the top bit set and identify
@@ -14,6 +14,48 @@ pub(super) struct Paint {
 }
 
 pub(super) fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) -> Paint {
+    let (mut label, mut src) = background(layout, rect, toroidal, step, offset);
+    let w = rect.width() as usize;
+    for (id, b) in layout.blocks_meeting(grid_extent(rect, step, offset)).iter().enumerate() {
+        let (i0, i1, j0, j1) = samples_in(b, rect, step, offset);
+        for j in j0..j1 {
+            let row = (j - rect.y0) as usize * w;
+            for i in i0..i1 {
+                let k = row + (i - rect.x0) as usize;
+                label[k] = id as u32;
+                src[k] = source(b, i, j, step, offset);
+            }
+        }
+    }
+    Paint { label, src }
+}
+
+/// [`paint`]'s source texels alone, for grids much sparser than the blocks (far zoom-outs):
+/// each sample shows the block of highest priority covering it — what painting in ascending
+/// priority leaves there — found by keeping each sample's best priority instead of sorting
+/// the blocks (most of which cover one sample or none).
+pub(super) fn sources(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) -> Vec<u32> {
+    let (_, mut src) = background(layout, rect, toroidal, step, offset);
+    let w = rect.width() as usize;
+    let mut top = vec![None; src.len()];
+    for b in layout.blocks_meeting_unordered(grid_extent(rect, step, offset)) {
+        let (i0, i1, j0, j1) = samples_in(&b, rect, step, offset);
+        for j in j0..j1 {
+            let row = (j - rect.y0) as usize * w;
+            for i in i0..i1 {
+                let k = row + (i - rect.x0) as usize;
+                if top[k] < Some(b.prio) {
+                    top[k] = Some(b.prio);
+                    src[k] = source(&b, i, j, step, offset);
+                }
+            }
+        }
+    }
+    src
+}
+
+/// Labels and source texels of the background (the tiled exemplar) at every sample.
+fn background(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) -> (Vec<u32>, Vec<u32>) {
     let n = layout.n;
     let (shift, mask) = (n.trailing_zeros(), n - 1);
     let (w, h) = (rect.width() as usize, rect.height() as usize);
@@ -34,29 +76,61 @@ pub(super) fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offs
             *s = sy | sx;
         }
     }
-    // Texel extent of the sample grid.
-    let tex = Rect {
+    (label, src)
+}
+
+/// Texel extent of the sample grid over `rect`.
+fn grid_extent(rect: Rect, step: i64, offset: i64) -> Rect {
+    Rect {
         x0: rect.x0 * step + offset,
         y0: rect.y0 * step + offset,
         x1: (rect.x1 - 1) * step + offset + 1,
         y1: (rect.y1 - 1) * step + offset + 1,
-    };
-    for (id, b) in layout.blocks_meeting(tex).iter().enumerate() {
-        // Sample i shows texel i·step + offset: the first index at or after texel d, and one
-        // past the last index before texel e.
-        let first = |d: i64| (d - offset).div_euclid(step) + i64::from((d - offset).rem_euclid(step) != 0);
-        let end = |e: i64| (e - 1 - offset).div_euclid(step) + 1;
-        let (i0, i1) = (first(b.dx).max(rect.x0), end(b.dx + b.w).min(rect.x1));
-        let (j0, j1) = (first(b.dy).max(rect.y0), end(b.dy + b.h).min(rect.y1));
-        for j in j0..j1 {
-            let sy = ((b.sy + j * step + offset - b.dy) as u32) << 16;
-            let row = (j - rect.y0) as usize * w;
-            for i in i0..i1 {
-                let k = row + (i - rect.x0) as usize;
-                label[k] = id as u32;
-                src[k] = sy | (b.sx + i * step + offset - b.dx) as u32;
+    }
+}
+
+/// The samples of `rect` inside block `b`: columns `i0..i1`, rows `j0..j1`. Sample `i` shows
+/// texel `i·step + offset`: the first index at or after texel `d` is `⌈(d − offset)/step⌉`, and
+/// one past the last before texel `e` is `⌊(e − 1 − offset)/step⌋ + 1` (power-of-two steps —
+/// every zoom — by shifts: a division per block was a third of a far zoom-out's painting).
+#[inline]
+fn samples_in(b: &Block, rect: Rect, step: i64, offset: i64) -> (i64, i64, i64, i64) {
+    let sh = step.trailing_zeros();
+    let floor_div = |v: i64| if step == 1 << sh { v >> sh } else { v.div_euclid(step) };
+    let first = |d: i64| -floor_div(offset - d);
+    let end = |e: i64| floor_div(e - 1 - offset) + 1;
+    (first(b.dx).max(rect.x0), end(b.dx + b.w).min(rect.x1), first(b.dy).max(rect.y0), end(b.dy + b.h).min(rect.y1))
+}
+
+/// The packed exemplar texel block `b` shows at sample `(i, j)`.
+#[inline]
+fn source(b: &Block, i: i64, j: i64, step: i64, offset: i64) -> u32 {
+    ((b.sy + j * step + offset - b.dy) as u32) << 16 | (b.sx + i * step + offset - b.dx) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::modes::mosaic::MosaicParams;
+
+    /// Keeping each sample's best priority gives what painting in priority order gives, on
+    /// dense and sparse grids, toroidal or not, with and without a period.
+    #[test]
+    fn sources_equal_the_painted_sources() {
+        for (seed, period) in [(0, None), (7, Some(512)), (3, Some(4096))] {
+            let layout = Layout::new(128, &MosaicParams { seed, period, ..MosaicParams::default() });
+            for (step, rect) in [
+                (1, Rect::new(-300, 70, 96, 64)),
+                (4, Rect::new(1000, -2000, 64, 48)),
+                (32, Rect::new(-9, -13, 40, 40)),
+                (128, Rect::new(5_000, 77, 33, 20)),
+                (3, Rect::new(-50, -50, 30, 30)),
+            ] {
+                for toroidal in [false, true] {
+                    let painted = paint(&layout, rect, toroidal, step, step / 2).src;
+                    assert_eq!(sources(&layout, rect, toroidal, step, step / 2), painted, "{seed} {period:?} {step} {rect:?}");
+                }
             }
         }
     }
-    Paint { label, src }
 }
