@@ -278,8 +278,12 @@ impl Mode for Umbrella {
             // zoom changes the detail, not the colour.
             let shift = colour_shift(&elements, &arr, p, src, cache, umbrella_zooms(&arr))?;
             let mut image = background;
+            // Per channel, every shifted value once (a table, not a rounding per pixel).
+            let table: [[u8; 256]; 3] = std::array::from_fn(|c| {
+                std::array::from_fn(|v| (v as f32 + shift[c]).round().clamp(0.0, 255.0) as u8)
+            });
             for (i, v) in image.pixels.iter_mut().enumerate() {
-                *v = (*v as f32 + shift[i % 3]).round().clamp(0.0, 255.0) as u8;
+                *v = table[i % 3][*v as usize];
             }
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
         };
