@@ -23,9 +23,7 @@ pub(super) struct Block {
     pub(super) h: i64,
     pub(super) dx: i64,
     pub(super) dy: i64,
-    /// The tile the block belongs to (its priority: [`Layout::priority`]).
-    pub(super) k1: i64,
-    pub(super) k2: i64,
+    pub(super) prio: (u64, i64, i64),
 }
 
 /// Block geometry and placement for a plane of `n`-texel tiles.
@@ -53,17 +51,12 @@ impl Layout {
         Layout { n, tiles, span, cat, period_tiles, p: p.clone() }
     }
 
-    /// The tile whose hashes tile `(k1, k2)` takes: itself, or within the period.
-    fn hashed_tile(&self, k1: i64, k2: i64) -> (i64, i64) {
-        match self.period_tiles {
-            Some(t) => (k1.rem_euclid(t), k2.rem_euclid(t)),
-            None => (k1, k2),
-        }
-    }
-
     /// The block of absolute tile `(k1, k2)`.
     fn block(&self, k1: i64, k2: i64) -> Block {
-        let (h1, h2) = self.hashed_tile(k1, k2);
+        let (h1, h2) = match self.period_tiles {
+            Some(t) => (k1.rem_euclid(t), k2.rem_euclid(t)),
+            None => (k1, k2),
+        };
         let z = hash(TAG_MOSAIC_BLOCK, self.p.seed, h1, h2, 0);
         let n = self.n;
         let rho = self.p.area_min as f64 + (((z & 0xFFFF) * (self.p.area_max - self.p.area_min) as u64) >> 16) as f64;
@@ -82,21 +75,16 @@ impl Layout {
         let [a, b, c, d] = self.cat;
         let s = (a.wrapping_mul(x0).wrapping_add(b.wrapping_mul(y0))) & mask;
         let t = (c.wrapping_mul(x0).wrapping_add(d.wrapping_mul(y0))) & mask;
-        Block { sx, sy, w, h, dx: s1 * self.span + s as i64, dy: s2 * self.span + t as i64, k1, k2 }
-    }
-
-    /// The stacking priority of block `b` (higher on top): a hash of its tile, then the tile
-    /// itself, so no two blocks tie. Apart from the geometry, for callers that need it only for
-    /// some blocks.
-    pub(super) fn priority(&self, b: &Block) -> (u64, i64, i64) {
-        let (h1, h2) = self.hashed_tile(b.k1, b.k2);
-        (hash(TAG_MOSAIC_PRIO, self.p.seed, h1, h2, 0), b.k2, b.k1)
+        let prio = hash(TAG_MOSAIC_PRIO, self.p.seed, h1, h2, 0);
+        Block { sx, sy, w, h, dx: s1 * self.span + s as i64, dy: s2 * self.span + t as i64, prio: (prio, k2, k1) }
     }
 
     /// Every block whose destination meets `r`, in ascending priority.
     pub(super) fn blocks_meeting(&self, r: Rect) -> Vec<Block> {
         let mut out = self.blocks_meeting_unordered(r);
-        out.sort_by_cached_key(|b| self.priority(b));
+        // Priorities are distinct (they end with the block's tile), so an unstable sort gives
+        // the one order there is.
+        out.sort_unstable_by_key(|b| b.prio);
         out
     }
 

@@ -33,23 +33,19 @@ pub(super) fn paint(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offs
 /// [`paint`]'s source texels alone, for grids much sparser than the blocks (far zoom-outs):
 /// each sample shows the block of highest priority covering it — what painting in ascending
 /// priority leaves there — found by keeping each sample's best priority instead of sorting
-/// the blocks (most of which cover one sample or none; those covering none are not ranked).
+/// the blocks (most of which cover one sample or none).
 pub(super) fn sources(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) -> Vec<u32> {
     let (_, mut src) = background(layout, rect, toroidal, step, offset);
     let w = rect.width() as usize;
     let mut top = vec![None; src.len()];
     for b in layout.blocks_meeting_unordered(grid_extent(rect, step, offset)) {
         let (i0, i1, j0, j1) = samples_in(&b, rect, step, offset);
-        if i0 >= i1 || j0 >= j1 {
-            continue;
-        }
-        let prio = Some(layout.priority(&b));
         for j in j0..j1 {
             let row = (j - rect.y0) as usize * w;
             for i in i0..i1 {
                 let k = row + (i - rect.x0) as usize;
-                if top[k] < prio {
-                    top[k] = prio;
+                if top[k] < Some(b.prio) {
+                    top[k] = Some(b.prio);
                     src[k] = source(&b, i, j, step, offset);
                 }
             }
