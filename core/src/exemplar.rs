@@ -2,12 +2,9 @@
 //! crop to the centred square, bring the side to a power of two with an exact integer area
 //! filter, and decide whether the exemplar wraps around seamlessly (toroidal).
 
-use std::io::Cursor;
-
-use image::{ImageReader, Limits};
-use serde::{Deserialize, Serialize};
-
 use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
 use crate::lattice::Lattice;
@@ -94,9 +91,7 @@ pub struct UmbrellaSet {
 impl Exemplar {
     /// Decode and prepare an exemplar from encoded image bytes (PNG, JPEG, WebP, TGA, BMP).
     pub fn from_bytes(bytes: &[u8], opts: &ExemplarOptions) -> Result<Exemplar> {
-        let reader = ImageReader::new(Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
+        let reader = crate::image::reader(bytes).map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
         if reader.format().is_none() {
             return Err(CoreError::ExemplarUndecodable(
                 "unrecognised image format (expected PNG, JPEG, WebP, TGA or BMP)".into(),
@@ -104,15 +99,8 @@ impl Exemplar {
         }
         let (w, h) = reader.into_dimensions().map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
         check_size(w, h, opts.max_input_side)?;
-        let mut reader = ImageReader::new(Cursor::new(bytes))
-            .with_guessed_format()
+        let img = crate::image::decode_within(bytes, opts.max_input_side, 256 << 20)
             .map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
-        let mut limits = Limits::default();
-        limits.max_image_width = Some(opts.max_input_side);
-        limits.max_image_height = Some(opts.max_input_side);
-        limits.max_alloc = Some(256 << 20);
-        reader.limits(limits);
-        let img = reader.decode().map_err(|e| CoreError::ExemplarUndecodable(e.to_string()))?;
         let rgba = img.to_rgba8();
         let (w, h) = rgba.dimensions();
         let px: Vec<[u8; 4]> = rgba.pixels().map(|p| p.0).collect();

@@ -1,5 +1,27 @@
 //! Images as the modes produce them: an RGB8 window, what rendering it cost, and the exact box
-//! filter that zoomed-out views of cheap modes are made with.
+//! filter that zoomed-out views of cheap modes are made with; and the bounded decoding of
+//! images given to us (exemplars, hand-made umbrella images).
+
+use std::io::Cursor;
+
+use image::{DynamicImage, ImageReader, ImageResult, Limits};
+
+/// A reader of encoded image bytes, its format guessed from them.
+pub fn reader(bytes: &[u8]) -> ImageResult<ImageReader<Cursor<&[u8]>>> {
+    Ok(ImageReader::new(Cursor::new(bytes)).with_guessed_format()?)
+}
+
+/// Decode encoded image bytes whose header size the caller has already checked, refusing any
+/// axis over `max_side` and more than `max_alloc` bytes of allocation while decoding.
+pub fn decode_within(bytes: &[u8], max_side: u32, max_alloc: u64) -> ImageResult<DynamicImage> {
+    let mut r = reader(bytes)?;
+    let mut limits = Limits::default();
+    limits.max_image_width = Some(max_side);
+    limits.max_image_height = Some(max_side);
+    limits.max_alloc = Some(max_alloc);
+    r.limits(limits);
+    r.decode()
+}
 
 /// An RGB8 image of a window.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -57,19 +57,12 @@ struct Picture {
 
 fn decode(name: &str, bytes: &[u8]) -> Result<Picture> {
     let undecodable = |e: &dyn std::fmt::Display| bad(format!("image '{name}': {e}"));
-    let reader = || image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| undecodable(&e));
     // The size from the header first: a huge image is refused before it is decoded.
-    let (w, h) = reader()?.into_dimensions().map_err(|e| undecodable(&e))?;
+    let (w, h) = crate::image::reader(bytes).and_then(|r| r.into_dimensions()).map_err(|e| undecodable(&e))?;
     if w > MAX_IMAGE_SIDE || h > MAX_IMAGE_SIDE || w == 0 || h == 0 {
         return Err(bad(format!("image '{name}' is {w}x{h}; an element image is at most {MAX_IMAGE_SIDE}x{MAX_IMAGE_SIDE}")));
     }
-    let mut r = reader()?;
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(MAX_IMAGE_SIDE);
-    limits.max_image_height = Some(MAX_IMAGE_SIDE);
-    limits.max_alloc = Some(16 << 20);
-    r.limits(limits);
-    let img = r.decode().map_err(|e| undecodable(&e))?;
+    let img = crate::image::decode_within(bytes, MAX_IMAGE_SIDE, 16 << 20).map_err(|e| undecodable(&e))?;
     if !img.color().has_alpha() {
         return Err(bad(format!("image '{name}' has no alpha channel: the element is where alpha ≥ 128")));
     }

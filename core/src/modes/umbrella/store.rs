@@ -215,10 +215,10 @@ pub enum Source {
 /// for the process ([`super::elements`] then finds it). A missing, stale or damaged file is
 /// replaced; the outcome may be "no elements" (kept too, so it is not recomputed).
 pub fn load_or_extract(ex: &Exemplar, path: &Path, store: bool) -> (Outcome, Source) {
-    let id = super::extraction_id(ex);
     if let Some(set) = &ex.umbrella_set {
         return (Ok(set.elements.clone()), Source::HandMade);
     }
+    let id = super::extraction_id(ex);
     if let Ok(bytes) = std::fs::read(path) {
         if let Ok((found, outcome)) = from_bytes(&bytes) {
             if found == id {
