@@ -136,9 +136,18 @@ pub fn merged_colour(m: &Merged, q: [f64; 2]) -> Option<[f32; 3]> {
 
 /// The convex hull of `points` (monotone chain), counter-clockwise in the y-up sense
 /// (positive `cross`), without collinear points.
-fn hull(mut points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
-    points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
-    points.dedup();
+fn hull(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    // Sorted lexicographically, (x, y), as one integer per point: each coordinate's bits
+    // mapped to an unsigned integer of the same order (−0 taken as +0, the same point).
+    let key = |v: f64| {
+        let b = (v + 0.0).to_bits();
+        if b >> 63 == 1 { !b } else { b | 1 << 63 }
+    };
+    let value = |k: u64| f64::from_bits(if k >> 63 == 1 { k & !(1 << 63) } else { !k });
+    let mut keys: Vec<u128> = points.iter().map(|p| (key(p[0]) as u128) << 64 | key(p[1]) as u128).collect();
+    keys.sort_unstable();
+    keys.dedup();
+    let points: Vec<[f64; 2]> = keys.iter().map(|&k| [value((k >> 64) as u64), value(k as u64)]).collect();
     if points.len() < 3 {
         return points;
     }
@@ -187,29 +196,46 @@ fn kmeans(members: &[Member], k: usize) -> Vec<Vec<usize>> {
     let d2 = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
     let k = k.min(pts.len()).max(1);
     let mut centres = vec![pts[0]];
+    // Each point's distance to the nearest centre chosen so far.
+    let mut near: Vec<f64> = pts.iter().map(|&p| d2(p, pts[0])).collect();
     while centres.len() < k {
-        let far = (0..pts.len())
-            .map(|i| (centres.iter().map(|&c| d2(pts[i], c)).fold(f64::MAX, f64::min), i))
-            .fold((f64::MIN, 0), |best, (d, i)| if d > best.0 { (d, i) } else { best });
-        centres.push(pts[far.1]);
+        let far = near.iter().enumerate().fold((f64::MIN, 0), |best, (i, &d)| if d > best.0 { (d, i) } else { best });
+        let c = pts[far.1];
+        centres.push(c);
+        for (n, &p) in near.iter_mut().zip(&pts) {
+            *n = n.min(d2(p, c));
+        }
     }
     let mut assign = vec![0usize; pts.len()];
     for _ in 0..KMEANS_ITERATIONS {
-        for (i, p) in pts.iter().enumerate() {
-            assign[i] = (0..k).fold(0, |best, c| if d2(*p, centres[c]) < d2(*p, centres[best]) { c } else { best });
-        }
-        for (c, centre) in centres.iter_mut().enumerate() {
-            let (mut s, mut n) = ([0f64; 2], 0f64);
-            for (_, p) in pts.iter().enumerate().filter(|(i, _)| assign[*i] == c) {
-                s = [s[0] + p[0], s[1] + p[1]];
-                n += 1.0;
+        for (a, &p) in assign.iter_mut().zip(&pts) {
+            let mut best = (d2(p, centres[0]), 0);
+            for (c, &centre) in centres.iter().enumerate().skip(1) {
+                let d = d2(p, centre);
+                if d < best.0 {
+                    best = (d, c);
+                }
             }
+            *a = best.1;
+        }
+        // Means, each summed in point order.
+        let mut sums = vec![([0f64; 2], 0f64); k];
+        for (&a, p) in assign.iter().zip(&pts) {
+            let (s, n) = &mut sums[a];
+            *s = [s[0] + p[0], s[1] + p[1]];
+            *n += 1.0;
+        }
+        for (centre, &(s, n)) in centres.iter_mut().zip(&sums) {
             if n > 0.0 {
                 *centre = [s[0] / n, s[1] / n];
             }
         }
     }
-    (0..k).map(|c| (0..pts.len()).filter(|&i| assign[i] == c).collect::<Vec<_>>()).filter(|g| !g.is_empty()).collect()
+    let mut groups = vec![Vec::new(); k];
+    for (i, &a) in assign.iter().enumerate() {
+        groups[a].push(i);
+    }
+    groups.into_iter().filter(|g| !g.is_empty()).collect()
 }
 
 /// One merged umbrella from a cluster (members front to back).
