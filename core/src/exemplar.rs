@@ -150,9 +150,8 @@ impl Exemplar {
     pub fn hash_content(&self, h: &mut blake3::Hasher) {
         h.update(&self.side.to_le_bytes());
         h.update(&[self.toroidal as u8]);
-        for p in &self.pixels {
-            h.update(p);
-        }
+        // One update for all the pixels (the same bytes as one per pixel, hashed faster).
+        h.update(self.pixels.as_flattened());
         if let Some(mask) = &self.randomness_mask {
             h.update(b"randomness-mask");
             h.update(mask.hash.as_bytes());
@@ -168,9 +167,7 @@ impl Exemplar {
         }
         if let Some(hires) = &self.hires {
             h.update(b"hires");
-            for p in hires {
-                h.update(p);
-            }
+            h.update(hires.as_flattened());
         }
     }
 

@@ -6,6 +6,7 @@
 //! far-away cells lose no precision. Lists are built a window at a time and kept in an LRU
 //! shared by all requests.
 
+use std::cell::OnceCell;
 use std::num::NonZeroUsize;
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -258,8 +259,14 @@ impl Arrangement {
     /// Whether umbrella `u`, centred at `(x, y)`, covers part of the square of side `g` at
     /// `(x0, y0)`: its centre or a rim vertex ([`Arrangement::rim`]) inside the square, a rim
     /// edge crossing it, or the square inside the umbrella.
-    #[allow(clippy::too_many_arguments)]
     pub fn meets(&self, u: &Placed, x: f64, y: f64, x0: f64, y0: f64, g: f64) -> bool {
+        self.meets_with(u, x, y, x0, y0, g, &OnceCell::new())
+    }
+
+    /// [`Arrangement::meets`], with `u`'s rim computed at most once over the calls that share
+    /// `rim`.
+    #[allow(clippy::too_many_arguments)]
+    fn meets_with(&self, u: &Placed, x: f64, y: f64, x0: f64, y0: f64, g: f64, rim: &OnceCell<[(f64, f64); RAYS]>) -> bool {
         // The discs first: the square's nearest point to the centre beyond the reach (with a
         // margin for rounding) → apart; within the inner disc, which the rim encloses → met.
         let (dx, dy) = (x - x.clamp(x0, x0 + g), y - y.clamp(y0, y0 + g));
@@ -271,7 +278,7 @@ impl Arrangement {
         if d2 < u.inner2 as f64 {
             return true;
         }
-        let rim = self.rim(u, x, y);
+        let rim = rim.get_or_init(|| self.rim(u, x, y));
         let inside_sq = |(px, py): (f64, f64)| px >= x0 && px <= x0 + g && py >= y0 && py <= y0 + g;
         if inside_sq((x, y)) || rim.iter().any(|&v| inside_sq(v)) {
             return true;
@@ -377,6 +384,7 @@ impl Arrangement {
                     let ur = u.reach as f64;
                     let (bx0, bx1) = (((x - ur) / g).floor() as i64, ((x + ur) / g).floor() as i64);
                     let (by0, by1) = (((y - ur) / g).floor() as i64, ((y + ur) / g).floor() as i64);
+                    let rim = OnceCell::new();
                     for cy in ay0.max(cy0)..=ay1.min(cy1 - 1) {
                         for cx in ax0.max(cx0)..=ax1.min(cx1 - 1) {
                             let n = (cy - cy0) as usize * w + (cx - cx0) as usize;
@@ -390,10 +398,10 @@ impl Arrangement {
                             let (x0, y0) = (cx as f64 * g, cy as f64 * g);
                             let covers = (bx0..=bx1).contains(&cx)
                                 && (by0..=by1).contains(&cy)
-                                && self.meets(&u, x, y, x0, y0, g);
+                                && self.meets_with(&u, x, y, x0, y0, g, &rim);
                             // Or it may shade the cell: it covers part of the cell moved by −ℓ.
                             let l = self.shadow_offset as f64;
-                            if covers || (l > 0.0 && self.meets(&u, x, y, x0 - l, y0 - l, g)) {
+                            if covers || (l > 0.0 && self.meets_with(&u, x, y, x0 - l, y0 - l, g, &rim)) {
                                 bins[n].push((v, covers));
                             }
                         }

@@ -10,7 +10,7 @@
 //! `sp` that is a power of two, so a sample's coverage depends on its absolute position only:
 //! windows are the same samples cut from larger ones.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use super::arrange::{Arrangement, Placed};
 use super::extract::{ray, RAYS};
@@ -58,37 +58,63 @@ pub fn fill(
             ymax = ymax.max(hi);
         }
     }
-    let first = ceil(ymin / sp - 0.5).max(rows.0);
-    let last = ceil(ymax / sp - 0.5).min(rows.1);
-    let mut xs = [0f32; RAYS];
-    for r in first..last {
-        if skip(r) {
-            continue;
-        }
-        let y = (r as f32 + 0.5) * sp;
-        let mut n = 0;
-        // Branch-free: whether an edge crosses the row is a coin toss from row to row.
-        for &[ay, by, ax, slope] in &edges[..ne] {
-            xs[n] = ax + (y - ay) * slope;
-            n += ((ay <= y) != (by <= y)) as usize;
-        }
-        let xs = &mut xs[..n];
-        // Insertion sort: a handful of crossings.
-        for i in 1..xs.len() {
-            let mut j = i;
-            while j > 0 && xs[j - 1] > xs[j] {
-                xs.swap(j - 1, j);
-                j -= 1;
-            }
-        }
-        for pair in xs.chunks_exact(2) {
-            let c0 = ceil(pair[0] / sp - 0.5).max(cols.0);
-            let c1 = ceil(pair[1] / sp - 0.5).min(cols.1);
-            if c0 < c1 {
-                span(r, c0, c1);
-            }
-        }
+    // `sp` is a power of two: multiplying by its inverse is dividing by it, exactly.
+    debug_assert_eq!(sp.to_bits() & 0x7F_FFFF, 0, "the sample spacing is a power of two");
+    let inv = 1.0 / sp;
+    let first = ceil(ymin * inv - 0.5).max(rows.0);
+    let last = ceil(ymax * inv - 0.5).min(rows.1);
+    if first >= last {
+        return;
     }
+    let height = (last - first) as usize;
+    CROSSINGS.with_borrow_mut(|(xs, counts)| {
+        // Each edge's crossings in the rows it spans (found from its ends, with a row of margin
+        // either side for rounding, then tested exactly), into its rows in edge order — the
+        // crossings of a row in the order a walk over all edges per row meets them.
+        xs.resize(height * RAYS, 0.0);
+        counts.clear();
+        counts.resize(height, 0);
+        for &[ay, by, ax, slope] in &edges[..ne] {
+            let (lo, hi) = (ay.min(by), ay.max(by));
+            let r0 = (ceil(lo * inv - 0.5) - 1).max(first);
+            let r1 = (ceil(hi * inv - 0.5) + 1).min(last);
+            for r in r0..r1 {
+                let y = (r as f32 + 0.5) * sp;
+                if (ay <= y) != (by <= y) {
+                    let k = (r - first) as usize;
+                    xs[k * RAYS + counts[k] as usize] = ax + (y - ay) * slope;
+                    counts[k] += 1;
+                }
+            }
+        }
+        for (k, &n) in counts.iter().enumerate() {
+            let r = first + k as i64;
+            if n < 2 || skip(r) {
+                continue;
+            }
+            let xs = &mut xs[k * RAYS..][..n as usize];
+            // Insertion sort: a handful of crossings.
+            for i in 1..xs.len() {
+                let mut j = i;
+                while j > 0 && xs[j - 1] > xs[j] {
+                    xs.swap(j - 1, j);
+                    j -= 1;
+                }
+            }
+            for pair in xs.chunks_exact(2) {
+                let c0 = ceil(pair[0] * inv - 0.5).max(cols.0);
+                let c1 = ceil(pair[1] * inv - 0.5).min(cols.1);
+                if c0 < c1 {
+                    span(r, c0, c1);
+                }
+            }
+        }
+    });
+}
+
+thread_local! {
+    /// [`fill`]'s crossings per row (at most [`RAYS`] each) and their counts.
+    static CROSSINGS: RefCell<(Vec<f32>, Vec<u8>)> = const { RefCell::new((Vec::new(), Vec::new())) };
 }
 
 /// `⌈v⌉` for the sample indices at hand (|v| < 2^23; without SSE4.1, `f32::ceil` is a call).
@@ -152,10 +178,12 @@ impl Coverage {
                 fill(p.vertices(), sp, rows, cols, full, |r, c0, c1| {
                     let k = at(r, c0);
                     let mut taken = 0;
+                    // Branch-free (vectorised): free samples take `id`.
                     for h in &mut hit[k..k + (c1 - c0) as usize] {
-                        let free = *h == NONE;
-                        taken += free as u32;
-                        *h = if free { id } else { *h };
+                        let free = (*h == NONE) as u32;
+                        taken += free;
+                        let mask = free.wrapping_neg();
+                        *h = (*h & !mask) | (id & mask);
                     }
                     let f = &free[(r - rows.0) as usize];
                     f.set(f.get() - taken);
