@@ -193,7 +193,9 @@ fn check_zoom_consistency(
     // Each step out with every umbrella drawn (level 0: a cell at least 8 pixels wide): the
     // parent (4×4 sub-samples per pixel over a 2×2 texel footprint, each umbrella's colour
     // looked up once per pixel in its mipmapped base texture) against the box filter of the
-    // children (each anti-aliased itself): the sub-sampling's and the mipmap's difference.
+    // children (each anti-aliased itself): the sub-sampling's and the mipmap's difference, and
+    // between umbrellas the background's (the mosaic's sampled zoomed-out pixels against its
+    // native ones box-filtered).
     // Bound: mean absolute difference ≤ 4/255 per channel, mean colours within 1/255 (no drift).
     // At the merged levels of detail (design note §5.5) a cluster of one stays the umbrella it
     // is, but larger clusters take their convex hull and keep only vertex colours (the texture

@@ -124,7 +124,7 @@ pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
 /// `rect` of the mosaic `zoom_out` steps out by the far zoom-out method at every zoom (each
 /// pixel one lookup of the box-filtered exemplar; see [`sampled`]): cheaper than [`render`]'s
 /// exact box filter of the native pixels for zoom-outs 1–3, for callers to whom an approximate
-/// view will do (the umbrella mode's background at its merged levels of detail).
+/// view will do (the umbrella mode's background, which shows only between umbrellas).
 pub fn render_sampled(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
     render_view(ex, p, zoom_out, rect, false)
 }

@@ -198,7 +198,7 @@ const SPECS: &[ParamSpec] = &[DENSITY, SCALE, SHAPE, COLOUR, SHADOW, SHADOW_OFFS
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 6;
+    const VERSION: u32 = 7;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -272,7 +272,7 @@ impl Mode for Umbrella {
         // Level 0 (every umbrella) while a cell is at least `lod::LOD_PIXELS` wide, then the
         // merged levels of detail, then the background's own zoomed-out pixels.
         let level = lod::level(&arr, view.zoom_out);
-        let background = background(p, src, cache, view, level == Some(0))?;
+        let background = background(p, src, cache, view)?;
         let Some(level) = level else {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
@@ -310,7 +310,7 @@ fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Sour
     }
     let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
     let level = lod::level(arr, zooms).unwrap_or(0);
-    let bg = background(p, src, cache, view, level == 0)?;
+    let bg = background(p, src, cache, view)?;
     let umb = paint(el, arr, p, view, &bg, level);
     let mut shift = [0f32; 3];
     for (i, (a, b)) in umb.pixels.iter().zip(&bg.pixels).enumerate() {
@@ -324,18 +324,16 @@ fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Sour
     Ok(shift)
 }
 
-/// The background of a view: another mode's pixels (or the mean colour); the mosaic's exact
-/// zoomed-out pixels only if `exact` (where every umbrella is drawn), else its approximate ones.
-fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View, exact: bool) -> Result<RgbWindow> {
+/// The background of a view: another mode's pixels (or the mean colour). Zoomed out, the
+/// mosaic's sampled pixels (one lookup of the box-filtered exemplar each), not its exact box
+/// filter of the native ones: the background shows only between umbrellas, and the exact
+/// filter cost a fifth of a zoom-out-1 tile.
+fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> Result<RgbWindow> {
     let ex = src.exemplar;
     Ok(match p.background {
         Background::Mosaic => {
             let mp = MosaicParams { seed: p.seed, period: p.period, ..MosaicParams::default() };
-            if exact {
-                mosaic::render(ex, &mp, view.zoom_out, view.rect)?
-            } else {
-                mosaic::render_sampled(ex, &mp, view.zoom_out, view.rect)?
-            }
+            mosaic::render_sampled(ex, &mp, view.zoom_out, view.rect)?
         }
         Background::Synth => {
             let sp = SynthParams { seed: p.seed, period: p.period, ..SynthParams::default() };
