@@ -331,28 +331,31 @@ pub fn cell(el: &Elements, arr: &Arrangement, sectors: &SectorTable, j: u32, cx:
     merged
 }
 
-/// A merged umbrella relative to a drawn cell's origin, for rasterising and colouring.
+/// A merged umbrella relative to the origin of a drawn row of cells, for rasterising and
+/// colouring.
 pub struct Local<'a> {
     /// The umbrella.
     pub m: &'a Merged,
-    /// Centre relative to the cell.
+    /// Centre relative to the row's origin.
     pub o: [f32; 2],
     /// Squared reach.
     pub reach2: f32,
-    /// Rim relative to the cell.
+    /// Rim relative to the row's origin.
     pub rim: Poly,
-    /// The cell's origin (absolute texels), to take a point back.
+    /// The row's origin (absolute texels), to take a point back.
     pub origin: [f64; 2],
 }
 
-/// The merged umbrellas that may cover level-`j` cell `(cx, cy)` or shade it, front to back,
-/// relative to its origin: those of the cells around it whose disc, grown by the shadow
-/// offset, meets it.
-pub fn list<'a>(cells: impl Iterator<Item = &'a Vec<Merged>>, arr: &Arrangement, j: u32, cx: i64, cy: i64) -> Vec<Local<'a>> {
+/// The merged umbrellas that may cover the row of level-`j` cells `cx0..cx1` at `cy` or shade
+/// it, front to back, relative to the origin of cell `(cx0, cy)`: those of the cells around it
+/// whose disc, grown by the shadow offset, meets it. (Merged levels keep every umbrella of a
+/// cell, not the first `k`, so the list of a row is the union of its cells' lists: each
+/// umbrella is rasterised once per row, not once per cell it reaches.)
+pub fn list<'a>(cells: impl Iterator<Item = &'a Vec<Merged>>, arr: &Arrangement, j: u32, (cx0, cx1): (i64, i64), cy: i64) -> Vec<Local<'a>> {
     let side = (arr.g << j) as f64;
-    let origin = [cx as f64 * side, cy as f64 * side];
+    let origin = [cx0 as f64 * side, cy as f64 * side];
     let grow = 1.5 * arr.shadow_offset as f64;
-    let extent = [0.0, side as f32, 0.0, side as f32];
+    let extent = [0.0, ((cx1 - cx0) as f64 * side) as f32, 0.0, side as f32];
     let mut out: Vec<Local> = cells
         .flat_map(|ms| ms.iter())
         .filter_map(|m| {
@@ -369,7 +372,7 @@ pub fn list<'a>(cells: impl Iterator<Item = &'a Vec<Merged>>, arr: &Arrangement,
             Some(Local { m, o, reach2, rim: Poly::new(v, m.rim.len()), origin })
         })
         .collect();
-    out.sort_by(|a, b| b.m.depth.cmp(&a.m.depth).then(a.m.id.cmp(&b.m.id)));
+    out.sort_unstable_by(|a, b| b.m.depth.cmp(&a.m.depth).then(a.m.id.cmp(&b.m.id)));
     out
 }
 
@@ -381,7 +384,7 @@ pub fn around(arr: &Arrangement, j: u32) -> i64 {
     ((arr.max_reach + 1.5 * arr.shadow_offset as f64) / side).ceil() as i64
 }
 
-/// The colour of `l` at `q` relative to its cell, for a lookup spanning `footprint` texels: a
+/// The colour of `l` at `q` relative to its row's origin, for a lookup spanning `footprint` texels: a
 /// single umbrella's from its base texture, a merged one's from its vertex colours (its
 /// centre's for a point the coverage put inside but the fan test, by rounding, just outside).
 #[allow(clippy::too_many_arguments)]
