@@ -137,6 +137,22 @@ pub fn merged_colour(m: &Merged, q: [f64; 2]) -> Option<[f32; 3]> {
 /// The convex hull of `points` (monotone chain), counter-clockwise in the y-up sense
 /// (positive `cross`), without collinear points.
 fn hull(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    // Points well inside the quadrilateral of the extreme points in x and y cannot be hull
+    // vertices: left out before sorting (Akl–Toussaint). The margin keeps any point that
+    // rounding could put on the hull.
+    let extreme = |better: fn(&[f64; 2], &[f64; 2]) -> bool| {
+        points.iter().copied().reduce(|a, b| if better(&b, &a) { b } else { a }).unwrap_or([0.0; 2])
+    };
+    let quad = [
+        extreme(|a, b| a[0] < b[0]),
+        extreme(|a, b| a[1] < b[1]),
+        extreme(|a, b| a[0] > b[0]),
+        extreme(|a, b| a[1] > b[1]),
+    ];
+    let span = (quad[2][0] - quad[0][0]).max(quad[3][1] - quad[1][1]);
+    let margin = 1e-9 * span * span;
+    let inside = |p: &[f64; 2]| (0..4).all(|i| cross(quad[i], quad[(i + 1) % 4], *p) > margin);
     // Sorted lexicographically, (x, y), as one integer per point: each coordinate's bits
     // mapped to an unsigned integer of the same order (−0 taken as +0, the same point).
     let key = |v: f64| {
@@ -144,14 +160,14 @@ fn hull(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
         if b >> 63 == 1 { !b } else { b | 1 << 63 }
     };
     let value = |k: u64| f64::from_bits(if k >> 63 == 1 { k & !(1 << 63) } else { !k });
-    let mut keys: Vec<u128> = points.iter().map(|p| (key(p[0]) as u128) << 64 | key(p[1]) as u128).collect();
+    let mut keys: Vec<u128> =
+        points.iter().filter(|p| !inside(p)).map(|p| (key(p[0]) as u128) << 64 | key(p[1]) as u128).collect();
     keys.sort_unstable();
     keys.dedup();
     let points: Vec<[f64; 2]> = keys.iter().map(|&k| [value((k >> 64) as u64), value(k as u64)]).collect();
     if points.len() < 3 {
         return points;
     }
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
     let mut h: Vec<[f64; 2]> = Vec::with_capacity(2 * points.len());
     for pass in 0..2 {
         let start = h.len();
@@ -406,4 +422,55 @@ pub fn colour_at(
         return shape::colour(&el.bases[t.base], rays, &t.colour, hit, footprint * u.inv_scale);
     }
     merged_colour(l.m, [l.origin[0] + q[0] as f64, l.origin[1] + q[1] as f64]).unwrap_or(l.m.centre)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hash::hash;
+
+    /// Monotone chain over every point, sorted by `f64::total_cmp`: what [`hull`] must equal.
+    fn reference(mut points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+        points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+        points.dedup();
+        if points.len() < 3 {
+            return points;
+        }
+        let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+        let mut h: Vec<[f64; 2]> = Vec::new();
+        for pass in 0..2 {
+            let start = h.len();
+            let order: Vec<[f64; 2]> = if pass == 0 { points.clone() } else { points.iter().rev().copied().collect() };
+            for p in order {
+                while h.len() >= start + 2 && cross(h[h.len() - 2], h[h.len() - 1], p) <= 0.0 {
+                    h.pop();
+                }
+                h.push(p);
+            }
+            h.pop();
+        }
+        h
+    }
+
+    #[test]
+    fn the_hull_with_interior_points_left_out_equals_the_hull_of_all_points() {
+        let unit = |n: u64, k: i64| (hash(0x4855, n, k, 0, 0) >> 11) as f64 / (1u64 << 53) as f64;
+        for n in 0..2000u64 {
+            // Rims of a few star-shaped umbrellas far from the origin, on a grid or not, with
+            // repeated and collinear points now and then.
+            let (cx, cy) = (1e5 * (unit(n, 0) - 0.5), -3e4 * unit(n, 1));
+            let count = 1 + (n % 5) as i64;
+            let mut points = Vec::new();
+            for m in 0..count {
+                let (ox, oy) = (cx + 30.0 * unit(n, 10 + m), cy + 30.0 * unit(n, 20 + m));
+                for i in 0..RAYS as i64 {
+                    let a = i as f64 * std::f64::consts::TAU / RAYS as f64;
+                    let r = if n % 7 == 0 { 8.0 } else { 4.0 + 8.0 * unit(n, 100 * m + i) };
+                    let p = [ox + r * a.cos(), oy + r * a.sin()];
+                    points.push(if n % 3 == 0 { [p[0].round(), p[1].round()] } else { p });
+                }
+            }
+            assert_eq!(hull(points.clone()), reference(points), "case {n}");
+        }
+    }
 }
