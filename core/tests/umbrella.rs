@@ -142,6 +142,26 @@ proptest! {
 }
 
 #[test]
+fn narrow_windows_at_the_merged_levels_are_columns_of_a_wide_one() {
+    // Merged levels rasterise a row of cells a stretch at a time; every window must see the
+    // same f32 positions, whatever its left edge. Far from the origin, where an origin that
+    // followed the window would round differently.
+    let ex = gravel();
+    let p = UmbrellaParams::default();
+    for (zoom, far) in [(1u32, 0i64), (2, 0), (1, 1 << 26), (2, (1 << 25) + 3)] {
+        let (x0, y0) = (far - 700, -far / 3);
+        let whole = render(&ex, &p, View::out(zoom, Rect::new(x0, y0, 576, 40)));
+        let mut x = 0;
+        while x < 576 {
+            let w = (13 + x % 29).min(576 - x);
+            let part = render(&ex, &p, View::out(zoom, Rect::new(x0 + x, y0, w, 40)));
+            assert_eq!(part, common::crop(&whole, x as u32, 0, w as u32, 40), "zoom-out {zoom} at {far}: columns {x}..{}", x + w);
+            x += w;
+        }
+    }
+}
+
+#[test]
 fn threads_and_periods() {
     let ex = gravel();
     let p = UmbrellaParams { seed: 5, ..UmbrellaParams::default() };

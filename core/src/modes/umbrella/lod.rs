@@ -347,31 +347,42 @@ pub fn cell(el: &Elements, arr: &Arrangement, sectors: &SectorTable, j: u32, cx:
     merged
 }
 
-/// A merged umbrella relative to the origin of a drawn row of cells, for rasterising and
-/// colouring.
+/// Cells per frame: a merged level's row of cells is rasterised a frame at a time, with
+/// positions relative to the frame's origin (cell `FRAME·n`), so that they are the same f32s
+/// whichever window asks.
+pub const FRAME: i64 = 64;
+
+/// A merged umbrella relative to the origin of a frame of cells, for rasterising and colouring.
 pub struct Local<'a> {
     /// The umbrella.
     pub m: &'a Merged,
-    /// Centre relative to the row's origin.
+    /// Centre relative to the frame's origin.
     pub o: [f32; 2],
     /// Squared reach.
     pub reach2: f32,
-    /// Rim relative to the row's origin.
+    /// Rim relative to the frame's origin.
     pub rim: Poly,
-    /// The row's origin (absolute texels), to take a point back.
+    /// The frame's origin (absolute texels), to take a point back.
     pub origin: [f64; 2],
 }
 
-/// The merged umbrellas that may cover the row of level-`j` cells `cx0..cx1` at `cy` or shade
-/// it, front to back, relative to the origin of cell `(cx0, cy)`: those of the cells around it
-/// whose disc, grown by the shadow offset, meets it. (Merged levels keep every umbrella of a
-/// cell, not the first `k`, so the list of a row is the union of its cells' lists: each
-/// umbrella is rasterised once per row, not once per cell it reaches.)
-pub fn list<'a>(cells: impl Iterator<Item = &'a Vec<Merged>>, arr: &Arrangement, j: u32, (cx0, cx1): (i64, i64), cy: i64) -> Vec<Local<'a>> {
+/// The merged umbrellas that may cover level-`j` cells `cx0..cx1` of row `cy` or shade them,
+/// front to back, relative to the origin of cell `(frame, cy)`: those of the cells around them
+/// whose disc, grown by the shadow offset, meets them. (Merged levels keep every umbrella of a
+/// cell, not the first `k`, so the list of a stretch of cells is the union of its cells'
+/// lists: each umbrella is rasterised once per stretch, not once per cell it reaches.)
+pub fn list<'a>(
+    cells: impl Iterator<Item = &'a Vec<Merged>>,
+    arr: &Arrangement,
+    j: u32,
+    frame: i64,
+    (cx0, cx1): (i64, i64),
+    cy: i64,
+) -> Vec<Local<'a>> {
     let side = (arr.g << j) as f64;
-    let origin = [cx0 as f64 * side, cy as f64 * side];
+    let origin = [frame as f64 * side, cy as f64 * side];
     let grow = 1.5 * arr.shadow_offset as f64;
-    let extent = [0.0, ((cx1 - cx0) as f64 * side) as f32, 0.0, side as f32];
+    let extent = [((cx0 - frame) as f64 * side) as f32, ((cx1 - frame) as f64 * side) as f32, 0.0, side as f32];
     let mut out: Vec<Local> = cells
         .flat_map(|ms| ms.iter())
         .filter_map(|m| {
@@ -400,7 +411,7 @@ pub fn around(arr: &Arrangement, j: u32) -> i64 {
     ((arr.max_reach + 1.5 * arr.shadow_offset as f64) / side).ceil() as i64
 }
 
-/// The colour of `l` at `q` relative to its row's origin, for a lookup spanning `footprint` texels: a
+/// The colour of `l` at `q` relative to its frame's origin, for a lookup spanning `footprint` texels: a
 /// single umbrella's from its base texture, a merged one's from its vertex colours (its
 /// centre's for a point the coverage put inside but the fan test, by rounding, just outside).
 #[allow(clippy::too_many_arguments)]

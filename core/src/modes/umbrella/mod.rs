@@ -417,7 +417,7 @@ pub fn outcome_result(outcome: store::Outcome) -> Result<Arc<Elements>> {
 /// Render a view at level of detail `level` (whose cells are at least two pixels wide): band by
 /// band — one row of cells each — the coverage of every pixel's fixed 4×4 sub-samples
 /// ([`raster`]) by the cells' umbrellas (level 0: each cell's list, cell by cell; merged
-/// levels: the merged umbrellas around the whole row, [`lod::list`]), then per pixel the colour of each umbrella (or the
+/// levels: the merged umbrellas around the row, a frame of cells at a time, [`lod::list`]), then per pixel the colour of each umbrella (or the
 /// background) its sub-samples see, evaluated once at their centroid and weighted by their
 /// number, darkened by their shadows: multisample anti-aliasing, with one colour evaluation
 /// for a pixel inside one umbrella.
@@ -485,17 +485,27 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
                     placed.extend(list.iter());
                 }
             } else {
-                // The whole row of cells at once, with the merged cells within `reach` of it.
-                let near = (cy - reach..=cy + reach)
-                    .flat_map(|y| (cx0 - reach..cx1 + reach).map(move |x| (x, y)))
-                    .map(|(x, y)| &*merged[(y - my0) as usize * mw + (x - mx0) as usize].2);
-                locals = lod::list(near, arr, level, (cx0, cx1), cy);
-                let shape = |n: usize, o: f32, extent: [f32; 4]| {
-                    let l = &locals[n];
-                    raster::disc_reaches(l.o[0] + o, l.o[1] + o, l.reach2, extent).then(|| l.rim.shifted(o))
-                };
-                let cols = ((rect.x0 - cx0 * ppc) * a, (rect.x1 - cx0 * ppc) * a);
-                cov.cell(locals.len(), shape, 0, sp, rows, cols, (0, 0), shadows);
+                // The row in stretches, one per frame of `lod::FRAME` cells it meets, each
+                // rasterised with one list: positions relative to the frame's origin, the same
+                // whichever window asks.
+                let mut fx = cx0;
+                while fx < cx1 {
+                    let frame = fx.div_euclid(lod::FRAME) * lod::FRAME;
+                    let end = cx1.min(frame + lod::FRAME);
+                    let near = (cy - reach..=cy + reach)
+                        .flat_map(|y| (fx - reach..end + reach).map(move |x| (x, y)))
+                        .map(|(x, y)| &*merged[(y - my0) as usize * mw + (x - mx0) as usize].2);
+                    let list = lod::list(near, arr, level, frame, (fx, end), cy);
+                    let shape = |n: usize, o: f32, extent: [f32; 4]| {
+                        let l = &list[n];
+                        raster::disc_reaches(l.o[0] + o, l.o[1] + o, l.reach2, extent).then(|| l.rim.shifted(o))
+                    };
+                    let (i0, i1) = (rect.x0.max(fx * ppc), rect.x1.min(end * ppc));
+                    let cols = ((i0 - frame * ppc) * a, (i1 - frame * ppc) * a);
+                    cov.cell(list.len(), shape, locals.len() as u32, sp, rows, cols, (0, (i0 - rect.x0) * a), shadows);
+                    locals.extend(list);
+                    fx = end;
+                }
             }
             let mut out = vec![0u8; 3 * w * rows_px];
             for (j, row) in out.chunks_exact_mut(3 * w).enumerate() {
@@ -503,8 +513,10 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
                 let oy = (y.rem_euclid(ppc) * step) as f32;
                 let bg_row = &bg.pixels[3 * (y - rect.y0) as usize * w..][..3 * w];
                 for i in 0..w {
-                    // Relative to the cell (level 0) or to the row of cells (merged levels).
-                    let ox = if level > 0 { (rect.x0 + i as i64 - cx0 * ppc) * step } else { (rect.x0 + i as i64).rem_euclid(ppc) * step } as f32;
+                    // Relative to the cell (level 0) or to its frame of cells (merged levels).
+                    let x = rect.x0 + i as i64;
+                    let ox = if level > 0 { x - x.div_euclid(ppc).div_euclid(lod::FRAME) * lod::FRAME * ppc } else { x.rem_euclid(ppc) } * step;
+                    let ox = ox as f32;
                     let b = &bg_row[3 * i..3 * i + 3];
                     // What a group of sub-samples sees, at `(qx, qy)` in the cell.
                     let eval = |key: u64, qx: f32, qy: f32| -> [f32; 3] {
