@@ -155,7 +155,12 @@ fn narrow_windows_at_the_merged_levels_are_columns_of_a_wide_one() {
         while x < 576 {
             let w = (13 + x % 29).min(576 - x);
             let part = render(&ex, &p, View::out(zoom, Rect::new(x0 + x, y0, w, 40)));
-            assert_eq!(part, common::crop(&whole, x as u32, 0, w as u32, 40), "zoom-out {zoom} at {far}: columns {x}..{}", x + w);
+            assert_eq!(
+                part,
+                common::crop(&whole, x as u32, 0, w as u32, 40),
+                "zoom-out {zoom} at {far}: columns {x}..{}",
+                x + w
+            );
             x += w;
         }
     }

@@ -272,12 +272,11 @@ impl Mode for Umbrella {
         // Level 0 (every umbrella) while a cell is at least `lod::LOD_PIXELS` wide, then the
         // merged levels of detail, then the background's own zoomed-out pixels.
         let level = lod::level(&arr, view.zoom_out);
-        let background = background(p, src, cache, view)?;
         let Some(level) = level else {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
             let shift = colour_shift(&elements, &arr, p, src, cache, umbrella_zooms(&arr))?;
-            let mut image = background;
+            let mut image = background(p, src, cache, view)?;
             // Per channel, every shifted value once (a table, not a rounding per pixel).
             let table: [[u8; 256]; 3] = std::array::from_fn(|c| {
                 std::array::from_fn(|v| (v as f32 + shift[c]).round().clamp(0.0, 255.0) as u8)
@@ -287,7 +286,7 @@ impl Mode for Umbrella {
             }
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
         };
-        let image = paint(&elements, &arr, p, view, &background, level);
+        let (image, _) = paint(&elements, &arr, p, view, level, || background(p, src, cache, view))?;
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
     }
 }
@@ -310,8 +309,7 @@ fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Sour
     }
     let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
     let level = lod::level(arr, zooms).unwrap_or(0);
-    let bg = background(p, src, cache, view)?;
-    let umb = paint(el, arr, p, view, &bg, level);
+    let (umb, bg) = paint(el, arr, p, view, level, || background(p, src, cache, view))?;
     let mut shift = [0f32; 3];
     for (i, (a, b)) in umb.pixels.iter().zip(&bg.pixels).enumerate() {
         shift[i % 3] += *a as f32 - *b as f32;
@@ -421,7 +419,14 @@ pub fn outcome_result(outcome: store::Outcome) -> Result<Arc<Elements>> {
 /// background) its sub-samples see, evaluated once at their centroid and weighted by their
 /// number, darkened by their shadows: multisample anti-aliasing, with one colour evaluation
 /// for a pixel inside one umbrella.
-fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &RgbWindow, level: u32) -> RgbWindow {
+fn paint(
+    el: &Elements,
+    arr: &Arrangement,
+    p: &UmbrellaParams,
+    view: View,
+    level: u32,
+    background: impl FnOnce() -> Result<RgbWindow> + Send,
+) -> Result<(RgbWindow, RgbWindow)> {
     let rect = view.rect;
     let step = 1i64 << view.zoom_out.min(40);
     let side = arr.g << level;
@@ -441,24 +446,28 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
     let (cx0, cx1) = (rect.x0.div_euclid(ppc), (rect.x1 - 1).div_euclid(ppc) + 1);
     let (cy0, cy1) = (rect.y0.div_euclid(ppc), (rect.y1 - 1).div_euclid(ppc) + 1);
     let row_cells = (cx1 - cx0) as usize;
-    // Level 0: the lists of all cells at once (spawn cells placed once), unless a huge window
-    // has more than is worth holding: then a row of cells at a time.
-    let all = (level == 0 && (cx1 - cx0) as u64 * (cy1 - cy0) as u64 <= 1 << 16).then(|| arr.lists(cx0, cy0, cx1, cy1));
-    // Merged levels: the merged cells around the view, computed in parallel.
+    // The background, and meanwhile the cells: level 0, the lists of all cells at once (spawn
+    // cells placed once), unless a huge window has more than is worth holding (then a row of
+    // cells at a time); merged levels, the merged cells around the view, in parallel.
     let reach = if level > 0 { lod::around(arr, level) } else { 0 };
     let (mx0, my0, mw) = (cx0 - reach, cy0 - reach, (cx1 - cx0 + 2 * reach) as usize);
-    let merged: Vec<(i64, i64, Arc<Vec<lod::Merged>>)> = if level > 0 {
-        let mh = (cy1 - cy0 + 2 * reach) as usize;
-        (0..mw * mh)
-            .into_par_iter()
-            .map(|n| {
-                let (x, y) = (mx0 + (n % mw) as i64, my0 + (n / mw) as i64);
-                (x, y, lod::cell(el, arr, &sectors, level, x, y))
-            })
-            .collect()
-    } else {
-        Vec::new()
-    };
+    let (bg, (all, merged)) = rayon::join(background, || {
+        let all = (level == 0 && (cx1 - cx0) as u64 * (cy1 - cy0) as u64 <= 1 << 16).then(|| arr.lists(cx0, cy0, cx1, cy1));
+        let merged: Vec<(i64, i64, Arc<Vec<lod::Merged>>)> = if level > 0 {
+            let mh = (cy1 - cy0 + 2 * reach) as usize;
+            (0..mw * mh)
+                .into_par_iter()
+                .map(|n| {
+                    let (x, y) = (mx0 + (n % mw) as i64, my0 + (n / mw) as i64);
+                    (x, y, lod::cell(el, arr, &sectors, level, x, y))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        (all, merged)
+    });
+    let bg = bg?;
     let bands: Vec<Vec<u8>> = (cy0..cy1)
         .into_par_iter()
         .map(|cy| {
@@ -582,7 +591,7 @@ fn paint(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, view: View, bg: &
             out
         })
         .collect();
-    RgbWindow { width: w as u32, height: rect.height() as u32, pixels: bands.concat() }
+    Ok((RgbWindow { width: w as u32, height: rect.height() as u32, pixels: bands.concat() }, bg))
 }
 
 /// Words of storage of the paper's Table 1, `J = b·w·h + 2·b·v + n·(1 + 3v) + k·W·H`, for a
