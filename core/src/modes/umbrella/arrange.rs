@@ -328,6 +328,36 @@ impl Arrangement {
         self.lists(cx, cy, cx + 1, cy + 1).pop().unwrap_or_default()
     }
 
+    /// The union of the lists of cells `(cx, list)` of one row (consecutive, at most 64, from
+    /// frame `frame` on), front to back, each umbrella with the mask of the cells that list it
+    /// (bit `cx − first cx`) and its position moved from its cell's origin to the frame's.
+    /// Lists stop at their `k`-th covering umbrella, so an umbrella may be in one cell's list
+    /// and not its neighbour's: filling the union masked so is filling each list in its cell.
+    pub fn union<'a>(&self, cells: impl Iterator<Item = (i64, &'a [Placed])>, frame: i64) -> Vec<(Placed, u64)> {
+        let mut items: Vec<(&Placed, i64)> = Vec::new();
+        let mut first = None;
+        for (cx, list) in cells {
+            first.get_or_insert(cx);
+            items.extend(list.iter().map(|u| (u, cx)));
+        }
+        items.sort_unstable_by(|(a, ca), (b, cb)| b.depth.cmp(&a.depth).then(a.id.cmp(&b.id)).then(ca.cmp(cb)));
+        let first = first.unwrap_or(0);
+        let mut union: Vec<(Placed, u64)> = Vec::new();
+        for (u, cx) in items {
+            let bit = 1u64 << (cx - first).clamp(0, 63);
+            match union.last_mut() {
+                Some((v, mask)) if v.id == u.id => *mask |= bit,
+                _ => {
+                    // Exact: multiples of 1/256 texel well within f32's precision.
+                    let mut v = *u;
+                    v.cx += ((cx - frame) * self.g) as f32;
+                    union.push((v, bit));
+                }
+            }
+        }
+        union
+    }
+
     /// The lists of cells `cx0..cx1 × cy0..cy1`, row by row: from the LRU where it has them,
     /// the others computed in bands of rows, in parallel — each band places the spawn cells
     /// around it once and bins their umbrellas into the cells they meet.

@@ -476,45 +476,46 @@ fn paint(
             let mut cov = raster::Coverage::new(w * AA, rows_px * AA);
             let rows = ((j0 - cy * ppc) * a, (j1 - cy * ppc) * a);
             let own;
-            let mut placed: Vec<&Placed> = Vec::new();
+            let mut placed: Vec<Placed> = Vec::new();
             let mut locals: Vec<lod::Local> = Vec::new();
-            if level == 0 {
-                let lists: &[Arc<Vec<Placed>>] = match &all {
-                    Some(v) => &v[(cy - cy0) as usize * row_cells..][..row_cells],
-                    None => {
-                        own = arr.lists(cx0, cy, cx1, cy + 1);
-                        &own
-                    }
-                };
-                for (list, cx) in lists.iter().zip(cx0..cx1) {
-                    let (i0, i1) = (rect.x0.max(cx * ppc), rect.x1.min((cx + 1) * ppc));
-                    let cols = ((i0 - cx * ppc) * a, (i1 - cx * ppc) * a);
-                    let shape = raster::placed_shape(arr, list);
-                    cov.cell(list.len(), shape, placed.len() as u32, sp, rows, cols, (0, (i0 - rect.x0) * a), shadows);
-                    placed.extend(list.iter());
+            let lists: &[Arc<Vec<Placed>>] = match (&all, level) {
+                (_, 1..) => &[],
+                (Some(v), _) => &v[(cy - cy0) as usize * row_cells..][..row_cells],
+                (None, _) => {
+                    own = arr.lists(cx0, cy, cx1, cy + 1);
+                    &own
                 }
-            } else {
-                // The row in stretches, one per frame of `lod::FRAME` cells it meets, each
-                // rasterised with one list: positions relative to the frame's origin, the same
-                // whichever window asks.
-                let mut fx = cx0;
-                while fx < cx1 {
-                    let frame = fx.div_euclid(lod::FRAME) * lod::FRAME;
-                    let end = cx1.min(frame + lod::FRAME);
+            };
+            // The row in stretches, one per frame of `lod::FRAME` cells it meets, each
+            // rasterised with one list, in positions relative to the frame's origin (the same
+            // whichever window asks): each umbrella filled once, not once per cell it reaches.
+            let mut fx = cx0;
+            while fx < cx1 {
+                let frame = fx.div_euclid(lod::FRAME) * lod::FRAME;
+                let end = cx1.min(frame + lod::FRAME);
+                let (i0, i1) = (rect.x0.max(fx * ppc), rect.x1.min(end * ppc));
+                let cols = ((i0 - frame * ppc) * a, (i1 - frame * ppc) * a);
+                let band = (0, (i0 - rect.x0) * a);
+                if level == 0 {
+                    // The union of the cells' lists, each umbrella masked to the cells that list it.
+                    let union = arr.union((fx..end).map(|cx| (cx, &lists[(cx - cx0) as usize][..])), frame);
+                    let cells = raster::Cells { base: (fx - frame) * ppc * a, width: ppc * a };
+                    let shape = raster::placed_shape(arr, &union);
+                    cov.fill_list(union.len(), shape, cells, placed.len() as u32, sp, rows, cols, band, shadows);
+                    placed.extend(union.iter().map(|(u, _)| *u));
+                } else {
                     let near = (cy - reach..=cy + reach)
                         .flat_map(|y| (fx - reach..end + reach).map(move |x| (x, y)))
                         .map(|(x, y)| &*merged[(y - my0) as usize * mw + (x - mx0) as usize].2);
                     let list = lod::list(near, arr, level, frame, (fx, end), cy);
                     let shape = |n: usize, o: f32, extent: [f32; 4]| {
                         let l = &list[n];
-                        raster::disc_reaches(l.o[0] + o, l.o[1] + o, l.reach2, extent).then(|| l.rim.shifted(o))
+                        raster::disc_reaches(l.o[0] + o, l.o[1] + o, l.reach2, extent).then(|| (l.rim.shifted(o), u64::MAX))
                     };
-                    let (i0, i1) = (rect.x0.max(fx * ppc), rect.x1.min(end * ppc));
-                    let cols = ((i0 - frame * ppc) * a, (i1 - frame * ppc) * a);
-                    cov.cell(list.len(), shape, locals.len() as u32, sp, rows, cols, (0, (i0 - rect.x0) * a), shadows);
+                    cov.fill_list(list.len(), shape, raster::Cells::ALL, locals.len() as u32, sp, rows, cols, band, shadows);
                     locals.extend(list);
-                    fx = end;
                 }
+                fx = end;
             }
             let mut out = vec![0u8; 3 * w * rows_px];
             for (j, row) in out.chunks_exact_mut(3 * w).enumerate() {
@@ -522,10 +523,9 @@ fn paint(
                 let oy = (y.rem_euclid(ppc) * step) as f32;
                 let bg_row = &bg.pixels[3 * (y - rect.y0) as usize * w..][..3 * w];
                 for i in 0..w {
-                    // Relative to the cell (level 0) or to its frame of cells (merged levels).
+                    // Relative to the origin of the pixel's frame of cells.
                     let x = rect.x0 + i as i64;
-                    let ox = if level > 0 { x - x.div_euclid(ppc).div_euclid(lod::FRAME) * lod::FRAME * ppc } else { x.rem_euclid(ppc) } * step;
-                    let ox = ox as f32;
+                    let ox = ((x - x.div_euclid(ppc).div_euclid(lod::FRAME) * lod::FRAME * ppc) * step) as f32;
                     let b = &bg_row[3 * i..3 * i + 3];
                     // What a group of sub-samples sees, at `(qx, qy)` in the cell.
                     let eval = |key: u64, qx: f32, qy: f32| -> [f32; 3] {
@@ -537,7 +537,7 @@ fn paint(
                             let c = lod::colour_at(&locals[id as usize], [qx, qy], el, arr, &sectors, &rays, step as f32);
                             return c.map(|v| v * f * 255.0);
                         }
-                        let u = placed[id as usize];
+                        let u = &placed[id as usize];
                         let m = &arr.table[u.modified as usize];
                         let (dx, dy) = (qx - u.cx, qy - u.cy);
                         let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
@@ -611,6 +611,45 @@ mod tests {
     use crate::exemplar::ExemplarOptions;
 
     #[test]
+    fn a_row_filled_with_the_union_of_its_lists_is_each_list_filled_in_its_cell() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png");
+        let ex = Exemplar::from_bytes(&std::fs::read(path).unwrap(), &ExemplarOptions::default()).unwrap();
+        let (el, id) = elements(&ex).unwrap();
+        let p = UmbrellaParams { shadow_offset: 3, k: 3, ..UmbrellaParams::default() };
+        let arr = Arrangement::new(&el, &p, &id);
+        let (sp, n, cy, cells) = (0.25f32, arr.g * 4, -2i64, 61..69i64);
+        let width = (n * (cells.end - cells.start)) as usize;
+        let lists: Vec<Arc<Vec<Placed>>> = cells.clone().map(|cx| arr.list(cx, cy)).collect();
+        // Each list in its cell, in the cell's coordinates.
+        let mut each = raster::Coverage::new(width, n as usize);
+        let mut ids = Vec::new();
+        for (i, list) in lists.iter().enumerate() {
+            let listed: Vec<(Placed, u64)> = list.iter().map(|u| (*u, u64::MAX)).collect();
+            let shape = raster::placed_shape(&arr, &listed);
+            let band = (0, i as i64 * n);
+            each.fill_list(list.len(), shape, raster::Cells::ALL, ids.len() as u32, sp, (0, n), (0, n), band, Some(3.0));
+            ids.extend(list.iter().map(|u| u.id));
+        }
+        // The union, in the frame's coordinates (cells 0..64), masked.
+        let union = arr.union(cells.clone().zip(&lists).map(|(cx, l)| (cx, &l[..])), 0);
+        assert!(union.iter().any(|(_, m)| m.count_ones() > 1), "umbrellas listed in several cells");
+        let mut once = raster::Coverage::new(width, n as usize);
+        let mask = raster::Cells { base: cells.start * n, width: n };
+        let cols = (cells.start * n, cells.end * n);
+        once.fill_list(union.len(), raster::placed_shape(&arr, &union), mask, 0, sp, (0, n), cols, (0, 0), Some(3.0));
+        let who = |hit: u32, ids: &dyn Fn(usize) -> (i64, i64, u32)| (hit != raster::NONE).then(|| ids(hit as usize));
+        let (mut differ, mut hits) = (0, 0);
+        for k in 0..each.hit.len() {
+            let a = (who(each.hit[k], &|i| ids[i]), each.shade[k]);
+            let b = (who(once.hit[k], &|i| union[i].0.id), once.shade[k]);
+            differ += (a != b) as usize;
+            hits += a.0.is_some() as usize;
+        }
+        eprintln!("{hits} of {} samples hit, {differ} differ (rounding at rims)", each.hit.len());
+        assert!(hits * 2 > each.hit.len() && differ * 1000 <= each.hit.len(), "{differ} samples differ");
+    }
+
+    #[test]
     fn coverage_sees_the_first_umbrella_and_shadows_come_only_from_those_in_front_of_it() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png");
         let ex = Exemplar::from_bytes(&std::fs::read(path).unwrap(), &ExemplarOptions::default()).unwrap();
@@ -637,7 +676,8 @@ mod tests {
             for cx in -2..3 {
                 let list = arr.list(cx, cy);
                 let mut cov = raster::Coverage::new(n as usize, n as usize);
-                cov.cell(list.len(), raster::placed_shape(&arr, &list), 0, sp, (0, n), (0, n), (0, 0), Some(4.0));
+                let listed: Vec<(Placed, u64)> = list.iter().map(|u| (*u, u64::MAX)).collect();
+                cov.fill_list(list.len(), raster::placed_shape(&arr, &listed), raster::Cells::ALL, 0, sp, (0, n), (0, n), (0, 0), Some(4.0));
                 for r in 0..n {
                     for c in 0..n {
                         let (qx, qy) = ((c as f32 + 0.5) * sp, (r as f32 + 0.5) * sp);

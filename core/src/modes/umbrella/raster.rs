@@ -1,14 +1,16 @@
 //! Coverage of a band of sub-samples by scanline fill: which umbrella each sub-sample sees and
-//! how many umbrellas in front of that one shade it. Every umbrella of a cell's list (front to
-//! back) fills its star polygon into the samples of that cell not yet taken, then counts a
-//! shadow on the samples its polygon moved by `+ℓ` covers that are still free — the same rule as
-//! walking the list per point (the first umbrella containing the point is hit; those before it
-//! containing the point moved by `−ℓ` shade it), at the cost of a few edge crossings per sample
-//! row instead of a point-in-polygon test per umbrella and sample.
+//! how many umbrellas in front of that one shade it. Every umbrella of a list (front to back)
+//! fills its star polygon into the samples not yet taken of the cells that list it, then counts
+//! a shadow on the samples its polygon moved by `+ℓ` covers that are still free — the same rule
+//! as walking each cell's list per point (the first umbrella containing the point is hit; those
+//! before it containing the point moved by `−ℓ` shade it), at the cost of a few edge crossings
+//! per sample row instead of a point-in-polygon test per umbrella and sample. A row of cells
+//! is filled with the union of its cells' lists, each umbrella masked to the cells that list it
+//! ([`Cells`]), so an umbrella that reaches several cells is filled once.
 //!
-//! Positions are relative to the cell, sample centres at `(r + ½)·sp` for a sample spacing
-//! `sp` that is a power of two, so a sample's coverage depends on its absolute position only:
-//! windows are the same samples cut from larger ones.
+//! Positions are relative to the origin of a fixed frame of cells, sample centres at
+//! `(r + ½)·sp` for a sample spacing `sp` that is a power of two, so a sample's coverage depends
+//! on its absolute position only: windows are the same samples cut from larger ones.
 
 use std::cell::{Cell, RefCell};
 
@@ -141,18 +143,20 @@ impl Coverage {
         Coverage { width, hit: vec![NONE; width * rows], shade: vec![0; width * rows] }
     }
 
-    /// Fill one cell's list of `count` shapes, front to back, into the band: the cell's samples
-    /// are rows `rows` and columns `cols` relative to the cell, which start at band row `row0`
+    /// Fill a list of `count` shapes, front to back, into the band: the samples are rows
+    /// `rows` and columns `cols` relative to the list's origin, which start at band row `row0`
     /// and band column `col0`; shape `n` is recorded as `first + n`. `shape(n, o, extent)` is
-    /// the polygon of shape `n` moved by `(o, o)` in the cell's coordinates, or `None` when its
-    /// disc does not reach `extent` (the cell's samples: `x0, x1, y0, y1`). `shadow`: the offset
-    /// ℓ at which shapes shade what is behind them, if they do.
-    /// Rows whose samples are all taken are passed over, and the list is left once all are.
+    /// the polygon of shape `n` moved by `(o, o)` in those coordinates with the mask of
+    /// `cells` it may take samples in, or `None` when its disc does not reach `extent` (the
+    /// samples: `x0, x1, y0, y1`). `shadow`: the offset ℓ at which shapes shade what is behind
+    /// them, if they do. Rows whose samples are all taken are passed over, and the list is left
+    /// once all are.
     #[allow(clippy::too_many_arguments)]
-    pub fn cell(
+    pub fn fill_list(
         &mut self,
         count: usize,
-        shape: impl Fn(usize, f32, [f32; 4]) -> Option<Poly>,
+        shape: impl Fn(usize, f32, [f32; 4]) -> Option<(Poly, u64)>,
+        cells: Cells,
         first: u32,
         sp: f32,
         rows: (i64, i64),
@@ -174,31 +178,70 @@ impl Coverage {
             }
             let id = first + n as u32;
             // (A shape listed only for its shadow takes no sample here.)
-            if let Some(p) = shape(n, 0.0, extent) {
+            if let Some((p, mask)) = shape(n, 0.0, extent) {
                 fill(p.vertices(), sp, rows, cols, full, |r, c0, c1| {
-                    let k = at(r, c0);
-                    let mut taken = 0;
-                    // Branch-free (vectorised): free samples take `id`.
-                    for h in &mut hit[k..k + (c1 - c0) as usize] {
-                        let free = (*h == NONE) as u32;
-                        taken += free;
-                        let mask = free.wrapping_neg();
-                        *h = (*h & !mask) | (id & mask);
-                    }
-                    let f = &free[(r - rows.0) as usize];
-                    f.set(f.get() - taken);
-                    left -= taken as u64;
+                    cells.clip(mask, c0, c1, |c0, c1| {
+                        let k = at(r, c0);
+                        let mut taken = 0;
+                        // Branch-free (vectorised): free samples take `id`.
+                        for h in &mut hit[k..k + (c1 - c0) as usize] {
+                            let free = (*h == NONE) as u32;
+                            taken += free;
+                            let mask = free.wrapping_neg();
+                            *h = (*h & !mask) | (id & mask);
+                        }
+                        let f = &free[(r - rows.0) as usize];
+                        f.set(f.get() - taken);
+                        left -= taken as u64;
+                    });
                 });
             }
-            if let Some(p) = shadow.and_then(|l| shape(n, l, extent)) {
+            if let Some((p, mask)) = shadow.and_then(|l| shape(n, l, extent)) {
                 fill(p.vertices(), sp, rows, cols, full, |r, c0, c1| {
-                    let k = at(r, c0);
-                    let n = (c1 - c0) as usize;
-                    for (h, s) in hit[k..k + n].iter().zip(&mut shade[k..k + n]) {
-                        *s = s.saturating_add((*h == NONE) as u8);
-                    }
+                    cells.clip(mask, c0, c1, |c0, c1| {
+                        let k = at(r, c0);
+                        let n = (c1 - c0) as usize;
+                        for (h, s) in hit[k..k + n].iter().zip(&mut shade[k..k + n]) {
+                            *s = s.saturating_add((*h == NONE) as u8);
+                        }
+                    });
                 });
             }
+        }
+    }
+}
+
+/// The cells of a list's row that its shapes may take samples in, by a mask per shape: bit
+/// `i` stands for sample columns `base + i·width .. base + (i + 1)·width`; all bits set, for
+/// every column.
+#[derive(Debug, Clone, Copy)]
+pub struct Cells {
+    /// First column of the cell of bit 0.
+    pub base: i64,
+    /// Sample columns per cell.
+    pub width: i64,
+}
+
+impl Cells {
+    /// Every column to every shape (masks of all bits set).
+    pub const ALL: Cells = Cells { base: 0, width: 1 };
+
+    /// Calls `f(s0, s1)` for the parts of columns `c0..c1` in the cells of `mask`, in order.
+    #[inline]
+    fn clip(&self, mask: u64, c0: i64, c1: i64, mut f: impl FnMut(i64, i64)) {
+        if mask == u64::MAX {
+            return f(c0, c1);
+        }
+        let mut m = mask;
+        while m != 0 {
+            // A run of set bits: cells `b0..b1`.
+            let b0 = m.trailing_zeros();
+            let b1 = b0 + (!(m >> b0)).trailing_zeros().min(64 - b0);
+            let (s0, s1) = (c0.max(self.base + b0 as i64 * self.width), c1.min(self.base + b1 as i64 * self.width));
+            if s0 < s1 {
+                f(s0, s1);
+            }
+            m = if b1 >= 64 { 0 } else { m & (u64::MAX << b1) };
         }
     }
 }
@@ -234,11 +277,12 @@ pub fn disc_reaches(cx: f32, cy: f32, r2: f32, extent: [f32; 4]) -> bool {
     dx * dx + dy * dy <= r2 * 1.001 + 1e-3
 }
 
-/// The shapes of a level-0 cell list for [`Coverage::cell`]: each umbrella's rim.
-pub fn placed_shape<'a>(arr: &'a Arrangement, list: &'a [Placed]) -> impl Fn(usize, f32, [f32; 4]) -> Option<Poly> + 'a {
+/// The shapes of a level-0 list for [`Coverage::fill_list`]: each umbrella's rim, with the mask
+/// of the cells it is listed in.
+pub fn placed_shape<'a>(arr: &'a Arrangement, list: &'a [(Placed, u64)]) -> impl Fn(usize, f32, [f32; 4]) -> Option<(Poly, u64)> + 'a {
     move |n, o, extent| {
-        let u = &list[n];
-        disc_reaches(u.cx + o, u.cy + o, u.reach2, extent).then(|| Poly::new(polygon(arr, u, o, o), RAYS))
+        let (u, mask) = &list[n];
+        disc_reaches(u.cx + o, u.cy + o, u.reach2, extent).then(|| (Poly::new(polygon(arr, u, o, o), RAYS), *mask))
     }
 }
 
