@@ -160,8 +160,8 @@ fn hull(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
         if b >> 63 == 1 { !b } else { b | 1 << 63 }
     };
     let value = |k: u64| f64::from_bits(if k >> 63 == 1 { k & !(1 << 63) } else { !k });
-    let mut keys: Vec<u128> =
-        points.iter().filter(|p| !inside(p)).map(|p| (key(p[0]) as u128) << 64 | key(p[1]) as u128).collect();
+    let mut keys: Vec<u128> = Vec::with_capacity(points.len());
+    keys.extend(points.iter().filter(|p| !inside(p)).map(|p| (key(p[0]) as u128) << 64 | key(p[1]) as u128));
     keys.sort_unstable();
     keys.dedup();
     let points: Vec<[f64; 2]> = keys.iter().map(|&k| [value((k >> 64) as u64), value(k as u64)]).collect();
@@ -206,7 +206,8 @@ fn simplify(mut rim: Vec<[f64; 2]>, n: usize) -> Vec<[f64; 2]> {
 
 /// Cluster `members` (sorted front to back) into at most `k` groups by k-means on their
 /// centres: the first centre the front-most member's, then each the member farthest from
-/// those chosen; fixed iterations; ties to the lower index.
+/// those chosen; at most [`KMEANS_ITERATIONS`] iterations, stopping once an assignment repeats
+/// (every further one would repeat it too); ties to the lower index.
 fn kmeans(members: &[Member], k: usize) -> Vec<Vec<usize>> {
     let pts: Vec<[f64; 2]> = members.iter().map(Member::centre).collect();
     let d2 = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
@@ -222,8 +223,10 @@ fn kmeans(members: &[Member], k: usize) -> Vec<Vec<usize>> {
             *n = n.min(d2(p, c));
         }
     }
-    let mut assign = vec![0usize; pts.len()];
+    let mut assign = vec![usize::MAX; pts.len()];
+    let mut sums = vec![([0f64; 2], 0f64); k];
     for _ in 0..KMEANS_ITERATIONS {
+        let mut changed = false;
         for (a, &p) in assign.iter_mut().zip(&pts) {
             let mut best = (d2(p, centres[0]), 0);
             for (c, &centre) in centres.iter().enumerate().skip(1) {
@@ -232,10 +235,15 @@ fn kmeans(members: &[Member], k: usize) -> Vec<Vec<usize>> {
                     best = (d, c);
                 }
             }
+            changed |= *a != best.1;
             *a = best.1;
         }
+        // The same assignment twice: the same means, so every further iteration repeats it.
+        if !changed {
+            break;
+        }
         // Means, each summed in point order.
-        let mut sums = vec![([0f64; 2], 0f64); k];
+        sums.fill(([0f64; 2], 0f64));
         for (&a, p) in assign.iter().zip(&pts) {
             let (s, n) = &mut sums[a];
             *s = [s[0] + p[0], s[1] + p[1]];
@@ -269,7 +277,7 @@ fn merge(members: &[&Member], palette: &Palette, background: [f32; 3]) -> Option
     }
     let n = members.len() as f64;
     let mut o = [0f64; 2];
-    let mut points = Vec::new();
+    let mut points = Vec::with_capacity(members.len() * RAYS);
     for m in members {
         let c = m.centre();
         o = [o[0] + c[0] / n, o[1] + c[1] / n];
