@@ -106,8 +106,8 @@ pub struct Arrangement {
     key: u64,
     /// Spawn cells to look at around a cell.
     spawn_reach: i64,
-    /// The rays' directions and diamond angles.
-    rays: [[f32; 2]; RAYS],
+    /// The rays' directions ([`ray`], computed once).
+    pub rays: [[f32; 2]; RAYS],
     angles: [f32; RAYS],
 }
 

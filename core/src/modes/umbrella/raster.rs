@@ -15,7 +15,7 @@
 use std::cell::{Cell, RefCell};
 
 use super::arrange::{Arrangement, Placed};
-use super::extract::{ray, RAYS};
+use super::extract::RAYS;
 
 /// No umbrella: the background shows.
 pub const NONE: u32 = u32::MAX;
@@ -26,7 +26,7 @@ pub fn polygon(arr: &Arrangement, u: &Placed, ox: f32, oy: f32) -> [[f32; 2]; RA
     let s = 1.0 / u.inv_scale;
     let (c, sn) = (u.cos * s, u.sin * s);
     std::array::from_fn(|i| {
-        let d = ray(i);
+        let d = arr.rays[i];
         let (lx, ly) = (d[0] * m.radii[i], d[1] * m.radii[i]);
         [u.cx + ox + c * lx - sn * ly, u.cy + oy + sn * lx + c * ly]
     })
