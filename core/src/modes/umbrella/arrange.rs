@@ -263,10 +263,20 @@ impl Arrangement {
         self.meets_with(u, x, y, x0, y0, g, &OnceCell::new())
     }
 
-    /// [`Arrangement::meets`], with `u`'s rim computed at most once over the calls that share
-    /// `rim`.
+    /// The rim of `u` centred at `(x, y)` ([`Arrangement::rim`]) and its bounding box
+    /// (`x0, x1, y0, y1`).
+    fn rim_and_box(&self, u: &Placed, x: f64, y: f64) -> Outline {
+        let rim = self.rim(u, x, y);
+        let b = rim.iter().fold([f64::MAX, f64::MIN, f64::MAX, f64::MIN], |b, &(px, py)| {
+            [b[0].min(px), b[1].max(px), b[2].min(py), b[3].max(py)]
+        });
+        (rim, b)
+    }
+
+    /// [`Arrangement::meets`], with `u`'s rim and its box computed at most once over the calls
+    /// that share `rim`.
     #[allow(clippy::too_many_arguments)]
-    fn meets_with(&self, u: &Placed, x: f64, y: f64, x0: f64, y0: f64, g: f64, rim: &OnceCell<[(f64, f64); RAYS]>) -> bool {
+    fn meets_with(&self, u: &Placed, x: f64, y: f64, x0: f64, y0: f64, g: f64, rim: &OnceCell<Outline>) -> bool {
         // The discs first: the square's nearest point to the centre beyond the reach (with a
         // margin for rounding) → apart; within the inner disc, which the rim encloses → met.
         let (dx, dy) = (x - x.clamp(x0, x0 + g), y - y.clamp(y0, y0 + g));
@@ -278,7 +288,12 @@ impl Arrangement {
         if d2 < u.inner2 as f64 {
             return true;
         }
-        let rim = rim.get_or_init(|| self.rim(u, x, y));
+        let (rim, b) = rim.get_or_init(|| self.rim_and_box(u, x, y));
+        // The rim's box apart from the square: so are the centre, every vertex and edge, and
+        // the square's centre (outside the rim by half a cell at least).
+        if b[1] < x0 || b[0] > x0 + g || b[3] < y0 || b[2] > y0 + g {
+            return false;
+        }
         let inside_sq = |(px, py): (f64, f64)| px >= x0 && px <= x0 + g && py >= y0 && py <= y0 + g;
         if inside_sq((x, y)) || rim.iter().any(|&v| inside_sq(v)) {
             return true;
@@ -459,6 +474,9 @@ impl Arrangement {
 }
 
 type ListKey = (u64, i64, i64);
+
+/// An umbrella's rim in absolute texels and its bounding box (`x0, x1, y0, y1`).
+type Outline = ([(f64, f64); RAYS], [f64; 4]);
 
 fn lists() -> &'static Mutex<LruCache<ListKey, Arc<Vec<Placed>>>> {
     static L: OnceLock<Mutex<LruCache<ListKey, Arc<Vec<Placed>>>>> = OnceLock::new();
