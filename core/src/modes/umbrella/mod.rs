@@ -412,13 +412,15 @@ pub fn outcome_result(outcome: store::Outcome) -> Result<Arc<Elements>> {
     outcome.map_err(|message| CoreError::Param { name: "umbrella", message })
 }
 
-/// Render a view at level of detail `level` (whose cells are at least two pixels wide): band by
-/// band — one row of cells each — the coverage of every pixel's fixed 4×4 sub-samples
-/// ([`raster`]) by the cells' umbrellas (level 0: each cell's list, cell by cell; merged
-/// levels: the merged umbrellas around the row, a frame of cells at a time, [`lod::list`]), then per pixel the colour of each umbrella (or the
-/// background) its sub-samples see, evaluated once at their centroid and weighted by their
-/// number, darkened by their shadows: multisample anti-aliasing, with one colour evaluation
-/// for a pixel inside one umbrella.
+/// Render a view at level of detail `level` (whose cells are at least two pixels wide) over a
+/// background (rendered meanwhile, and returned too): band by band — one row of cells each, a
+/// frame of [`lod::FRAME`] cells at a time — the coverage of every pixel's fixed 4×4
+/// sub-samples ([`raster`]) by the cells' umbrellas (level 0: the union of the cells' lists,
+/// each umbrella masked to the cells that list it; merged levels: the merged umbrellas around
+/// the row, [`lod::list`]), then per pixel the colour of each umbrella (or the background) its
+/// sub-samples see, evaluated once at their centroid and weighted by their number, darkened by
+/// their shadows: multisample anti-aliasing, with one colour evaluation for a pixel inside one
+/// umbrella.
 fn paint(
     el: &Elements,
     arr: &Arrangement,
@@ -527,7 +529,7 @@ fn paint(
                     let x = rect.x0 + i as i64;
                     let ox = ((x - x.div_euclid(ppc).div_euclid(lod::FRAME) * lod::FRAME * ppc) * step) as f32;
                     let b = &bg_row[3 * i..3 * i + 3];
-                    // What a group of sub-samples sees, at `(qx, qy)` in the cell.
+                    // What a group of sub-samples sees, at `(qx, qy)` from the frame's origin.
                     let eval = |key: u64, qx: f32, qy: f32| -> [f32; 3] {
                         let (id, f) = ((key >> 8) as u32, darken[(key & 0xFF) as usize]);
                         if id == raster::NONE {

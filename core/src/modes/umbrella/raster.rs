@@ -34,8 +34,9 @@ pub fn polygon(arr: &Arrangement, u: &Placed, ox: f32, oy: f32) -> [[f32; 2]; RA
 
 /// Runs of samples inside polygon `poly` (even–odd rule, half-open crossings): calls
 /// `span(r, c0, c1)` for samples `c0..c1` of sample row `r`, rows within `rows` and columns
-/// within `cols` (sample indices relative to the cell, centres at `(i + ½)·sp`); rows for which
-/// `skip(r)` holds are passed over.
+/// within `cols` (sample indices relative to the list's origin, centres at `(i + ½)·sp`); rows
+/// for which `skip(r)` holds are passed over. The crossings are kept in a per-thread buffer, so
+/// `span` must not call `fill` itself.
 pub fn fill(
     poly: &[[f32; 2]],
     sp: f32,
