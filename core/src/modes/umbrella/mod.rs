@@ -547,16 +547,23 @@ fn paint(
                         let hit = m.rim.locate_clamped(&sectors, lx, ly);
                         shape::colour(&el.bases[m.base], &rays, &m.colour, hit, step as f32 * u.inv_scale).map(|v| v * f * 255.0)
                     };
-                    let mut keys = [0u64; AA * AA];
-                    for sy in 0..AA {
-                        let k = (j * AA + sy) * cov.width + i * AA;
-                        for sx in 0..AA {
-                            keys[sy * AA + sx] = (cov.hit[k + sx] as u64) << 8 | cov.shade[k + sx] as u64;
-                        }
-                    }
-                    let out = if keys.iter().all(|&k| k == keys[0]) {
-                        eval(keys[0], ox + 0.5 * step as f32, oy + 0.5 * step as f32)
+                    // A pixel whose sub-samples all see the same (most are): one evaluation.
+                    let k0 = j * AA * cov.width + i * AA;
+                    let (h0, s0) = (cov.hit[k0], cov.shade[k0]);
+                    let uniform = (0..AA).all(|sy| {
+                        let k = k0 + sy * cov.width;
+                        cov.hit[k..k + AA].iter().all(|&h| h == h0) && cov.shade[k..k + AA].iter().all(|&s| s == s0)
+                    });
+                    let out = if uniform {
+                        eval((h0 as u64) << 8 | s0 as u64, ox + 0.5 * step as f32, oy + 0.5 * step as f32)
                     } else {
+                        let mut keys = [0u64; AA * AA];
+                        for sy in 0..AA {
+                            let k = k0 + sy * cov.width;
+                            for sx in 0..AA {
+                                keys[sy * AA + sx] = (cov.hit[k + sx] as u64) << 8 | cov.shade[k + sx] as u64;
+                            }
+                        }
                         // Groups of equal sub-samples: key, count, sum of positions.
                         let mut groups = [(0u64, 0u32, 0f32, 0f32); AA * AA];
                         let mut ng = 0;
