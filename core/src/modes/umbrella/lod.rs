@@ -21,7 +21,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use lru::LruCache;
 
 use super::arrange::{Arrangement, Placed};
-use super::extract::{ray, Elements, RAYS};
+use super::extract::{Elements, RAYS};
 use super::raster::{disc_reaches, Poly};
 use super::shape::{self, SectorTable};
 
@@ -137,7 +137,6 @@ pub fn merged_colour(m: &Merged, q: [f64; 2]) -> Option<[f32; 3]> {
 /// The convex hull of `points` (monotone chain), counter-clockwise in the y-up sense
 /// (positive `cross`), without collinear points.
 fn hull(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
     // Points well inside the quadrilateral of the extreme points in x and y cannot be hull
     // vertices: left out before sorting (Akl–Toussaint). The margin keeps any point that
     // rounding could put on the hull.
@@ -165,8 +164,18 @@ fn hull(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
     keys.sort_unstable();
     keys.dedup();
     let points: Vec<[f64; 2]> = keys.iter().map(|&k| [value((k >> 64) as u64), value(k as u64)]).collect();
+    chain(&points)
+}
+
+/// `(a − o) × (b − o)`: positive when `o, a, b` turn counter-clockwise (y up).
+fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+}
+
+/// The monotone chain over distinct points sorted by `(x, y)`: their convex hull.
+fn chain(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
     if points.len() < 3 {
-        return points;
+        return points.to_vec();
     }
     let mut h: Vec<[f64; 2]> = Vec::with_capacity(2 * points.len());
     for pass in 0..2 {
@@ -335,7 +344,7 @@ pub fn cell(el: &Elements, arr: &Arrangement, sectors: &SectorTable, j: u32, cx:
         el,
         arr,
         sectors,
-        rays: std::array::from_fn(ray),
+        rays: arr.rays,
         footprint: ((arr.g << j) / LOD_PIXELS).max(1) as f32,
     };
     let merged: Vec<Merged> = if members.is_empty() {
@@ -355,10 +364,14 @@ pub fn cell(el: &Elements, arr: &Arrangement, sectors: &SectorTable, j: u32, cx:
     merged
 }
 
-/// Cells per frame: a merged level's row of cells is rasterised a frame at a time, with
-/// positions relative to the frame's origin (cell `FRAME·n`), so that they are the same f32s
-/// whichever window asks.
+/// Cells per frame: a row of cells is rasterised a frame at a time, with positions relative to
+/// the frame's origin (cell `FRAME·n`), so that they are the same f32s whichever window asks.
 pub const FRAME: i64 = 64;
+
+/// The first cell of the frame holding cell `cx`.
+pub fn frame_of(cx: i64) -> i64 {
+    cx.div_euclid(FRAME) * FRAME
+}
 
 /// A merged umbrella relative to the origin of a frame of cells, for rasterising and colouring.
 pub struct Local<'a> {
@@ -419,9 +432,10 @@ pub fn around(arr: &Arrangement, j: u32) -> i64 {
     ((arr.max_reach + 1.5 * arr.shadow_offset as f64) / side).ceil() as i64
 }
 
-/// The colour of `l` at `q` relative to its frame's origin, for a lookup spanning `footprint` texels: a
-/// single umbrella's from its base texture, a merged one's from its vertex colours (its
-/// centre's for a point the coverage put inside but the fan test, by rounding, just outside).
+/// The colour of `l` at `q` relative to its frame's origin, for a lookup spanning `footprint`
+/// texels: a single umbrella's from its base texture, a merged one's from its vertex colours
+/// (its centre's for a point the coverage put inside but the fan test, by rounding, just
+/// outside).
 #[allow(clippy::too_many_arguments)]
 pub fn colour_at(
     l: &Local,
@@ -448,27 +462,11 @@ mod tests {
     use super::*;
     use crate::hash::hash;
 
-    /// Monotone chain over every point, sorted by `f64::total_cmp`: what [`hull`] must equal.
+    /// The monotone chain over every point, sorted by `f64::total_cmp`: what [`hull`] must equal.
     fn reference(mut points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
         points.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
         points.dedup();
-        if points.len() < 3 {
-            return points;
-        }
-        let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-        let mut h: Vec<[f64; 2]> = Vec::new();
-        for pass in 0..2 {
-            let start = h.len();
-            let order: Vec<[f64; 2]> = if pass == 0 { points.clone() } else { points.iter().rev().copied().collect() };
-            for p in order {
-                while h.len() >= start + 2 && cross(h[h.len() - 2], h[h.len() - 1], p) <= 0.0 {
-                    h.pop();
-                }
-                h.push(p);
-            }
-            h.pop();
-        }
-        h
+        chain(&points)
     }
 
     #[test]

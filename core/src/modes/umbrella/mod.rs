@@ -37,7 +37,7 @@ use crate::modes::tiling::{Tiling, TilingParams};
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
 use arrange::{Arrangement, Placed};
-use extract::{ray, Elements, RAYS};
+use extract::{Elements, RAYS};
 
 /// Largest window, in pixels, one call may render (2^24: sub-sampling makes pixels dear).
 pub const MAX_PIXELS: i64 = 1 << 24;
@@ -444,7 +444,7 @@ fn paint(
         darken[n] = darken[n - 1] * (1.0 - shadow);
     }
     let sectors = shape::SectorTable::default();
-    let rays: [[f32; 2]; RAYS] = std::array::from_fn(ray);
+    let rays = &arr.rays;
     let (cx0, cx1) = (rect.x0.div_euclid(ppc), (rect.x1 - 1).div_euclid(ppc) + 1);
     let (cy0, cy1) = (rect.y0.div_euclid(ppc), (rect.y1 - 1).div_euclid(ppc) + 1);
     let row_cells = (cx1 - cx0) as usize;
@@ -493,7 +493,7 @@ fn paint(
             // whichever window asks): each umbrella filled once, not once per cell it reaches.
             let mut fx = cx0;
             while fx < cx1 {
-                let frame = fx.div_euclid(lod::FRAME) * lod::FRAME;
+                let frame = lod::frame_of(fx);
                 let end = cx1.min(frame + lod::FRAME);
                 let (i0, i1) = (rect.x0.max(fx * ppc), rect.x1.min(end * ppc));
                 let cols = ((i0 - frame * ppc) * a, (i1 - frame * ppc) * a);
@@ -527,7 +527,7 @@ fn paint(
                 for i in 0..w {
                     // Relative to the origin of the pixel's frame of cells.
                     let x = rect.x0 + i as i64;
-                    let ox = ((x - x.div_euclid(ppc).div_euclid(lod::FRAME) * lod::FRAME * ppc) * step) as f32;
+                    let ox = ((x - lod::frame_of(x.div_euclid(ppc)) * ppc) * step) as f32;
                     let b = &bg_row[3 * i..3 * i + 3];
                     // What a group of sub-samples sees, at `(qx, qy)` from the frame's origin.
                     let eval = |key: u64, qx: f32, qy: f32| -> [f32; 3] {
@@ -536,7 +536,7 @@ fn paint(
                             return [0, 1, 2].map(|k| b[k] as f32 * f);
                         }
                         if level > 0 {
-                            let c = lod::colour_at(&locals[id as usize], [qx, qy], el, arr, &sectors, &rays, step as f32);
+                            let c = lod::colour_at(&locals[id as usize], [qx, qy], el, arr, &sectors, rays, step as f32);
                             return c.map(|v| v * f * 255.0);
                         }
                         let u = &placed[id as usize];
@@ -545,9 +545,11 @@ fn paint(
                         let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
                         let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
                         let hit = m.rim.locate_clamped(&sectors, lx, ly);
-                        shape::colour(&el.bases[m.base], &rays, &m.colour, hit, step as f32 * u.inv_scale).map(|v| v * f * 255.0)
+                        shape::colour(&el.bases[m.base], rays, &m.colour, hit, step as f32 * u.inv_scale).map(|v| v * f * 255.0)
                     };
                     // A pixel whose sub-samples all see the same (most are): one evaluation.
+                    // A sample's key: the umbrella it sees and its shadows.
+                    let key = |k: usize| (cov.hit[k] as u64) << 8 | cov.shade[k] as u64;
                     let k0 = j * AA * cov.width + i * AA;
                     let (h0, s0) = (cov.hit[k0], cov.shade[k0]);
                     let uniform = (0..AA).all(|sy| {
@@ -555,15 +557,9 @@ fn paint(
                         cov.hit[k..k + AA].iter().all(|&h| h == h0) && cov.shade[k..k + AA].iter().all(|&s| s == s0)
                     });
                     let out = if uniform {
-                        eval((h0 as u64) << 8 | s0 as u64, ox + 0.5 * step as f32, oy + 0.5 * step as f32)
+                        eval(key(k0), ox + 0.5 * step as f32, oy + 0.5 * step as f32)
                     } else {
-                        let mut keys = [0u64; AA * AA];
-                        for sy in 0..AA {
-                            let k = k0 + sy * cov.width;
-                            for sx in 0..AA {
-                                keys[sy * AA + sx] = (cov.hit[k + sx] as u64) << 8 | cov.shade[k + sx] as u64;
-                            }
-                        }
+                        let keys: [u64; AA * AA] = std::array::from_fn(|n| key(k0 + (n / AA) * cov.width + n % AA));
                         // Groups of equal sub-samples: key, count, sum of positions.
                         let mut groups = [(0u64, 0u32, 0f32, 0f32); AA * AA];
                         let mut ng = 0;
@@ -665,7 +661,7 @@ mod tests {
         let (el, id) = elements(&ex).unwrap();
         let p = UmbrellaParams { shadow_offset: 4, shadow: ONE_Q16 / 2, ..UmbrellaParams::default() };
         let arr = Arrangement::new(&el, &p, &id);
-        let (angles, rays) = (shape::ray_angles(), std::array::from_fn(ray));
+        let (angles, rays) = (shape::ray_angles(), arr.rays);
         // Independently, per point: inside by the barycentric test in the umbrella's frame.
         let contains = |u: &Placed, qx: f32, qy: f32| {
             let (dx, dy) = (qx - u.cx, qy - u.cy);

@@ -12,7 +12,7 @@
 //! `(r + ½)·sp` for a sample spacing `sp` that is a power of two, so a sample's coverage depends
 //! on its absolute position only: windows are the same samples cut from larger ones.
 
-use std::cell::{Cell, RefCell};
+use std::cell::Cell;
 
 use super::arrange::{Arrangement, Placed};
 use super::extract::RAYS;
@@ -35,13 +35,15 @@ pub fn polygon(arr: &Arrangement, u: &Placed, ox: f32, oy: f32) -> [[f32; 2]; RA
 /// Runs of samples inside polygon `poly` (even–odd rule, half-open crossings): calls
 /// `span(r, c0, c1)` for samples `c0..c1` of sample row `r`, rows within `rows` and columns
 /// within `cols` (sample indices relative to the list's origin, centres at `(i + ½)·sp`); rows
-/// for which `skip(r)` holds are passed over. The crossings are kept in a per-thread buffer, so
-/// `span` must not call `fill` itself.
+/// for which `skip(r)` holds are passed over. `crossings` is scratch space, reused from call to
+/// call.
+#[allow(clippy::too_many_arguments)]
 pub fn fill(
     poly: &[[f32; 2]],
     sp: f32,
     rows: (i64, i64),
     cols: (i64, i64),
+    crossings: &mut Crossings,
     skip: impl Fn(i64) -> bool,
     mut span: impl FnMut(i64, i64, i64),
 ) {
@@ -70,11 +72,15 @@ pub fn fill(
         return;
     }
     let height = (last - first) as usize;
-    CROSSINGS.with_borrow_mut(|(xs, counts)| {
+    {
+        let Crossings { xs, counts } = crossings;
         // Each edge's crossings in the rows it spans (found from its ends, with a row of margin
         // either side for rounding, then tested exactly), into its rows in edge order — the
         // crossings of a row in the order a walk over all edges per row meets them.
-        xs.resize(height * RAYS, 0.0);
+        // Only grown: every slot read is written first.
+        if xs.len() < height * RAYS {
+            xs.resize(height * RAYS, 0.0);
+        }
         counts.clear();
         counts.resize(height, 0);
         for &[ay, by, ax, slope] in &edges[..ne] {
@@ -112,12 +118,14 @@ pub fn fill(
                 }
             }
         }
-    });
+    }
 }
 
-thread_local! {
-    /// [`fill`]'s crossings per row (at most [`RAYS`] each) and their counts.
-    static CROSSINGS: RefCell<(Vec<f32>, Vec<u8>)> = const { RefCell::new((Vec::new(), Vec::new())) };
+/// [`fill`]'s scratch space: the crossings of each row (at most [`RAYS`]) and their counts.
+#[derive(Debug, Default)]
+pub struct Crossings {
+    xs: Vec<f32>,
+    counts: Vec<u8>,
 }
 
 /// `⌈v⌉` for the sample indices at hand (|v| < 2^23; without SSE4.1, `f32::ceil` is a call).
@@ -136,12 +144,14 @@ pub struct Coverage {
     pub hit: Vec<u32>,
     /// Shadows per sample (saturating).
     pub shade: Vec<u8>,
+    /// The scanline fill's scratch space.
+    crossings: Crossings,
 }
 
 impl Coverage {
     /// An uncovered band of `width × rows` samples.
     pub fn new(width: usize, rows: usize) -> Coverage {
-        Coverage { width, hit: vec![NONE; width * rows], shade: vec![0; width * rows] }
+        Coverage { width, hit: vec![NONE; width * rows], shade: vec![0; width * rows], crossings: Crossings::default() }
     }
 
     /// Fill a list of `count` shapes, front to back, into the band: the samples are rows
@@ -171,7 +181,7 @@ impl Coverage {
         let free: Vec<Cell<u32>> = (rows.0..rows.1).map(|_| Cell::new((cols.1 - cols.0) as u32)).collect();
         let full = |r: i64| free[(r - rows.0) as usize].get() == 0;
         let mut left: u64 = free.iter().map(|f| f.get() as u64).sum();
-        let (hit, shade) = (&mut self.hit, &mut self.shade);
+        let (hit, shade, crossings) = (&mut self.hit, &mut self.shade, &mut self.crossings);
         let extent = [cols.0 as f32 * sp, cols.1 as f32 * sp, rows.0 as f32 * sp, rows.1 as f32 * sp];
         for n in 0..count {
             if left == 0 {
@@ -180,7 +190,7 @@ impl Coverage {
             let id = first + n as u32;
             // (A shape listed only for its shadow takes no sample here.)
             if let Some((p, mask)) = shape(n, 0.0, extent) {
-                fill(p.vertices(), sp, rows, cols, full, |r, c0, c1| {
+                fill(p.vertices(), sp, rows, cols, crossings, full, |r, c0, c1| {
                     cells.clip(mask, c0, c1, |c0, c1| {
                         let k = at(r, c0);
                         let mut taken = 0;
@@ -198,7 +208,7 @@ impl Coverage {
                 });
             }
             if let Some((p, mask)) = shadow.and_then(|l| shape(n, l, extent)) {
-                fill(p.vertices(), sp, rows, cols, full, |r, c0, c1| {
+                fill(p.vertices(), sp, rows, cols, crossings, full, |r, c0, c1| {
                     cells.clip(mask, c0, c1, |c0, c1| {
                         let k = at(r, c0);
                         let n = (c1 - c0) as usize;
@@ -300,12 +310,12 @@ mod tests {
             *v = corners[i * 4 / RAYS];
         }
         let mut seen = Vec::new();
-        fill(&sq, 0.5, (0, 100), (0, 100), |_| false, |r, c0, c1| seen.extend((c0..c1).map(|c| (r, c))));
+        fill(&sq, 0.5, (0, 100), (0, 100), &mut Crossings::default(), |_| false, |r, c0, c1| seen.extend((c0..c1).map(|c| (r, c))));
         // Centres at (i + ½)/2: 1.25, 1.75, 2.25, 2.75 → indices 2..6 both ways.
         let want: Vec<_> = (2..6).flat_map(|r| (2..6).map(move |c| (r, c))).collect();
         assert_eq!(seen, want);
         seen.clear();
-        fill(&sq, 0.5, (3, 4), (0, 3), |_| false, |r, c0, c1| seen.extend((c0..c1).map(|c| (r, c))));
+        fill(&sq, 0.5, (3, 4), (0, 3), &mut Crossings::default(), |_| false, |r, c0, c1| seen.extend((c0..c1).map(|c| (r, c))));
         assert_eq!(seen, vec![(3, 2)], "clipped to the rows and columns asked for");
     }
 }
