@@ -470,6 +470,9 @@ fn paint(
         (all, merged)
     });
     let bg = bg?;
+    // Per pixel column, its left edge relative to the origin of its frame of cells (the same
+    // in every band).
+    let oxs: Vec<f32> = (rect.x0..rect.x1).map(|x| ((x - lod::frame_of(x.div_euclid(ppc)) * ppc) * step) as f32).collect();
     let bands: Vec<Vec<u8>> = (cy0..cy1)
         .into_par_iter()
         .map(|cy| {
@@ -525,9 +528,7 @@ fn paint(
                 let oy = (y.rem_euclid(ppc) * step) as f32;
                 let bg_row = &bg.pixels[3 * (y - rect.y0) as usize * w..][..3 * w];
                 for i in 0..w {
-                    // Relative to the origin of the pixel's frame of cells.
-                    let x = rect.x0 + i as i64;
-                    let ox = ((x - lod::frame_of(x.div_euclid(ppc)) * ppc) * step) as f32;
+                    let ox = oxs[i];
                     let b = &bg_row[3 * i..3 * i + 3];
                     // What a group of sub-samples sees, at `(qx, qy)` from the frame's origin.
                     let eval = |key: u64, qx: f32, qy: f32| -> [f32; 3] {
