@@ -15,7 +15,7 @@ pub const MIN_BASES: usize = 4;
 pub const MAX_BASES: usize = 10;
 /// Version of what extraction computes: bump it whenever an exemplar's extraction changes, so
 /// that stored extractions of earlier versions are recomputed.
-pub const EXTRACTION_VERSION: u32 = 2;
+pub const EXTRACTION_VERSION: u32 = 3;
 /// Variants (colour offsets and morph targets) kept per base at most.
 pub const MAX_VARIANTS: usize = 4;
 
@@ -295,8 +295,34 @@ pub fn ray(i: usize) -> [f32; 2] {
     [a.cos() as f32, a.sin() as f32]
 }
 
+/// A rim radius more than this many times its rim's radial opening there is a spike.
+const SPIKE: f32 = 3.0;
+/// What a spike is cut to, in times the opening.
+const SPIKE_CUT: f32 = 1.5;
+
+/// Rim radii with spikes cut: a radius more than [`SPIKE`] times the rim's radial opening there
+/// (the largest of the minima over the three-ray windows that hold it) is cut to [`SPIKE_CUT`]
+/// times the opening. A ray cast along a thin bridge into a neighbouring element, or along a
+/// crack, runs far past its neighbours (gravel: 3.7 and 4 times the opening); mapped onto a
+/// sector, it stretches a sliver of texture into a long streak. Lobes three rays wide or more,
+/// smooth profiles such as an ellipse's and a leaf's pointed lobes (leaves: 2.6 times) are left
+/// as they are. Cutting a radius keeps the spoke on the element: it is a part of the one that was.
+fn despike(radii: [f32; RAYS]) -> [f32; RAYS] {
+    let at = |r: &[f32; RAYS], i: usize, d: usize| r[(i + RAYS - 1 + d) % RAYS];
+    let eroded: [f32; RAYS] = std::array::from_fn(|i| (0..3).map(|d| at(&radii, i, d)).fold(f32::MAX, f32::min));
+    std::array::from_fn(|i| {
+        let opened = (0..3).map(|d| at(&eroded, i, d)).fold(0f32, f32::max);
+        if radii[i] > SPIKE * opened {
+            SPIKE_CUT * opened
+        } else {
+            radii[i]
+        }
+    })
+}
+
 /// Rim radii: along each ray from the centre, the distance to the first texel outside the
-/// element (in steps of a quarter texel), so the rim encloses the element's star-shaped part.
+/// element (in steps of a quarter texel), so the rim encloses the element's star-shaped part;
+/// spikes cut ([`despike`]).
 fn rim(inside: &dyn Fn(i64, i64) -> bool, c: (usize, usize)) -> [f32; RAYS] {
     let mut radii = [0f32; RAYS];
     for (i, r) in radii.iter_mut().enumerate() {
@@ -312,7 +338,7 @@ fn rim(inside: &dyn Fn(i64, i64) -> bool, c: (usize, usize)) -> [f32; RAYS] {
         }
         *r = t.max(0.5);
     }
-    radii
+    despike(radii)
 }
 
 /// Extract the elements of an exemplar (`m × m` RGB) and choose its base umbrellas.
@@ -629,4 +655,37 @@ fn sector_colours(px: &[[u8; 3]], m: usize, e: &Element) -> [[f32; 3]; RAYS + 1]
         out[i + 1] = acc.map(|v| v / 4.0);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spikes_are_cut_and_lobes_and_smooth_rims_kept() {
+        // A spike two rays wide on a disc of radius 10: cut to 1.5 times the disc.
+        let mut radii = [10f32; RAYS];
+        radii[5] = 40.0;
+        radii[6] = 36.0;
+        let cut = despike(radii);
+        assert_eq!((cut[5], cut[6]), (15.0, 15.0));
+        assert!((0..RAYS).filter(|i| ![5, 6].contains(i)).all(|i| cut[i] == 10.0));
+        // A pointed lobe (2.6 times its neighbours) stays, and so does a lobe three rays wide.
+        let mut lobe = [10f32; RAYS];
+        lobe[5] = 26.0;
+        assert_eq!(despike(lobe), lobe);
+        radii[7] = 38.0;
+        assert_eq!(despike(radii), radii);
+        // An ellipse with semi-axes 7 and 3 (the tip is the narrowest part of its profile) stays.
+        let ellipse: [f32; RAYS] = std::array::from_fn(|i| {
+            let d = ray(i);
+            21.0 / ((3.0 * d[0]).powi(2) + (7.0 * d[1]).powi(2)).sqrt()
+        });
+        assert_eq!(despike(ellipse), ellipse);
+        // No radius ever grows.
+        for n in 0..200u32 {
+            let r: [f32; RAYS] = std::array::from_fn(|i| 0.5 + ((n as usize * 7 + i * i * 13) % 29) as f32);
+            assert!(despike(r).iter().zip(&r).all(|(a, b)| a <= b));
+        }
+    }
 }
