@@ -198,7 +198,7 @@ const SPECS: &[ParamSpec] = &[DENSITY, SCALE, SHAPE, COLOUR, SHADOW, SHADOW_OFFS
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 8;
+    const VERSION: u32 = 9;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -276,17 +276,11 @@ impl Mode for Umbrella {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
             let shift = colour_shift(&elements, &arr, p, src, cache, umbrella_zooms(&arr))?;
-            let mut image = background(p, src, cache, view)?;
-            // Per channel, every shifted value once (a table, not a rounding per pixel).
-            let table: [[u8; 256]; 3] = std::array::from_fn(|c| {
-                std::array::from_fn(|v| (v as f32 + shift[c]).round().clamp(0.0, 255.0) as u8)
-            });
-            for (i, v) in image.pixels.iter_mut().enumerate() {
-                *v = table[i % 3][*v as usize];
-            }
+            let image = shifted(background(p, src, cache, view)?, shift);
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
         };
-        let (image, _) = paint(&elements, &arr, p, view, level, || background(p, src, cache, view))?;
+        let gaps = gap_shift(&elements, &arr, p, src, cache)?;
+        let (image, _) = paint(&elements, &arr, p, view, level, || Ok(shifted(background(p, src, cache, view)?, gaps)))?;
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
     }
 }
@@ -298,28 +292,90 @@ pub fn umbrella_zooms(arr: &Arrangement) -> u32 {
     (0..64).take_while(|&z| lod::level(arr, z).is_some()).last().unwrap_or(0)
 }
 
-/// Mean colour of the umbrellas' view minus the background's, per channel, at the last zoom
-/// where umbrellas are drawn, over a fixed 128² window at the origin (memoised per texture and
-/// parameters): what the background is shifted by further out.
-fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source, cache: &Pyramid, zooms: u32) -> Result<[f32; 3]> {
-    static MEMO: OnceLock<Mutex<LruCache<u64, [f32; 3]>>> = OnceLock::new();
-    let memo = MEMO.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(64).unwrap_or(NonZeroUsize::MIN))));
-    if let Some(s) = memo.lock().ok().and_then(|mut m| m.get(&arr.key()).copied()) {
+/// `image` with `shift` added to each channel, rounded and clamped (a table per channel, not a
+/// rounding per pixel).
+fn shifted(mut image: RgbWindow, shift: [f32; 3]) -> RgbWindow {
+    let table: [[u8; 256]; 3] =
+        std::array::from_fn(|c| std::array::from_fn(|v| (v as f32 + shift[c]).round().clamp(0.0, 255.0) as u8));
+    for (i, v) in image.pixels.iter_mut().enumerate() {
+        *v = table[i % 3][*v as usize];
+    }
+    image
+}
+
+/// A per-arrangement figure, memoised by [`Arrangement::key`] (texture and parameters).
+fn memoised(memo: &'static OnceLock<Mutex<LruCache<u64, [f32; 3]>>>, key: u64, f: impl FnOnce() -> Result<[f32; 3]>) -> Result<[f32; 3]> {
+    let memo = memo.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(64).unwrap_or(NonZeroUsize::MIN))));
+    if let Some(s) = memo.lock().ok().and_then(|mut m| m.get(&key).copied()) {
         return Ok(s);
     }
-    let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
-    let level = lod::level(arr, zooms).unwrap_or(0);
-    let (umb, bg) = paint(el, arr, p, view, level, || background(p, src, cache, view))?;
-    let mut shift = [0f32; 3];
-    for (i, (a, b)) in umb.pixels.iter().zip(&bg.pixels).enumerate() {
-        shift[i % 3] += *a as f32 - *b as f32;
-    }
-    let n = (umb.pixels.len() / 3).max(1) as f32;
-    let shift = shift.map(|v| v / n);
+    let s = f()?;
     if let Ok(mut m) = memo.lock() {
-        m.put(arr.key(), shift);
+        m.put(key, s);
     }
-    Ok(shift)
+    Ok(s)
+}
+
+/// Largest shift of the background's colour for the gaps ([`gap_shift`]), per channel.
+const MAX_GAP_SHIFT: f32 = 48.0;
+
+/// What the background is shifted by, per channel, where it shows between umbrellas: so that
+/// the native view's mean colour is the exemplar's. The background stands for the gaps between
+/// elements, but it is another mode's view of the whole exemplar — elements included — so
+/// with light elements on dark gaps (leaves, smallstone, gravel) the output came out brighter
+/// than the exemplar, and darker for dark ones (granite). Measured over a fixed 256² native
+/// window at the origin: the mean colour, and the background's weight in it (the view with a
+/// white background less the view with a black one); the difference to the exemplar's mean
+/// over that weight, at most [`MAX_GAP_SHIFT`]. Elements keep their colours. Memoised.
+fn gap_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source, cache: &Pyramid) -> Result<[f32; 3]> {
+    static MEMO: OnceLock<Mutex<LruCache<u64, [f32; 3]>>> = OnceLock::new();
+    memoised(&MEMO, arr.key(), || {
+        let Some(level) = lod::level(arr, 0) else {
+            return Ok([0.0; 3]);
+        };
+        let view = View::out(0, crate::geom::Rect::new(0, 0, 256, 256));
+        let flat = |v: u8| move || Ok(RgbWindow { width: 256, height: 256, pixels: vec![v; 3 * 256 * 256] });
+        let (image, _) = paint(el, arr, p, view, level, || background(p, src, cache, view))?;
+        let (black, _) = paint(el, arr, p, view, level, flat(0))?;
+        let (white, _) = paint(el, arr, p, view, level, flat(255))?;
+        let mut sums = [[0f64; 3]; 2];
+        for (i, ((&v, &b), &w)) in image.pixels.iter().zip(&black.pixels).zip(&white.pixels).enumerate() {
+            sums[0][i % 3] += v as f64;
+            sums[1][i % 3] += w as f64 - b as f64;
+        }
+        let n = (image.pixels.len() / 3).max(1) as f64;
+        Ok(std::array::from_fn(|c| {
+            let (mean, weight) = (sums[0][c] / n, sums[1][c] / n / 255.0);
+            let target = el.mean_colour[c] as f64 * 255.0;
+            if weight < 0.05 {
+                0.0
+            } else {
+                ((target - mean) / weight).clamp(-MAX_GAP_SHIFT as f64, MAX_GAP_SHIFT as f64) as f32
+            }
+        }))
+    })
+}
+
+/// Mean colour of the umbrellas' view (its gaps shifted, [`gap_shift`]) minus the background's,
+/// per channel, at the last zoom where umbrellas are drawn, over a fixed 128² window at the
+/// origin (memoised per texture and parameters): what the background is shifted by further
+/// out.
+fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source, cache: &Pyramid, zooms: u32) -> Result<[f32; 3]> {
+    static MEMO: OnceLock<Mutex<LruCache<u64, [f32; 3]>>> = OnceLock::new();
+    let gaps = gap_shift(el, arr, p, src, cache)?;
+    memoised(&MEMO, arr.key(), || {
+        let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
+        let level = lod::level(arr, zooms).unwrap_or(0);
+        let raw = background(p, src, cache, view)?;
+        let gapped = shifted(raw.clone(), gaps);
+        let (umb, _) = paint(el, arr, p, view, level, || Ok(gapped))?;
+        let mut shift = [0f32; 3];
+        for (i, (a, b)) in umb.pixels.iter().zip(&raw.pixels).enumerate() {
+            shift[i % 3] += *a as f32 - *b as f32;
+        }
+        let n = (umb.pixels.len() / 3).max(1) as f32;
+        Ok(shift.map(|v| v / n))
+    })
 }
 
 /// The background of a view: another mode's pixels (or the mean colour). Zoomed out, the
