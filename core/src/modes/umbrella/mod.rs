@@ -326,7 +326,8 @@ const MAX_GAP_SHIFT: f32 = 48.0;
 /// than the exemplar, and darker for dark ones (granite). Measured over a fixed 256² native
 /// window at the origin: the mean colour, and the background's weight in it (the view with a
 /// white background less the view with a black one); the difference to the exemplar's mean
-/// over that weight, at most [`MAX_GAP_SHIFT`]. Elements keep their colours. Memoised.
+/// over that weight, at most [`MAX_GAP_SHIFT`]. Elements keep their colours. Memoised (the
+/// exemplar is part of the arrangement's key).
 fn gap_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source, cache: &Pyramid) -> Result<[f32; 3]> {
     static MEMO: OnceLock<Mutex<LruCache<u64, [f32; 3]>>> = OnceLock::new();
     memoised(&MEMO, arr.key(), || {
@@ -344,9 +345,12 @@ fn gap_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source,
             sums[1][i % 3] += w as f64 - b as f64;
         }
         let n = (image.pixels.len() / 3).max(1) as f64;
+        // The exemplar's mean (for a hand-made set too, whose elements' mean it is not).
+        let ex = &src.exemplar.pixels;
+        let target: [f64; 3] = std::array::from_fn(|c| ex.iter().map(|p| p[c] as f64).sum::<f64>() / ex.len().max(1) as f64);
         Ok(std::array::from_fn(|c| {
             let (mean, weight) = (sums[0][c] / n, sums[1][c] / n / 255.0);
-            let target = el.mean_colour[c] as f64 * 255.0;
+            let target = target[c];
             if weight < 0.05 {
                 0.0
             } else {
