@@ -275,11 +275,11 @@ impl Mode for Umbrella {
         let Some(level) = level else {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
-            let shift = colour_shift(&elements, &arr, p, src, cache, umbrella_zooms(&arr))?;
+            let shift = colour_shift(&elements, p, &ident, src, cache, umbrella_zooms(&arr))?;
             let image = shifted(background(p, src, cache, view)?, shift);
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
         };
-        let gaps = gap_shift(&elements, &arr, p, src, cache)?;
+        let gaps = gap_shift(&elements, p, &ident, src, cache)?;
         let (image, _) = paint(&elements, &arr, p, view, level, || Ok(shifted(background(p, src, cache, view)?, gaps)))?;
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
     }
@@ -303,13 +303,24 @@ fn shifted(mut image: RgbWindow, shift: [f32; 3]) -> RgbWindow {
     image
 }
 
-/// A per-arrangement figure, memoised by [`Arrangement::key`] (texture and parameters).
-fn memoised(memo: &'static OnceLock<Mutex<LruCache<u64, [f32; 3]>>>, key: u64, f: impl FnOnce() -> Result<[f32; 3]>) -> Result<[f32; 3]> {
+/// A colour calibration of texture `ident` with parameters `p`, memoised: `f` is given the
+/// parameters it is measured with — `p` with seed 0, since a calibration is a statistic of the
+/// arrangement that another seed changes only by chance, and a new seed should not pay for it
+/// again — and their arrangement.
+fn calibrated(
+    memo: &'static OnceLock<Mutex<LruCache<String, [f32; 3]>>>,
+    el: &Elements,
+    p: &UmbrellaParams,
+    ident: &str,
+    f: impl FnOnce(&UmbrellaParams, &Arrangement) -> Result<[f32; 3]>,
+) -> Result<[f32; 3]> {
+    let p = UmbrellaParams { seed: 0, ..p.clone() };
+    let key = format!("{ident};{}", p.canonical());
     let memo = memo.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(64).unwrap_or(NonZeroUsize::MIN))));
     if let Some(s) = memo.lock().ok().and_then(|mut m| m.get(&key).copied()) {
         return Ok(s);
     }
-    let s = f()?;
+    let s = f(&p, &Arrangement::new(el, &p, ident))?;
     if let Ok(mut m) = memo.lock() {
         m.put(key, s);
     }
@@ -326,11 +337,11 @@ const MAX_GAP_SHIFT: f32 = 48.0;
 /// than the exemplar, and darker for dark ones (granite). Measured over a fixed 256² native
 /// window at the origin: the mean colour, and the background's weight in it (the view with a
 /// white background less the view with a black one); the difference to the exemplar's mean
-/// over that weight, at most [`MAX_GAP_SHIFT`]. Elements keep their colours. Memoised (the
-/// exemplar is part of the arrangement's key).
-fn gap_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source, cache: &Pyramid) -> Result<[f32; 3]> {
-    static MEMO: OnceLock<Mutex<LruCache<u64, [f32; 3]>>> = OnceLock::new();
-    memoised(&MEMO, arr.key(), || {
+/// over that weight, at most [`MAX_GAP_SHIFT`]. Elements keep their colours. Measured with
+/// seed 0 and memoised ([`calibrated`]).
+fn gap_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, cache: &Pyramid) -> Result<[f32; 3]> {
+    static MEMO: OnceLock<Mutex<LruCache<String, [f32; 3]>>> = OnceLock::new();
+    calibrated(&MEMO, el, p, ident, |p, arr| {
         let Some(level) = lod::level(arr, 0) else {
             return Ok([0.0; 3]);
         };
@@ -362,12 +373,12 @@ fn gap_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source,
 
 /// Mean colour of the umbrellas' view (its gaps shifted, [`gap_shift`]) minus the background's,
 /// per channel, at the last zoom where umbrellas are drawn, over a fixed 128² window at the
-/// origin (memoised per texture and parameters): what the background is shifted by further
-/// out.
-fn colour_shift(el: &Elements, arr: &Arrangement, p: &UmbrellaParams, src: &Source, cache: &Pyramid, zooms: u32) -> Result<[f32; 3]> {
-    static MEMO: OnceLock<Mutex<LruCache<u64, [f32; 3]>>> = OnceLock::new();
-    let gaps = gap_shift(el, arr, p, src, cache)?;
-    memoised(&MEMO, arr.key(), || {
+/// origin (measured with seed 0 and memoised, [`calibrated`]): what the background is shifted
+/// by further out.
+fn colour_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, cache: &Pyramid, zooms: u32) -> Result<[f32; 3]> {
+    static MEMO: OnceLock<Mutex<LruCache<String, [f32; 3]>>> = OnceLock::new();
+    let gaps = gap_shift(el, p, ident, src, cache)?;
+    calibrated(&MEMO, el, p, ident, |p, arr| {
         let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
         let level = lod::level(arr, zooms).unwrap_or(0);
         let raw = background(p, src, cache, view)?;
