@@ -2,7 +2,10 @@
 //! cell's umbrellas — those its `2^j × 2^j` spawn cells place — are clustered by deterministic
 //! k-means on their centres into at most `k`; each cluster becomes one *merged* umbrella —
 //! centre the mean of its members', rim the convex hull of their rims simplified to
-//! [`MERGED_VERTICES`] by deleting the flattest vertex, depth the front-most member's — coloured
+//! [`MERGED_VERTICES`] by deleting the flattest vertex and shrunk to the area its members are
+//! expected to cover (the hull grows a cluster over the gaps between its members, the note's
+//! stated limit; shrunk, a merged level keeps the share of gaps and so the mean colour and
+//! contrast of what it summarises), depth the front-most member's — coloured
 //! only at its centre and vertices, by sampling its members along each spoke. A cluster of one
 //! stays the umbrella it is (its rim, its mipmapped base texture). Merged cells are memoised.
 //! A zoom draws the level whose cells are about [`LOD_PIXELS`] pixels wide: tile zooms are
@@ -193,6 +196,16 @@ fn chain(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
     h
 }
 
+/// The area of a polygon (shoelace, positive for either orientation).
+fn area(poly: &[[f64; 2]]) -> f64 {
+    let n = poly.len();
+    let twice: f64 = (0..n).map(|i| {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        a[0] * b[1] - a[1] * b[0]
+    }).sum();
+    (twice / 2.0).abs()
+}
+
 /// Delete the flattest vertex (interior angle closest to 180°: the largest cosine between
 /// its two edges' directions) until at most `n` are left; ties: the first.
 fn simplify(mut rim: Vec<[f64; 2]>, n: usize) -> Vec<[f64; 2]> {
@@ -287,15 +300,24 @@ fn merge(members: &[&Member], palette: &Palette, background: [f32; 3]) -> Option
     let n = members.len() as f64;
     let mut o = [0f64; 2];
     let mut points = Vec::with_capacity(members.len() * RAYS);
+    let mut covered = 0f64;
     for m in members {
         let c = m.centre();
         o = [o[0] + c[0] / n, o[1] + c[1] / n];
+        let from = points.len();
         points.extend(palette.arr.rim(&m.u, m.x, m.y).iter().map(|&(a, b)| [a, b]));
+        covered += area(&points[from..]);
     }
     let rim = simplify(hull(points), MERGED_VERTICES);
     if rim.len() < 3 {
         return None;
     }
+    // The hull also covers the gaps between the members: shrunk about the members' mean centre
+    // to the area they are expected to cover (their areas scattered over the hull at random:
+    // `1 − e^(−Σ/hull)` of it), so that a merged level keeps the share of gaps it stands for.
+    let hull_area = area(&rim);
+    let shrink = if hull_area > 0.0 { (1.0 - (-covered / hull_area).exp()).sqrt() } else { 1.0 };
+    let rim: Vec<[f64; 2]> = rim.iter().map(|v| [o[0] + shrink * (v[0] - o[0]), o[1] + shrink * (v[1] - o[1])]).collect();
     // The centre must stay inside the simplified rim (it may not, for a sliver): else the
     // rim's vertex mean, which is.
     let inside = |o: [f64; 2]| {
