@@ -297,8 +297,10 @@ pub fn umbrella_zooms(arr: &Arrangement) -> u32 {
 fn shifted(mut image: RgbWindow, shift: [f32; 3]) -> RgbWindow {
     let table: [[u8; 256]; 3] =
         std::array::from_fn(|c| std::array::from_fn(|v| (v as f32 + shift[c]).round().clamp(0.0, 255.0) as u8));
-    for (i, v) in image.pixels.iter_mut().enumerate() {
-        *v = table[i % 3][*v as usize];
+    for px in image.pixels.chunks_exact_mut(3) {
+        for (v, t) in px.iter_mut().zip(&table) {
+            *v = t[*v as usize];
+        }
     }
     image
 }
