@@ -280,7 +280,7 @@ impl Mode for Umbrella {
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
         };
         let gaps = gap_shift(&elements, p, &ident, src, cache)?;
-        let (image, _) = paint(&elements, &arr, p, view, level, || Ok(shifted(background(p, src, cache, view)?, gaps)))?;
+        let image = paint(&elements, &arr, p, view, level, || Ok(shifted(background(p, src, cache, view)?, gaps)))?;
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
     }
 }
@@ -349,9 +349,9 @@ fn gap_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, cache
         };
         let view = View::out(0, crate::geom::Rect::new(0, 0, 256, 256));
         let flat = |v: u8| move || Ok(RgbWindow { width: 256, height: 256, pixels: vec![v; 3 * 256 * 256] });
-        let (image, _) = paint(el, arr, p, view, level, || background(p, src, cache, view))?;
-        let (black, _) = paint(el, arr, p, view, level, flat(0))?;
-        let (white, _) = paint(el, arr, p, view, level, flat(255))?;
+        let image = paint(el, arr, p, view, level, || background(p, src, cache, view))?;
+        let black = paint(el, arr, p, view, level, flat(0))?;
+        let white = paint(el, arr, p, view, level, flat(255))?;
         let mut sums = [[0f64; 3]; 2];
         for (i, ((&v, &b), &w)) in image.pixels.iter().zip(&black.pixels).zip(&white.pixels).enumerate() {
             sums[0][i % 3] += v as f64;
@@ -359,8 +359,7 @@ fn gap_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, cache
         }
         let n = (image.pixels.len() / 3).max(1) as f64;
         // The exemplar's mean (for a hand-made set too, whose elements' mean it is not).
-        let ex = &src.exemplar.pixels;
-        let target: [f64; 3] = std::array::from_fn(|c| ex.iter().map(|p| p[c] as f64).sum::<f64>() / ex.len().max(1) as f64);
+        let target = mean_colour(src.exemplar);
         Ok(std::array::from_fn(|c| {
             let (mean, weight) = (sums[0][c] / n, sums[1][c] / n / 255.0);
             let target = target[c];
@@ -385,7 +384,7 @@ fn colour_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, ca
         let level = lod::level(arr, zooms).unwrap_or(0);
         let raw = background(p, src, cache, view)?;
         let gapped = shifted(raw.clone(), gaps);
-        let (umb, _) = paint(el, arr, p, view, level, || Ok(gapped))?;
+        let umb = paint(el, arr, p, view, level, || Ok(gapped))?;
         let mut shift = [0f32; 3];
         for (i, (a, b)) in umb.pixels.iter().zip(&raw.pixels).enumerate() {
             shift[i % 3] += *a as f32 - *b as f32;
@@ -416,13 +415,15 @@ fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> 
         }
         Background::Mean => {
             let (w, h) = (view.rect.width() as usize, view.rect.height() as usize);
-            let mean = mean_colour(ex);
+            // Rounded half up, as the exact integer means were.
+            let mean = mean_colour(ex).map(|v| v.round() as u8);
             RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) }
         }
     })
 }
 
-fn mean_colour(ex: &Exemplar) -> [u8; 3] {
+/// The exemplar's mean colour, RGB in `[0, 255]` (exact sums).
+fn mean_colour(ex: &Exemplar) -> [f64; 3] {
     let n = ex.pixels.len().max(1) as u64;
     let mut s = [0u64; 3];
     for p in &ex.pixels {
@@ -430,7 +431,7 @@ fn mean_colour(ex: &Exemplar) -> [u8; 3] {
             s[k] += p[k] as u64;
         }
     }
-    s.map(|v| ((v + n / 2) / n) as u8)
+    s.map(|v| v as f64 / n as f64)
 }
 
 /// The extraction id of an exemplar: a hash of its content and [`extract::EXTRACTION_VERSION`]
@@ -486,7 +487,7 @@ pub fn outcome_result(outcome: store::Outcome) -> Result<Arc<Elements>> {
 }
 
 /// Render a view at level of detail `level` (whose cells are at least two pixels wide) over a
-/// background (rendered meanwhile, and returned too): band by band — one row of cells each, a
+/// background (rendered meanwhile): band by band — one row of cells each, a
 /// frame of [`lod::FRAME`] cells at a time — the coverage of every pixel's fixed 4×4
 /// sub-samples ([`raster`]) by the cells' umbrellas (level 0: the union of the cells' lists,
 /// each umbrella masked to the cells that list it; merged levels: the merged umbrellas around
@@ -501,7 +502,7 @@ fn paint(
     view: View,
     level: u32,
     background: impl FnOnce() -> Result<RgbWindow> + Send,
-) -> Result<(RgbWindow, RgbWindow)> {
+) -> Result<RgbWindow> {
     let rect = view.rect;
     let step = 1i64 << view.zoom_out.min(40);
     let side = arr.g << level;
@@ -670,7 +671,7 @@ fn paint(
             out
         })
         .collect();
-    Ok((RgbWindow { width: w as u32, height: rect.height() as u32, pixels: bands.concat() }, bg))
+    Ok(RgbWindow { width: w as u32, height: rect.height() as u32, pixels: bands.concat() })
 }
 
 /// Words of storage of the paper's Table 1, `J = b·w·h + 2·b·v + n·(1 + 3v) + k·W·H`, for a
