@@ -9,6 +9,7 @@ mod paint;
 pub mod params;
 mod smooth;
 
+use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
 use crate::cache::Pyramid;
@@ -158,6 +159,9 @@ fn render_view(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect, exact
     Ok(sampled(ex, &layout, zoom_out, rect))
 }
 
+/// Rows per band of [`sampled`]'s parallel labelling.
+const SAMPLED_BAND: i64 = 32;
+
 /// Far zoom-out (`2^k` texels per pixel, k > 3): label each pixel by its centre texel and colour
 /// it from the box-filtered exemplar at that scale (the mean colour once a pixel covers the
 /// whole exemplar). Approximate, like the paper's reduced-scale rendering.
@@ -167,11 +171,25 @@ fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let lvl = k.min(ex.side.trailing_zeros()) as usize;
     let side = n >> lvl;
     let mip = box_mip(&ex.pixels, n, lvl);
-    let mut pixels = Vec::with_capacity(3 * w * h);
-    let step = 1i64 << k.min(40);
-    for v in &sources(layout, rect, ex.toroidal, step, step / 2) {
-        let (x, y) = ((v & 0xFFFF) as usize >> lvl, (v >> 16) as usize >> lvl);
-        pixels.extend_from_slice(&mip[y.min(side - 1) * side + x.min(side - 1)]);
+    if let [mean] = mip[..] {
+        // A pixel covers the whole exemplar: every label gives its mean.
+        return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
     }
-    RgbWindow { width: w as u32, height: h as u32, pixels }
+    let step = 1i64 << k.min(40);
+    // Bands of rows in parallel (each pixel's label depends on its position alone).
+    let pixels: Vec<Vec<u8>> = (rect.y0..rect.y1)
+        .step_by(SAMPLED_BAND as usize)
+        .collect::<Vec<i64>>()
+        .into_par_iter()
+        .map(|y0| {
+            let band = Rect { y0, y1: rect.y1.min(y0 + SAMPLED_BAND), ..rect };
+            let mut pixels = Vec::with_capacity(3 * w * band.height() as usize);
+            for v in &sources(layout, band, ex.toroidal, step, step / 2) {
+                let (x, y) = ((v & 0xFFFF) as usize >> lvl, (v >> 16) as usize >> lvl);
+                pixels.extend_from_slice(&mip[y.min(side - 1) * side + x.min(side - 1)]);
+            }
+            pixels
+        })
+        .collect();
+    RgbWindow { width: w as u32, height: h as u32, pixels: pixels.concat() }
 }
