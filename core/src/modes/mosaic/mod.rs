@@ -122,10 +122,11 @@ pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
     render_view(ex, p, zoom_out, rect, true)
 }
 
-/// `rect` of the mosaic `zoom_out` steps out by the far zoom-out method at every zoom (each
-/// pixel one lookup of the box-filtered exemplar; see [`sampled`]): cheaper than [`render`]'s
-/// exact box filter of the native pixels for zoom-outs 1–3, for callers to whom an approximate
-/// view will do (the umbrella mode's background, which shows only between umbrellas).
+/// `rect` of the mosaic `zoom_out` steps out by labelling one sample per pixel at every zoom
+/// (see [`sampled`]; zoom-outs 1–3 averaging the pixel's footprint around its sample's source):
+/// cheaper than [`render`]'s exact box filter of the native pixels for zoom-outs 1–3, for
+/// callers to whom an approximate view will do (the umbrella mode's background, which shows
+/// only between umbrellas).
 pub fn render_sampled(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
     render_view(ex, p, zoom_out, rect, false)
 }
@@ -162,9 +163,13 @@ fn render_view(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect, exact
 /// Rows per band of [`sampled`]'s parallel labelling.
 const SAMPLED_BAND: i64 = 32;
 
-/// Far zoom-out (`2^k` texels per pixel, k > 3): label each pixel by its centre texel and colour
-/// it from the box-filtered exemplar at that scale (the mean colour once a pixel covers the
-/// whole exemplar). Approximate, like the paper's reduced-scale rendering.
+/// Zoomed out `k` steps (`2^k` texels per pixel) by labelling each pixel with its centre
+/// texel's source: approximate, like the paper's reduced-scale rendering. Zoom-outs 1–3 (asked
+/// for only by [`render_sampled`]): the mean of the `2^k × 2^k` exemplar texels around that
+/// source (toroidally), from an integral image — the exact box filter of the native pixels
+/// wherever they all share the label, all but a block edge's pixels. Further out: the texel of
+/// the box-filtered exemplar that holds the source (a pixel spans block edges anyway), the mean
+/// colour once a pixel covers the whole exemplar.
 fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let n = layout.n as usize;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
@@ -176,6 +181,7 @@ fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
         return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
     }
     let step = 1i64 << k.min(40);
+    let footprint = (k <= 3).then(|| Integral::new(&ex.pixels, n, step as usize));
     // Bands of rows in parallel (each pixel's label depends on its position alone).
     let pixels: Vec<Vec<u8>> = (rect.y0..rect.y1)
         .step_by(SAMPLED_BAND as usize)
@@ -185,11 +191,55 @@ fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
             let band = Rect { y0, y1: rect.y1.min(y0 + SAMPLED_BAND), ..rect };
             let mut pixels = Vec::with_capacity(3 * w * band.height() as usize);
             for v in &sources(layout, band, ex.toroidal, step, step / 2) {
-                let (x, y) = ((v & 0xFFFF) as usize >> lvl, (v >> 16) as usize >> lvl);
-                pixels.extend_from_slice(&mip[y.min(side - 1) * side + x.min(side - 1)]);
+                let (x, y) = ((v & 0xFFFF) as usize, (v >> 16) as usize);
+                match &footprint {
+                    Some(sums) => pixels.extend_from_slice(&sums.mean_around(x, y)),
+                    None => pixels.extend_from_slice(&mip[(y >> lvl).min(side - 1) * side + (x >> lvl).min(side - 1)]),
+                }
             }
             pixels
         })
         .collect();
     RgbWindow { width: w as u32, height: h as u32, pixels: pixels.concat() }
+}
+
+/// Sums of the exemplar's texels over `f × f` boxes anywhere on its torus, from an integral
+/// image of the exemplar extended by `f` texels right and down (wrapping).
+struct Integral {
+    /// Side of the exemplar.
+    n: usize,
+    /// Box side.
+    f: usize,
+    /// `(n + f + 1)²` prefix sums per channel: entry `(x, y)` sums the texels left of and
+    /// above it.
+    sums: Vec<[u32; 3]>,
+}
+
+impl Integral {
+    fn new(texels: &[[u8; 3]], n: usize, f: usize) -> Integral {
+        debug_assert!(n.is_power_of_two() && f <= n, "a power-of-two exemplar, boxes no wider");
+        let s = n + f + 1;
+        let mut sums = vec![[0u32; 3]; s * s];
+        for y in 1..s {
+            for x in 1..s {
+                let t = texels[((y - 1) % n) * n + (x - 1) % n];
+                let (l, u, d) = (sums[y * s + x - 1], sums[(y - 1) * s + x], sums[(y - 1) * s + x - 1]);
+                sums[y * s + x] = std::array::from_fn(|c| t[c] as u32 + l[c] + u[c] - d[c]);
+            }
+        }
+        Integral { n, f, sums }
+    }
+
+    /// The mean (rounded to nearest) of the `f × f` texels centred on texel `(x, y)` (from
+    /// `f/2` before it to `f/2 − 1` after), on the torus.
+    fn mean_around(&self, x: usize, y: usize) -> [u8; 3] {
+        let (n, f, s) = (self.n, self.f, self.n + self.f + 1);
+        // `n` is a power of two (exemplar sides are), `f/2 < n`.
+        let (x0, y0) = ((x + n - f / 2) & (n - 1), (y + n - f / 2) & (n - 1));
+        let at = |x: usize, y: usize| self.sums[y * s + x];
+        let (a, b, c, d) = (at(x0, y0), at(x0 + f, y0), at(x0, y0 + f), at(x0 + f, y0 + f));
+        // `f` is a power of two too: dividing by the area is a shift.
+        let shift = 2 * f.trailing_zeros();
+        std::array::from_fn(|k| ((d[k] + a[k] - b[k] - c[k] + (1 << shift >> 1)) >> shift) as u8)
+    }
 }

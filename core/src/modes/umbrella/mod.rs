@@ -198,7 +198,7 @@ const SPECS: &[ParamSpec] = &[DENSITY, SCALE, SHAPE, COLOUR, SHADOW, SHADOW_OFFS
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 9;
+    const VERSION: u32 = 10;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -395,9 +395,9 @@ fn colour_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, ca
 }
 
 /// The background of a view: another mode's pixels (or the mean colour). Zoomed out, the
-/// mosaic's sampled pixels (one lookup of the box-filtered exemplar each), not its exact box
-/// filter of the native ones: the background shows only between umbrellas, and the exact
-/// filter cost a fifth of a zoom-out-1 tile.
+/// mosaic's sampled pixels (each labelled once, at its centre, and averaged over its footprint
+/// around that label's source), not its exact box filter of the native ones: the background
+/// shows only between umbrellas, and the exact filter cost a fifth of a zoom-out-1 tile.
 fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> Result<RgbWindow> {
     let ex = src.exemplar;
     Ok(match p.background {
