@@ -217,26 +217,32 @@ fn neighbours(i: usize, m: usize) -> impl Iterator<Item = usize> {
 }
 
 /// A component grown back by `r` texels within `fg` (undoing the erosion that split it from
-/// its neighbours), clipped to the exemplar; sorted texel indices.
-fn regrow(c: &Component, fg: &[bool], m: usize, r: usize, taken: &[bool]) -> Vec<usize> {
-    let mut set: Vec<bool> = vec![false; m * m];
+/// its neighbours), clipped to the exemplar; sorted texel indices. `seen` is scratch space, an
+/// `m × m` mask left all false as it was found (so one serves every component: work in the
+/// component's size, not the exemplar's).
+fn regrow(c: &Component, fg: &[bool], m: usize, r: usize, taken: &[bool], seen: &mut [bool]) -> Vec<usize> {
+    let mut out = c.texels.clone();
     for &i in &c.texels {
-        set[i] = true;
+        seen[i] = true;
     }
-    let mut frontier = c.texels.clone();
+    let mut from = 0;
     for _ in 0..r {
-        let mut next = Vec::new();
-        for &i in &frontier {
-            for j in neighbours(i, m) {
-                if fg[j] && !set[j] && !taken[j] {
-                    set[j] = true;
-                    next.push(j);
+        let to = out.len();
+        for k in from..to {
+            for j in neighbours(out[k], m) {
+                if fg[j] && !seen[j] && !taken[j] {
+                    seen[j] = true;
+                    out.push(j);
                 }
             }
         }
-        frontier = next;
+        from = to;
     }
-    (0..m * m).filter(|&i| set[i]).collect()
+    for &i in &out {
+        seen[i] = false;
+    }
+    out.sort_unstable();
+    out
 }
 
 /// A segmented element: its texels (a mask over the exemplar), centre and rim.
@@ -358,12 +364,13 @@ pub fn extract(px: &[[u8; 3]], m: usize, toroidal: bool) -> Result<Elements> {
             for r in [0usize, 1, 2] {
                 let core = erode(&fg, m, r);
                 let mut taken = vec![false; m * m];
+                let mut seen = vec![false; m * m];
                 let mut kept = Vec::new();
                 for c in components(&core, m) {
                     if c.bbox.0 == 0 || c.bbox.1 == 0 || c.bbox.2 + 1 >= m || c.bbox.3 + 1 >= m {
                         continue;
                     }
-                    let grown = regrow(&c, &fg, m, r, &taken);
+                    let grown = regrow(&c, &fg, m, r, &taken, &mut seen);
                     let touches = grown.iter().any(|&i| i % m == 0 || i / m == 0 || i % m == m - 1 || i / m == m - 1);
                     if touches || grown.len() < amin || grown.len() > amax {
                         continue;
