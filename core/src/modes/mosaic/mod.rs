@@ -173,15 +173,18 @@ const SAMPLED_BAND: i64 = 32;
 fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let n = layout.n as usize;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
-    let lvl = k.min(ex.side.trailing_zeros()) as usize;
-    let side = n >> lvl;
-    let mip = box_mip(&ex.pixels, n, lvl);
-    if let [mean] = mip[..] {
-        // A pixel covers the whole exemplar: every label gives its mean.
-        return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
-    }
     let step = 1i64 << k.min(40);
-    let footprint = (k <= 3).then(|| Integral::new(&ex.pixels, n, step as usize));
+    let colouring = if k <= 3 {
+        Colouring::Footprint(Integral::new(&ex.pixels, n, step as usize))
+    } else {
+        let lvl = k.min(ex.side.trailing_zeros()) as usize;
+        let texels = box_mip(&ex.pixels, n, lvl);
+        if let [mean] = texels[..] {
+            // A pixel covers the whole exemplar: every label gives its mean.
+            return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
+        }
+        Colouring::Mip { lvl, side: n >> lvl, texels }
+    };
     // Bands of rows in parallel (each pixel's label depends on its position alone).
     let pixels: Vec<Vec<u8>> = (rect.y0..rect.y1)
         .step_by(SAMPLED_BAND as usize)
@@ -191,16 +194,31 @@ fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
             let band = Rect { y0, y1: rect.y1.min(y0 + SAMPLED_BAND), ..rect };
             let mut pixels = Vec::with_capacity(3 * w * band.height() as usize);
             for v in &sources(layout, band, ex.toroidal, step, step / 2) {
-                let (x, y) = ((v & 0xFFFF) as usize, (v >> 16) as usize);
-                match &footprint {
-                    Some(sums) => pixels.extend_from_slice(&sums.mean_around(x, y)),
-                    None => pixels.extend_from_slice(&mip[(y >> lvl).min(side - 1) * side + (x >> lvl).min(side - 1)]),
-                }
+                pixels.extend_from_slice(&colouring.at((v & 0xFFFF) as usize, (v >> 16) as usize));
             }
             pixels
         })
         .collect();
     RgbWindow { width: w as u32, height: h as u32, pixels: pixels.concat() }
+}
+
+/// How [`sampled`] colours a pixel from its label's source texel.
+enum Colouring {
+    /// Zoom-outs 1–3: the mean of the pixel's footprint around the source.
+    Footprint(Integral),
+    /// Further out: the texel of the exemplar box-filtered by `2^lvl` (`side²` texels) that
+    /// holds the source.
+    Mip { lvl: usize, side: usize, texels: Vec<[u8; 3]> },
+}
+
+impl Colouring {
+    /// The colour of a pixel whose label's source is exemplar texel `(x, y)`.
+    fn at(&self, x: usize, y: usize) -> [u8; 3] {
+        match self {
+            Colouring::Footprint(sums) => sums.mean_around(x, y),
+            Colouring::Mip { lvl, side, texels } => texels[(y >> lvl).min(side - 1) * side + (x >> lvl).min(side - 1)],
+        }
+    }
 }
 
 /// Sums of the exemplar's texels over `f × f` boxes anywhere on its torus, from an integral
