@@ -65,6 +65,19 @@ fn loadtest_runs_every_pattern_and_reports() {
     let replay = dir.path().join("urls.txt");
     std::fs::write(&replay, format!("# recorded\n/tiles/grass/7/0/0.png\n{}/tiles/grass/6/1/1.png?seed=2\n", s.base))
         .unwrap();
+    // One request at a time, the pan's computation ratio is a property of the pyramidal cache alone:
+    // native tiles computed alone cost ≈ 1.84 (design note §1.6) and neighbours share coarse levels
+    // and padding. (Concurrent neighbours may both compute a level they share, so with concurrency
+    // the ratio also depends on timing; brick has not been requested yet, so its levels start cold.)
+    let out = Command::new(binary())
+        .args(["loadtest", "--url", &s.base, "--texture", "brick", "--pattern", "pan", "--requests", "40"])
+        .args(["--concurrency", "1", "--duration", "300", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "sequential pan: {}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON report");
+    let ratio = report["server_computation_ratio"].as_f64().unwrap();
+    assert!((1.0..1.45).contains(&ratio), "sequential pan computation ratio {ratio}");
     for pattern in ["pan", "zoom", "random", "hot", "replay"] {
         let out = Command::new(binary())
             .args(["loadtest", "--url", &s.base, "--texture", "grass", "--pattern", pattern, "--requests", "40"])
@@ -78,10 +91,10 @@ fn loadtest_runs_every_pattern_and_reports() {
         assert_eq!(report["status"]["200"], 40, "{pattern}: {report}");
         assert!(report["latency_ms"]["p99"].as_f64().unwrap() >= report["latency_ms"]["p50"].as_f64().unwrap());
         if pattern == "pan" {
-            // Native tiles computed alone cost ≈ 1.84 (design note §1.6); the pyramidal cache
-            // shares coarse levels and padding between neighbours.
+            // Four at a time, neighbours still share most of their levels: clearly under the
+            // 1.84 of tiles computed alone, whatever the timing.
             let ratio = report["server_computation_ratio"].as_f64().unwrap();
-            assert!((1.0..1.5).contains(&ratio), "pan computation ratio {ratio}");
+            assert!((1.0..1.7).contains(&ratio), "pan computation ratio {ratio}");
         }
         let ratio = report["server_cache_hit_ratio"].as_f64().unwrap();
         if pattern == "hot" || pattern == "replay" {
