@@ -58,6 +58,17 @@ async fn metrics_count_requests_cache_and_syntheses() {
     assert!(text.contains("textile_level_cache_evictions_total"));
 }
 
+/// The JSON report of `textile loadtest` against `base` (40 requests, within 300 s) with `args`.
+fn loadtest_json(base: &str, args: &[&str]) -> serde_json::Value {
+    let out = Command::new(binary())
+        .args(["loadtest", "--url", base, "--requests", "40", "--duration", "300", "--json"])
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("JSON report")
+}
+
 #[test]
 fn loadtest_runs_every_pattern_and_reports() {
     let s = Server::builder().start();
@@ -69,24 +80,15 @@ fn loadtest_runs_every_pattern_and_reports() {
     // native tiles computed alone cost ≈ 1.84 (design note §1.6) and neighbours share coarse levels
     // and padding. (Concurrent neighbours may both compute a level they share, so with concurrency
     // the ratio also depends on timing; brick has not been requested yet, so its levels start cold.)
-    let out = Command::new(binary())
-        .args(["loadtest", "--url", &s.base, "--texture", "brick", "--pattern", "pan", "--requests", "40"])
-        .args(["--concurrency", "1", "--duration", "300", "--json"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "sequential pan: {}", String::from_utf8_lossy(&out.stderr));
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON report");
+    let report = loadtest_json(&s.base, &["--texture", "brick", "--pattern", "pan", "--concurrency", "1"]);
     let ratio = report["server_computation_ratio"].as_f64().unwrap();
     assert!((1.0..1.45).contains(&ratio), "sequential pan computation ratio {ratio}");
+    let replay = replay.to_str().unwrap();
     for pattern in ["pan", "zoom", "random", "hot", "replay"] {
-        let out = Command::new(binary())
-            .args(["loadtest", "--url", &s.base, "--texture", "grass", "--pattern", pattern, "--requests", "40"])
-            .args(["--concurrency", "4", "--duration", "60", "--json", "--file"])
-            .arg(&replay)
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "{pattern}: {}", String::from_utf8_lossy(&out.stderr));
-        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON report");
+        let report = loadtest_json(
+            &s.base,
+            &["--texture", "grass", "--pattern", pattern, "--concurrency", "4", "--file", replay],
+        );
         assert_eq!(report["requests"], 40, "{pattern}: {report}");
         assert_eq!(report["status"]["200"], 40, "{pattern}: {report}");
         assert!(report["latency_ms"]["p99"].as_f64().unwrap() >= report["latency_ms"]["p50"].as_f64().unwrap());
