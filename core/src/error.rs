@@ -21,6 +21,17 @@ pub enum CoreError {
         /// Largest accepted side.
         max: u32,
     },
+    /// The exemplar is flat: too little colour variation to synthesize anything from it.
+    #[error(
+        "exemplar is flat: its most varied channel has a standard deviation of {spread:.2} levels, under the \
+         {min} needed to synthesize a texture from it"
+    )]
+    FlatExemplar {
+        /// Standard deviation of the most varied channel, in 8-bit levels.
+        spread: f64,
+        /// The least accepted.
+        min: f64,
+    },
     /// An analysis file could not be read or written.
     #[error("analysis file {path}: {source}")]
     Io {

@@ -18,6 +18,11 @@ pub const MIN_SIDE: u32 = 32;
 /// Largest prepared exemplar side.
 pub const MAX_SIDE: u32 = 512;
 
+/// Least colour variation of a synthesizable exemplar: the standard deviation, in 8-bit levels,
+/// of its most varied channel. Below it the image is flat (one colour, or noise of a level or
+/// two): synthesis has nothing to arrange and only its analysis's ties to break.
+pub const MIN_SPREAD: f64 = 2.0;
+
 /// How an input image is accepted and prepared.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ExemplarOptions {
@@ -142,6 +147,31 @@ impl Exemplar {
             lattice: None,
             umbrella_set: None,
         }
+    }
+
+    /// The colour variation of the prepared pixels: the standard deviation, in 8-bit levels,
+    /// of the most varied channel.
+    pub fn spread(&self) -> f64 {
+        let n = self.pixels.len().max(1) as f64;
+        (0..3)
+            .map(|c| {
+                let (s, s2) = self.pixels.iter().fold((0u64, 0u64), |(s, s2), p| {
+                    let v = p[c] as u64;
+                    (s + v, s2 + v * v)
+                });
+                let mean = s as f64 / n;
+                (s2 as f64 / n - mean * mean).max(0.0).sqrt()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Refuse a flat exemplar ([`MIN_SPREAD`]): [`CoreError::FlatExemplar`].
+    pub fn check_not_flat(&self) -> Result<()> {
+        let spread = self.spread();
+        if spread < MIN_SPREAD {
+            return Err(CoreError::FlatExemplar { spread, min: MIN_SPREAD });
+        }
+        Ok(())
     }
 
     /// Feed everything that determines this exemplar's pixels in every mode to `h`: side,

@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use crate::analysis::features::SEARCH_DIMS;
 use crate::analysis::kdtree::KdTree;
+use crate::error::Result;
 
 /// Geometry of one level's candidate problem.
 pub struct CandidateRules {
@@ -110,6 +111,10 @@ impl SearchPlan {
     }
 }
 
+/// Bands of rows each phase of [`candidate_sets`] is computed in: between two bands it reports
+/// progress and may stop, so that even the slowest level answers within a fraction of its time.
+pub const BANDS: usize = 8;
+
 /// Compute `[C_1(u), C_2(u)] = [u, C_2(u)]` (texel indices `y·m + x`) for every texel as
 /// `plan` says: searching only the texels of a grid of step `plan.step` in the k-d tree (their
 /// [`GRID_MATCHES`] nearest matches far enough from them, the first of which is `C_2`) and
@@ -117,7 +122,16 @@ impl SearchPlan {
 /// shifted by the texel's offset from the grid texel (the coherence of a smooth level) and
 /// every texel within one of those, the best far enough; a tree search where no proposal
 /// qualifies. Step 1 searches every texel.
-pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, plan: SearchPlan) -> Vec<[u32; 2]> {
+///
+/// The work comes in `2 ×` [`BANDS`] bands of rows (the grid's, then the texels'; step 1 has
+/// only the second); `between(done)` is called before band `done` and after the last one
+/// (`done = 2 × BANDS`), and an error it returns (cancellation) stops the search.
+pub fn candidate_sets(
+    feats: &[[f64; SEARCH_DIMS]],
+    rules: &CandidateRules,
+    plan: SearchPlan,
+    between: &dyn Fn(usize) -> Result<()>,
+) -> Result<Vec<[u32; 2]>> {
     let m = rules.m;
     let tree = KdTree::new((0..feats.len()).map(|i| (feats[i], i as u32)).collect());
     let search = |u: usize| {
@@ -129,41 +143,60 @@ pub fn candidate_sets(feats: &[[f64; SEARCH_DIMS]], rules: &CandidateRules, plan
     };
     let step = plan.step.clamp(1, m.max(1));
     if step == 1 {
-        return (0..feats.len()).into_par_iter().map(search).collect();
+        between(0)?;
+        let sets = in_bands(m, m, BANDS, &|b| between(BANDS + b), &|_: &mut (), u| search(u))?;
+        between(2 * BANDS)?;
+        return Ok(sets);
     }
     // Per grid texel: its nearest matches far enough from it (C_2 first).
     let gm = m.div_ceil(step);
-    let grid: Vec<Vec<u32>> = (0..gm * gm)
-        .into_par_iter()
-        .map(|g| {
-            let u = (g / gm) * step * m + (g % gm) * step;
-            tree.nearest_k_approx(&feats[u], GRID_MATCHES, plan.slack, |x| rules.allowed(x as usize, u))
-                .into_iter()
-                .map(|b| b.1)
-                .collect()
-        })
-        .collect();
-    (0..feats.len())
-        .into_par_iter()
-        .map_init(Vec::new, |props, u| {
-            let (x, y) = (u % m, u / m);
-            if x % step == 0 && y % step == 0 {
-                let g = &grid[(y / step) * gm + x / step];
-                return [u as u32, g.first().copied().unwrap_or(u as u32)];
-            }
-            proposals(rules, &grid, gm, step, x, y, props);
-            let q = &feats[u];
-            let best = props
-                .iter()
-                .filter(|&&v| rules.allowed(v as usize, u))
-                .map(|&v| (distance(q, &feats[v as usize]), v))
-                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            match best {
-                Some((_, c2)) => [u as u32, c2],
-                None => search(u),
-            }
-        })
-        .collect()
+    let grid: Vec<Vec<u32>> = in_bands(gm, gm, BANDS, &between, &|_: &mut (), g| {
+        let u = (g / gm) * step * m + (g % gm) * step;
+        tree.nearest_k_approx(&feats[u], GRID_MATCHES, plan.slack, |x| rules.allowed(x as usize, u))
+            .into_iter()
+            .map(|b| b.1)
+            .collect()
+    })?;
+    let sets = in_bands(m, m, BANDS, &|b| between(BANDS + b), &|props: &mut Vec<u32>, u| {
+        let (x, y) = (u % m, u / m);
+        if x % step == 0 && y % step == 0 {
+            let g = &grid[(y / step) * gm + x / step];
+            return [u as u32, g.first().copied().unwrap_or(u as u32)];
+        }
+        proposals(rules, &grid, gm, step, x, y, props);
+        let q = &feats[u];
+        let best = props
+            .iter()
+            .filter(|&&v| rules.allowed(v as usize, u))
+            .map(|&v| (distance(q, &feats[v as usize]), v))
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        match best {
+            Some((_, c2)) => [u as u32, c2],
+            None => search(u),
+        }
+    })?;
+    between(2 * BANDS)?;
+    Ok(sets)
+}
+
+/// `f` of every index `0..rows·row_len`, in parallel, computed in `bands` bands of whole rows
+/// with `before(band)` called before each (its error stops the work); each rayon job keeps a
+/// scratch `S`.
+fn in_bands<T: Send, S: Default>(
+    rows: usize,
+    row_len: usize,
+    bands: usize,
+    before: &dyn Fn(usize) -> Result<()>,
+    f: &(dyn Fn(&mut S, usize) -> T + Sync),
+) -> Result<Vec<T>> {
+    let per = rows.div_ceil(bands).max(1);
+    let mut out = Vec::with_capacity(rows * row_len);
+    for b in 0..bands {
+        before(b)?;
+        let (r0, r1) = ((b * per).min(rows), ((b + 1) * per).min(rows));
+        out.par_extend((r0 * row_len..r1 * row_len).into_par_iter().map_init(S::default, f));
+    }
+    Ok(out)
 }
 
 /// The matches of the grid texels around `(x, y)`, shifted by its offset from each, and every

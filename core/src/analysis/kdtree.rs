@@ -8,6 +8,11 @@
 //! distances to a query are computed [`LANES`] at a time (with AVX where the processor has it);
 //! each distance is still summed in dimension order, so the results are the same bits as one
 //! point at a time.
+//!
+//! Identical points are stored once, with all their items (sorted): degenerate exemplars (flat,
+//! periodic, binary) give thousands of equal neighbourhoods, and a search that had to visit
+//! each of them to break its ties by item was quadratic (minutes for a flat 256² exemplar).
+//! Where no two points are equal, the tree is the one built over the points as given.
 
 /// Most points per leaf.
 const LEAF: usize = 16;
@@ -28,25 +33,53 @@ pub struct KdTree<const D: usize> {
     /// Per group of [`LANES`] slots, `D` lane vectors (one per dimension); padding slots are
     /// at infinity.
     lanes: Vec<[f64; LANES]>,
-    /// Item of every slot (padding: `u32::MAX`).
+    /// Smallest item of every slot's point (padding: `u32::MAX`).
     items: Vec<u32>,
+    /// Per slot, where its point's other items start in `more` (one more entry at the end:
+    /// slot `s` has `more[more_at[s]..more_at[s + 1]]`, ascending).
+    more_at: Vec<u32>,
+    /// The items of repeated points beyond their smallest.
+    more: Vec<u32>,
     nodes: Vec<Node>,
     /// Whether the processor runs AVX (the leaf distances use it).
     avx: bool,
 }
 
 impl<const D: usize> KdTree<D> {
-    /// Build over `(point, item)` pairs. Median splits on the widest dimension.
-    pub fn new(mut entries: Vec<([f64; D], u32)>) -> Self {
+    /// Build over `(point, item)` pairs. Median splits on the widest dimension; equal points
+    /// share one slot.
+    pub fn new(entries: Vec<([f64; D], u32)>) -> Self {
         #[cfg(target_arch = "x86_64")]
         let avx = std::arch::is_x86_feature_detected!("avx");
         #[cfg(not(target_arch = "x86_64"))]
         let avx = false;
-        let mut tree = KdTree { lanes: Vec::new(), items: Vec::new(), nodes: Vec::new(), avx };
-        if !entries.is_empty() {
-            tree.build(&mut entries);
+        let (mut unique, repeats) = collapse_equal(entries);
+        let mut tree = KdTree {
+            lanes: Vec::new(),
+            items: Vec::new(),
+            more_at: Vec::new(),
+            more: Vec::new(),
+            nodes: Vec::new(),
+            avx,
+        };
+        if !unique.is_empty() {
+            tree.build(&mut unique);
         }
+        // Each slot's other items, in slot order.
+        tree.more_at.reserve(tree.items.len() + 1);
+        for &item in &tree.items {
+            tree.more_at.push(tree.more.len() as u32);
+            if let Some(others) = repeats.get(&item) {
+                tree.more.extend_from_slice(others);
+            }
+        }
+        tree.more_at.push(tree.more.len() as u32);
         tree
+    }
+
+    /// The items of slot `s`'s point beyond its smallest, ascending.
+    fn more_items(&self, s: usize) -> &[u32] {
+        &self.more[self.more_at[s] as usize..self.more_at[s + 1] as usize]
     }
 
     /// The item nearest to `q` (squared Euclidean distance) among those `keep` accepts, with its
@@ -98,9 +131,25 @@ impl<const D: usize> KdTree<D> {
                     let i = hits.trailing_zeros() as usize;
                     hits &= hits - 1;
                     let (d, item) = (dist[i], self.items[slot + i]);
-                    if (d < w.0 || (d == w.0 && item < w.1)) && keep(item) {
+                    if !(d < w.0 || (d == w.0 && item < w.1)) {
+                        continue;
+                    }
+                    if keep(item) {
                         offer(best, k, d, item);
                         w = worst(best);
+                    }
+                    // The same point's other items, ascending: until one could not enter.
+                    if self.more.is_empty() {
+                        continue;
+                    }
+                    for &other in self.more_items(slot + i) {
+                        if !(d < w.0 || (d == w.0 && other < w.1)) {
+                            break;
+                        }
+                        if keep(other) {
+                            offer(best, k, d, other);
+                            w = worst(best);
+                        }
                     }
                 }
             }
@@ -113,14 +162,16 @@ impl<const D: usize> KdTree<D> {
                 // from `q` along each dimension, and its distance is summed in the same order
                 // from terms at least as large: in floating point too, it is at least `reach`.
                 // Beyond the k-th best, no point there could be accepted (with `slack` > 1,
-                // none much nearer than the k-th best).
+                // none much nearer than the k-th best). Once the k best are all at distance 0
+                // they are items of the one slot equal to `q`, and nothing can be better.
                 let old = gap[dim];
                 gap[dim] = diff;
                 let mut reach = 0.0;
                 for g in gap.iter() {
                     reach += g * g;
                 }
-                if reach * query.slack <= worst(best).0 {
+                let w = worst(best).0;
+                if reach * query.slack <= w && w > 0.0 {
                     self.search(far, q, query, best, gap);
                 }
                 gap[dim] = old;
@@ -195,6 +246,35 @@ impl<const D: usize> KdTree<D> {
     }
 }
 
+/// Equal points (`-0.0` taken as `0.0`) collapsed to one entry with their smallest item, in the
+/// order of the entries given; and, per smallest item of a repeated point, its other items
+/// (ascending).
+#[allow(clippy::type_complexity)]
+fn collapse_equal<const D: usize>(
+    entries: Vec<([f64; D], u32)>,
+) -> (Vec<([f64; D], u32)>, std::collections::HashMap<u32, Vec<u32>>) {
+    let key = |p: &[f64; D]| p.map(|v| if v == 0.0 { 0 } else { v.to_bits() });
+    let mut order: Vec<usize> = (0..entries.len()).collect();
+    order.sort_unstable_by(|&a, &b| key(&entries[a].0).cmp(&key(&entries[b].0)).then(entries[a].1.cmp(&entries[b].1)));
+    let mut repeats = std::collections::HashMap::new();
+    let mut dropped = vec![false; entries.len()];
+    for run in order.chunk_by(|&a, &b| key(&entries[a].0) == key(&entries[b].0)) {
+        if let [first, rest @ ..] = run {
+            if !rest.is_empty() {
+                repeats.insert(entries[*first].1, rest.iter().map(|&r| entries[r].1).collect::<Vec<_>>());
+                for &r in rest {
+                    dropped[r] = true;
+                }
+            }
+        }
+    }
+    if repeats.is_empty() {
+        return (entries, repeats);
+    }
+    let unique = entries.into_iter().zip(dropped).filter(|(_, d)| !d).map(|(e, _)| e).collect();
+    (unique, repeats)
+}
+
 /// What a search looks for.
 struct Query<F> {
     k: usize,
@@ -267,6 +347,19 @@ fn group_distances_avx<const D: usize>(
 mod tests {
     use super::*;
 
+    /// Every accepted point with its squared distance to `q`, nearest first (ties to the
+    /// smallest item).
+    fn brute_force<const D: usize>(pts: &[[f64; D]], q: &[f64; D], keep: impl Fn(u32) -> bool) -> Vec<(f64, u32)> {
+        let mut all: Vec<(f64, u32)> = pts
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| keep(*i as u32))
+            .map(|(i, p)| (p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>(), i as u32))
+            .collect();
+        all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        all
+    }
+
     #[test]
     fn nearest_and_k_nearest_match_brute_force_with_a_predicate() {
         let pts: Vec<[f64; 3]> =
@@ -275,20 +368,8 @@ mod tests {
         for qi in 0..60u32 {
             let q = [(qi * 13 % 100) as f64 + 0.5, (qi * 29 % 90) as f64, (qi % 7) as f64];
             let keep = |i: u32| i % 3 != qi % 3;
-            let brute = pts
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| keep(*i as u32))
-                .map(|(i, p)| (p.iter().zip(&q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>(), i as u32))
-                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            assert_eq!(tree.nearest(&q, keep), brute);
-            let mut all: Vec<(f64, u32)> = pts
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| keep(*i as u32))
-                .map(|(i, p)| (p.iter().zip(&q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>(), i as u32))
-                .collect();
-            all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let all = brute_force(&pts, &q, keep);
+            assert_eq!(tree.nearest(&q, keep), all.first().copied());
             assert_eq!(tree.nearest_k(&q, 7, keep), all[..7]);
         }
     }
@@ -339,6 +420,30 @@ mod tests {
                     assert!(keep(a.1) && a.0 == dist(&pts[a.1 as usize], &q));
                 }
                 assert!(approx.windows(2).all(|w| w[0].0 <= w[1].0));
+            }
+        }
+    }
+
+    #[test]
+    fn repeated_points_give_the_brute_force_result_ties_to_the_smallest_item() {
+        // A flat region (one point 2 000 times), a two-valued one (checkerboard) and a few
+        // distinct points; `-0.0` equals `0.0`.
+        let mut pts: Vec<[f64; 3]> = vec![[0.0, 0.0, 0.0]; 2000];
+        pts.extend((0..1000).map(|i| if i % 2 == 0 { [1.0, -0.0, 2.0] } else { [1.0, 0.0, 2.0] }));
+        pts.extend((0..1000).map(|i| if i % 3 == 0 { [5.0, 5.0, 5.0] } else { [-5.0, 5.0, 5.0] }));
+        pts.extend((0..50).map(|i| [i as f64 * 0.1, 1.0, 2.0]));
+        let tree = KdTree::new(pts.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect());
+        for (qi, slack) in [(0usize, 1.0), (17, 2.25), (2001, 1.0), (2500, 2.25), (3001, 1.0), (4010, 1.0)] {
+            let q = pts[qi];
+            let keep = |i: u32| (i as usize).abs_diff(qi) > 300 && i % 7 != 3;
+            let all = brute_force(&pts, &q, keep);
+            for k in [1, 8, 40] {
+                let got = tree.nearest_k_approx(&q, k, slack, keep);
+                if slack == 1.0 {
+                    assert_eq!(got, all[..k], "query {qi}, k {k}");
+                } else {
+                    assert!(got.iter().zip(&all).all(|(g, e)| g.0 <= slack * e.0 && keep(g.1)), "query {qi}, k {k}");
+                }
             }
         }
     }

@@ -10,7 +10,7 @@ pub mod stack;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::candidates::{candidate_sets, CandidateRules, SearchPlan};
+use crate::analysis::candidates::{candidate_sets, CandidateRules, SearchPlan, BANDS};
 use crate::analysis::features::{
     principal_directions, project_runtime, quantise_projection, InnerTaps, LevelColours, SearchProjection,
     RUNTIME_DIMS, SEARCH_DIMS,
@@ -107,7 +107,8 @@ pub trait Progress: Sync {
     /// `done` of `total` steps are finished; `what` names the current step.
     fn step(&self, done: u32, total: u32, what: &str);
 
-    /// Whether the work should stop (asked between steps by [`Analysis::try_build`]).
+    /// Whether the work should stop (asked between steps by [`Analysis::try_build`]: at least
+    /// every [`candidates::BANDS`]-th of a level).
     fn cancelled(&self) -> bool {
         false
     }
@@ -210,20 +211,26 @@ impl Analysis {
         let search = index.resolve(ex.side);
         let m = ex.side as usize;
         let levels = ex.side.trailing_zeros();
-        let total = levels - FIRST_CORRECTED_LEVEL + 2;
+        // Steps: the stack, then every corrected level's bands of candidate search.
+        let per_level = 2 * BANDS as u32;
+        let total = 1 + (levels + 1 - FIRST_CORRECTED_LEVEL) * per_level;
         progress.step(0, total, "gaussian stack");
         let stack = build_stack(&ex.pixels, m, ex.toroidal);
         let stack8 = derive_stack8(&stack);
         let mut corrected = Vec::new();
         for l in FIRST_CORRECTED_LEVEL..=levels {
-            if progress.cancelled() {
-                return Err(CoreError::Cancelled);
-            }
-            progress.step(l - FIRST_CORRECTED_LEVEL + 1, total, "neighbourhoods and candidates");
+            let first = 1 + (l - FIRST_CORRECTED_LEVEL) * per_level;
+            let between = |done: usize| {
+                if progress.cancelled() {
+                    return Err(CoreError::Cancelled);
+                }
+                progress.step(first + done as u32, total, "neighbourhoods and candidates");
+                Ok(())
+            };
             let h = 1 << (levels - l);
             let phase = ex.lattice.map_or((1, 1), |lat| lat.moduli(ex.side, h));
             let rules = CandidateRules::new(m, ex.toroidal).with_phase(phase.0 as usize, phase.1 as usize);
-            corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search));
+            corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search, &between)?);
         }
         progress.step(total, total, "done");
         let header = AnalysisHeader {
@@ -348,7 +355,13 @@ fn analysis_id(ex: &Exemplar, search: SearchIndex) -> String {
     h.finalize().to_hex()[..16].to_string()
 }
 
-fn analyse_level(px: &[[u8; 3]], rules: &CandidateRules, h: usize, search_index: SearchIndex) -> CorrectionLevel {
+fn analyse_level(
+    px: &[[u8; 3]],
+    rules: &CandidateRules,
+    h: usize,
+    search_index: SearchIndex,
+    between: &dyn Fn(usize) -> Result<()>,
+) -> Result<CorrectionLevel> {
     use rayon::prelude::*;
     let (m, toroidal) = (rules.m, rules.toroidal);
     let cols = LevelColours { px, m: m as i64, toroidal, h: h as i64 };
@@ -377,11 +390,11 @@ fn analyse_level(px: &[[u8; 3]], rules: &CandidateRules, h: usize, search_index:
         SearchIndex::Exact => SearchPlan::EXACT,
         SearchIndex::Coherent => SearchPlan::coherent(h),
     };
-    let sets = candidate_sets(&search, rules, plan);
+    let sets = candidate_sets(&search, rules, plan, between)?;
     let cand = |i: u32| {
         let i = i as usize;
         Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }
     };
     let cands = sets.iter().map(|&[a, b]| [cand(a), cand(b)]).collect();
-    CorrectionLevel { proj, cands }
+    Ok(CorrectionLevel { proj, cands })
 }
