@@ -55,6 +55,14 @@ fn bad_inputs_are_clear_errors_and_leave_no_file() {
     assert_ne!(code, 0);
     assert!(err.contains("notes.png") && err.contains("not a decodable image"), "{err}");
     assert!(std::fs::read_dir(dir.path()).unwrap().count() == 1, "nothing else was written");
+    // A flat exemplar (one grey): refused at once, saying why and what the threshold is.
+    let flat = dir.path().join("flat.png");
+    image::RgbImage::from_pixel(256, 256, image::Rgb([128, 128, 128])).save(&flat).unwrap();
+    let (code, _, err) = run(&["analyze", flat.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("flat.png") && err.contains("exemplar is flat") && err.contains("under the 2"), "{err}");
+    assert!(!out.exists());
+    std::fs::remove_file(&flat).unwrap();
     let truncated = dir.path().join("short.tex");
     std::fs::write(&truncated, b"TXTLANA\0\x01\0\0\0").unwrap();
     let (code, _, err) = run(&["info", truncated.to_str().unwrap()]);

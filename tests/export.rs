@@ -117,3 +117,28 @@ fn an_interrupted_export_leaves_no_file_under_the_target_name() {
     child.wait().expect("wait");
     assert!(!out.exists(), "no file under the target name after kill -9");
 }
+
+#[test]
+fn an_export_without_parameters_names_urls_without_an_empty_query() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("plain.mbtiles");
+    let data = shared_data_dir();
+    let (code, _, err) = textile(&[
+        "export",
+        "--texture",
+        "gravel",
+        "--bbox",
+        "0,0,1,1",
+        "--data-dir",
+        data.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("tiles of 'gravel' (archive zooms"), "no trailing '?' after the texture: {err}");
+    let db = rusqlite::Connection::open(&out).unwrap();
+    let json: String = db.query_row("SELECT value FROM metadata WHERE name = 'json'", [], |r| r.get(0)).unwrap();
+    let meta: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let url = meta["textile"]["tile_url"].as_str().unwrap();
+    assert!(url.ends_with("{y}.png"), "{url}");
+}

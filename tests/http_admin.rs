@@ -330,9 +330,52 @@ async fn analyses_of_uploads_wait_their_turn_and_stop_on_shutdown() {
     assert!(started.elapsed() < Duration::from_secs(5), "shutdown waited {:?}", started.elapsed());
     let stray: Vec<String> = files_in(data.path()).into_iter().filter(|f| f.contains("second")).collect();
     assert!(stray.is_empty(), "{stray:?}");
-    // The uploads were kept: the next start analyses them, and serves them.
+    // The uploads were kept: the next start analyses them (in the background: the service is
+    // ready at once), and serves them.
     let s = admin_server(data.path(), &[]);
-    assert_eq!(s.json("/textures/second").await["status"], "ready");
+    until_ready(&s, "/textures/second").await;
     let (status, _) = s.get_bytes("/tiles/first/8/0/0.png").await;
     assert_eq!(status, 200);
+}
+
+#[tokio::test]
+async fn a_data_directory_that_cannot_store_uploads_is_a_507_naming_no_path() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[]);
+    // The uploads folder's place is taken by a file: nothing can be stored there.
+    std::fs::write(data.path().join("uploads"), b"not a folder").unwrap();
+    let (status, _, body) = upload(&s, "?id=nowhere", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 507, "{body}");
+    assert_eq!(body["error"], "storage_failed", "{body}");
+    let msg = body["message"].as_str().unwrap();
+    let dir = data.path().to_string_lossy().to_string();
+    assert!(msg.contains("could not be stored in the data directory") && !msg.contains(&dir), "{msg}");
+    assert!(!msg.contains('/'), "no path at all: {msg}");
+    assert!(s.log_text().contains(&dir), "the path is in the log");
+    support::assert_error(&s, "/textures/nowhere", 404, "unknown_texture").await;
+}
+
+#[tokio::test]
+async fn two_servers_on_one_data_directory_cannot_both_store_an_id() {
+    let data = tempfile::tempdir().unwrap();
+    let (a, b) = (admin_server(data.path(), &[]), admin_server(data.path(), &[]));
+    let (status, _, body) = upload(&a, "?id=shared", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    // The other server has no 'shared' in its catalogue, but the data directory has: refused,
+    // and the first server's files are untouched.
+    let mut jpeg = std::io::Cursor::new(Vec::new());
+    image::load_from_memory(&brick()).unwrap().to_rgb8().write_to(&mut jpeg, image::ImageFormat::Jpeg).unwrap();
+    let (status, _, body) = upload(&b, "?id=shared", "image/jpeg", jpeg.into_inner(), Some(TOKEN)).await;
+    assert_eq!(status, 409, "{body}");
+    assert_eq!(body["error"], "texture_exists", "{body}");
+    assert!(body["message"].as_str().unwrap().contains("another server sharing this data directory"), "{body}");
+    support::assert_error(&b, "/textures/shared", 404, "unknown_texture").await;
+    assert_eq!(files_in(&data.path().join("uploads")), ["shared.png", "shared.toml"]);
+    until_ready(&a, "/textures/shared").await;
+    // Restarted, the second serves the first's upload, byte for byte.
+    let (_, from_a) = a.get_bytes("/tiles/shared/7/1/1.png").await;
+    drop(b);
+    let b = admin_server(data.path(), &[]);
+    until_ready(&b, "/textures/shared").await;
+    assert_eq!(b.get_bytes("/tiles/shared/7/1/1.png").await, (200, from_a));
 }

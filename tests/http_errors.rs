@@ -50,11 +50,21 @@ async fn bad_requests_are_json_4xx() {
     for &(path, status, code) in cases {
         assert_error(&s, path, status, code).await;
     }
-    for (method, path) in [("POST", "/tiles/gravel/7/0/0.png"), ("DELETE", "/catalog"), ("PUT", "/health")] {
+    // 405: the JSON error names the methods the route takes, as its Allow header does.
+    for (method, path, allow, says) in [
+        ("POST", "/tiles/gravel/7/0/0.png", "GET,HEAD", "use GET or HEAD"),
+        ("DELETE", "/catalog", "GET,HEAD", "use GET or HEAD"),
+        ("PUT", "/health", "GET,HEAD", "use GET or HEAD"),
+        ("GET", "/samples/gravel", "POST", "use POST"),
+        ("GET", "/admin/textures", "POST", "use POST"),
+    ] {
         let r = s.client.request(method.parse().unwrap(), s.url(path)).send().await.unwrap();
         assert_eq!(r.status(), 405, "{method} {path}");
+        assert_eq!(r.headers()["allow"].to_str().unwrap().replace(' ', ""), allow, "{method} {path}");
         let body: serde_json::Value = r.json().await.unwrap();
         assert_eq!(body["error"], "method_not_allowed");
+        let msg = body["message"].as_str().unwrap();
+        assert!(msg.starts_with(&format!("{method} is not allowed on '{path}'")) && msg.ends_with(says), "{msg}");
     }
     // The server is still healthy after all of that.
     assert_eq!(s.json("/health").await["status"], "ok");

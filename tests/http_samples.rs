@@ -177,6 +177,20 @@ async fn bad_bodies_get_json_errors_and_the_server_keeps_serving() {
     check("NaN", 400, "invalid_sample", s.post("/samples/gravel?records=footprints", bin, nan).await);
     let nan_lod = footprint_records(&[(0.5, 0.5, f32::NAN)]);
     check("NaN lod", 400, "invalid_sample", s.post("/samples/gravel?records=footprints", bin, nan_lod).await);
+    // Infinite levels of detail, binary (±inf) and JSON (a number beyond f32): refused, naming
+    // the sample and why.
+    let json = "application/json";
+    for (what, path, ct, body) in [
+        ("+inf lod", "?records=footprints", bin, footprint_records(&[(0.5, 0.5, 0.0), (0.5, 0.5, f32::INFINITY)])),
+        ("-inf lod", "?records=footprints", bin, footprint_records(&[(0.5, 0.5, 0.0), (0.5, 0.5, f32::NEG_INFINITY)])),
+        ("JSON lod beyond f32", "", json, br#"{"footprints": [[0.5, 0.5, 0], [0.5, 0.5, 1e300]]}"#.to_vec()),
+    ] {
+        let (st, h, b) = s.post(&format!("/samples/gravel{path}"), ct, body).await;
+        let v: Value = serde_json::from_slice(&b).expect("JSON error");
+        let msg = v["message"].as_str().unwrap_or_default();
+        assert!(msg.starts_with("sample 1:") && msg.contains("lod") && msg.contains("not finite"), "{what}: {v}");
+        check(what, 400, "invalid_sample", (st, h, b));
+    }
     check("content type", 415, "unsupported_media_type", s.post("/samples/gravel", "text/plain", one.clone()).await);
     check("records kind", 400, "invalid_parameter", s.post("/samples/gravel?records=pixels", bin, one.clone()).await);
     check("unknown parameter", 400, "unknown_parameter", s.post("/samples/gravel?sharpness=2", bin, one.clone()).await);
@@ -185,7 +199,6 @@ async fn bad_bodies_get_json_errors_and_the_server_keeps_serving() {
     check("beyond the tile range", 400, "invalid_sample", s.post("/samples/gravel", bin, far).await);
     let zoom = texel_records(&[Point { x: 0, y: 0, z: 8 }]);
     check("zoom", 400, "invalid_sample", s.post("/samples/gravel", bin, zoom).await);
-    let json = "application/json";
     check(
         "malformed JSON",
         400,

@@ -60,6 +60,7 @@ fn read_exemplar(path: &Path, opts: &ExemplarOptions) -> Result<Exemplar, Box<dy
 pub fn analyze(a: AnalyzeArgs) -> CliResult {
     let toroidal = toroidal_flag(&a.toroidal);
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
+    ex.check_not_flat().map_err(|e| format!("{}: {e}", a.exemplar.display()))?;
     let t = std::time::Instant::now();
     let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"))?;
     an.save(&a.output)?;
@@ -315,7 +316,7 @@ fn configured_texture(c: &ConfigArgs, id: &str) -> Result<Arc<Texture>, Box<dyn 
         return Err(format!("no texture '{id}'; configured: {}", ids.join(", ")).into());
     }
     let _ = exemplar_bytes(&only, &only.textures[0])?;
-    let reg = load_registry(&only, &|s| eprintln!("{s}"), &textile_core::NoProgress)?;
+    let reg = load_registry(&only, &|s| eprintln!("{s}"))?;
     Ok(reg.list[0].clone())
 }
 
@@ -370,12 +371,12 @@ pub fn export(a: ExportArgs) -> CliResult {
         return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", a.output.display()).into());
     }
     eprintln!(
-        "exporting {} tiles of '{}' (archive zooms {}..={}, ?{}) to {}",
+        "exporting {} tiles of '{}{}' (archive zooms {}..={}) to {}",
         plan.count(),
         plan.tex.config.id,
+        plan.query_suffix(),
         plan.zooms.0,
         plan.zooms.1,
-        plan.query,
         a.output.display()
     );
     let r = export::run(&plan, &a.output)?;

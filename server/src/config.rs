@@ -35,6 +35,8 @@ const ENV_KEYS: &[&str] = &[
     "admin_token",
     "max_upload_mib",
     "max_concurrent_analyses",
+    "analysis_threads",
+    "analysis_timeout_secs",
     "max_uploaded_textures",
     "memory_budget_mib",
 ];
@@ -256,6 +258,10 @@ fn default_max_concurrent_analyses() -> usize {
     1
 }
 
+fn default_analysis_timeout_secs() -> u64 {
+    600
+}
+
 fn default_max_uploaded_textures() -> usize {
     100
 }
@@ -333,6 +339,15 @@ pub struct Config {
     /// Analyses of uploaded textures run at once at most; more wait their turn.
     #[serde(default = "default_max_concurrent_analyses")]
     pub max_concurrent_analyses: usize,
+    /// Threads of the analysis pool, which runs every analysis (uploads, and those computed at
+    /// start) at the lowest CPU priority, apart from the synthesis pool; 0 = one fewer than the
+    /// cores (at least one), so a core is always left to serving.
+    #[serde(default)]
+    pub analysis_threads: usize,
+    /// Longest an analysis may take, in seconds; beyond it the upload's status turns `failed`
+    /// (a configured texture's stops the start-up) with a message saying so.
+    #[serde(default = "default_analysis_timeout_secs")]
+    pub analysis_timeout_secs: u64,
     /// Uploaded textures kept at most.
     #[serde(default = "default_max_uploaded_textures")]
     pub max_uploaded_textures: usize,
@@ -491,6 +506,15 @@ impl Config {
         }
         if !(1..=64).contains(&self.max_concurrent_analyses) {
             return bad("max_concurrent_analyses", format!("{} is outside 1..=64", self.max_concurrent_analyses));
+        }
+        if self.analysis_threads > 1024 {
+            return bad(
+                "analysis_threads",
+                format!("{} is outside 0..=1024 (0 = one fewer than the cores)", self.analysis_threads),
+            );
+        }
+        if !(1..=86_400).contains(&self.analysis_timeout_secs) {
+            return bad("analysis_timeout_secs", format!("{} is outside 1..=86400", self.analysis_timeout_secs));
         }
         if self.max_uploaded_textures > 100_000 {
             return bad("max_uploaded_textures", format!("{} is outside 0..=100000", self.max_uploaded_textures));

@@ -30,6 +30,8 @@ pub enum Kind {
     Unprocessable,
     /// Temporarily unable: loading, overloaded or too slow; retry after `retry_after`.
     Unavailable,
+    /// The data directory could not store what the request made.
+    InsufficientStorage,
     /// A fault of ours.
     Internal,
 }
@@ -100,6 +102,7 @@ impl From<CoreError> for ApiError {
             CoreError::Cancelled => Self::new(Kind::Unavailable, "cancelled", msg),
             CoreError::ExemplarUndecodable(_) => Self::new(Kind::Unprocessable, "undecodable_image", msg),
             CoreError::ExemplarSize { .. } => Self::new(Kind::Unprocessable, "image_size", msg),
+            CoreError::FlatExemplar { .. } => Self::bad_request("flat_image", msg),
             CoreError::NotAnalysed { .. } => {
                 ApiError { retry_after: Some(2), ..Self::new(Kind::Unavailable, "not_ready", msg) }
             }

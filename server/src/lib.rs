@@ -10,6 +10,7 @@
 //! [`encode`] → [`http::content`] headers. `textile render` goes through the same
 //! [`pipeline::ImageJob`].
 
+pub mod analysing;
 pub mod assets;
 pub mod cache;
 pub mod cli;

@@ -104,8 +104,8 @@ fn texel(tex: &Texture, index: usize, x: i64, y: i64, z: i64) -> Result<Texel, A
     Ok(Texel { x, y, zoom_out: tex.native_zoom() - z as u32 })
 }
 
-/// A footprint checked against the native tile range (`lod` is clamped when sampled; NaN and
-/// infinities are refused there).
+/// A footprint checked against the native tile range; a finite `lod` is clamped when sampled,
+/// NaN and infinities (also a JSON number beyond `f32`) are refused.
 fn footprint(index: usize, u: f64, v: f64, lod: f32) -> Result<Footprint, ApiError> {
     for (name, p) in [("u", u), ("v", v)] {
         if !(p.is_finite() && p >= PIXEL_MIN as f64 && p < (PIXEL_MAX + 1) as f64) {
@@ -117,6 +117,9 @@ fn footprint(index: usize, u: f64, v: f64, lod: f32) -> Result<Footprint, ApiErr
     }
     if lod.is_nan() {
         return Err(invalid(index, "lod is not a number".into()));
+    }
+    if lod.is_infinite() {
+        return Err(invalid(index, format!("lod = {lod} is not finite (beyond the range of a 32-bit float)")));
     }
     Ok(Footprint { u, v, lod })
 }

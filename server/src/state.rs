@@ -10,6 +10,7 @@ use axum::body::Bytes;
 use textile_core::Pyramid;
 use tokio::sync::Semaphore;
 
+use crate::analysing::AnalysisPool;
 use crate::cache::{CacheStats, TileCache};
 use crate::config::Config;
 use crate::error::ApiError;
@@ -32,6 +33,8 @@ pub struct AppState {
     pub catalogue_writer: tokio::sync::Mutex<()>,
     /// Permits to run analyses of uploaded textures (`max_concurrent_analyses`).
     pub analyses: Arc<Semaphore>,
+    /// Where every analysis runs: its own threads, at the lowest CPU priority.
+    pub analysis_pool: AnalysisPool,
     /// Set when the service is stopping: background analyses stop at their next step.
     pub stopping: Cancel,
     /// Set once the textures present at start-up are analysed (readiness; uploads analysed
@@ -63,8 +66,9 @@ pub type Reservation = tokio::sync::OwnedSemaphorePermit;
 const MIB: u64 = 1 << 20;
 
 impl AppState {
-    /// New state for a configuration.
-    pub fn new(config: Config) -> Self {
+    /// New state for a configuration (fails only if the analysis pool's threads cannot be
+    /// started).
+    pub fn new(config: Config) -> Result<Self, rayon::ThreadPoolBuildError> {
         let metrics = Metrics::new();
         let stats = CacheStats {
             hits: metrics.cache_hits.clone(),
@@ -73,7 +77,8 @@ impl AppState {
             bytes: metrics.cache_bytes.clone(),
             entries: metrics.cache_entries.clone(),
         };
-        AppState {
+        Ok(AppState {
+            analysis_pool: AnalysisPool::new(config.analysis_threads)?,
             cache: TileCache::new(config.cache_mib << 20, stats),
             admission: Arc::new(Semaphore::new(config.max_in_flight)),
             running: RunQueue::new(
@@ -90,7 +95,7 @@ impl AppState {
             stopping: Cancel::default(),
             loaded: Default::default(),
             metrics,
-        }
+        })
     }
 
     /// Syntheses started so far (every mode, and glTF documents).

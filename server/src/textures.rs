@@ -11,6 +11,7 @@ use std::sync::{Arc, OnceLock};
 
 use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, Progress, Source};
 
+use crate::analysing;
 use crate::config::{Config, TextureConfig};
 
 /// Zoom steps served beyond native, magnified (design note §1.8); `@2x` tiles at the highest
@@ -247,6 +248,14 @@ pub enum LoadError {
     /// Loading was stopped by a shutdown signal.
     #[error("loading stopped by a shutdown signal")]
     Stopped,
+    /// An analysis ran out of its time budget.
+    #[error("texture '{id}': {message}")]
+    AnalysisTimeout {
+        /// Texture id.
+        id: String,
+        /// What happened.
+        message: String,
+    },
     /// The exemplar or its analysis is unusable.
     #[error("texture '{id}': {source}")]
     Core {
@@ -324,6 +333,7 @@ pub fn prepare_texture(
     let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal };
     let core = |source| LoadError::Core { id: t.id.clone(), source };
     let mut ex = Exemplar::from_bytes(bytes, &opts).map_err(core)?;
+    ex.check_not_flat().map_err(core)?;
     // The mask is prepared like the exemplar's image, so that they stay aligned.
     let mask = match &t.randomness_mask {
         Some(path) => Some(Exemplar::from_bytes(&image_bytes(cfg, t, path)?, &opts).map_err(core)?),
@@ -397,10 +407,11 @@ pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, 
     Ok(Registry::new(list))
 }
 
-/// Load or compute the analysis of every texture of a prepared registry, in configuration order
-/// (each texture serves its analysis-needing modes as soon as its own is attached). `progress`
-/// receives analysis progress; `stop` is asked between textures and ends the loading with
-/// [`LoadError::Stopped`] once it answers true.
+/// Load or compute the analysis of every texture of a prepared registry that `which` selects,
+/// in configuration order (each texture serves its analysis-needing modes as soon as its own is
+/// attached), each watched by an [`analysing::Watch`]: `stop` is asked between textures and
+/// during each analysis, and ends the loading with [`LoadError::Stopped`] once it answers true;
+/// an analysis longer than `analysis_timeout_secs` ends it with [`LoadError::AnalysisTimeout`].
 ///
 /// The data directory is checked first: stale temporary files of interrupted writes are removed,
 /// and if analyses cannot be stored there (read-only, full, not a directory) the server warns
@@ -408,21 +419,37 @@ pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, 
 pub fn analyse_registry(
     cfg: &Config,
     reg: &Registry,
+    which: &dyn Fn(&Texture) -> bool,
     log: &dyn Fn(String),
-    progress: &dyn Progress,
-    stop: &dyn Fn() -> bool,
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<(), LoadError> {
     let data_dir = cfg.data_dir();
     let storable = data_dir_storable(cfg, log);
-    for tex in &reg.list {
+    let budget = std::time::Duration::from_secs(cfg.analysis_timeout_secs);
+    for tex in reg.list.iter().filter(|t| which(t)) {
         if stop() {
             return Err(LoadError::Stopped);
         }
-        if let Err(source) = analyse_texture(&data_dir, storable, tex, log, progress) {
-            return Err(LoadError::Core { id: tex.config.id.clone(), source });
+        let watch = analysing::Watch::new(tex, stop, budget);
+        match analyse_texture(&data_dir, storable, tex, log, &watch) {
+            Ok(()) => {}
+            Err(textile_core::CoreError::Cancelled) if watch.timed_out() => {
+                return Err(LoadError::AnalysisTimeout { id: tex.config.id.clone(), message: watch.timeout_message() })
+            }
+            // Removed meanwhile (DELETE): nothing of it is kept; on to the next.
+            Err(textile_core::CoreError::Cancelled) if tex.removed.is_set() => {}
+            Err(textile_core::CoreError::Cancelled) => return Err(LoadError::Stopped),
+            Err(source) => return Err(LoadError::Core { id: tex.config.id.clone(), source }),
         }
     }
     Ok(())
+}
+
+/// Whether `data_dir` holds an analysis of `tex` that is current (by its header: loading it
+/// still checks the whole file).
+pub fn has_current_analysis(data_dir: &std::path::Path, tex: &Texture) -> bool {
+    let path = data_dir.join(format!("{}.tex", tex.config.id));
+    Analysis::read_header(&path).is_ok_and(|h| h.id == Analysis::id_for(&tex.exemplar, tex.config.index))
 }
 
 /// Whether analyses can be stored in the data directory (checked first, with stale temporary
@@ -531,8 +558,8 @@ pub fn analyse_texture(
 }
 
 /// Both phases: every texture with its analysis.
-pub fn load_registry(cfg: &Config, log: &dyn Fn(String), progress: &dyn Progress) -> Result<Registry, LoadError> {
+pub fn load_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, LoadError> {
     let reg = prepare_registry(cfg, log)?;
-    analyse_registry(cfg, &reg, log, progress, &|| false)?;
+    analyse_registry(cfg, &reg, &|_| true, log, &|| false)?;
     Ok(reg)
 }

@@ -13,10 +13,11 @@ use textile_core::error::clip;
 
 use std::sync::Arc;
 
+use crate::analysing::Watch;
 use crate::config::{Config, TextureConfig, Toroidal};
 use crate::error::ApiError;
-use crate::files::{write_atomic, writer_alive};
-use crate::state::{AppState, Cancel};
+use crate::files::{write_exclusive, writer_alive};
+use crate::state::AppState;
 use crate::textures::Texture;
 
 /// The folder of uploaded textures inside the data directory.
@@ -121,16 +122,53 @@ pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiE
     Ok(t)
 }
 
-/// Store an upload: the exemplar bytes as `ID.EXT`, then its configuration as `ID.toml` (each
-/// written to a temporary file, synced and renamed into place).
-pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> std::io::Result<()> {
+/// Why an upload could not be stored.
+#[derive(Debug, thiserror::Error)]
+pub enum StoreError {
+    /// Another process (a server sharing the data directory) stored or is storing an upload of
+    /// this id.
+    #[error("another process has stored an upload of this id in the data directory")]
+    Taken,
+    /// The data directory refused the files.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// Store an upload: the exemplar bytes as `ID.EXT`, then its configuration as `ID.toml`, each
+/// written to a temporary file, synced and linked into place only where no file is — so of two
+/// servers sharing the data directory that store the same id, one wins and the other gets
+/// [`StoreError::Taken`] and leaves nothing (it removes only the files it created). An image
+/// without a record older than [`ORPHAN_AGE`] (an interrupted upload) is replaced.
+pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> Result<(), StoreError> {
+    use std::io::ErrorKind::AlreadyExists;
     std::fs::create_dir_all(dir)?;
     let file = format!("{}.{ext}", t.id);
-    write_atomic(&dir.join(&file), image)?;
+    let image_path = dir.join(&file);
+    let record = dir.join(format!("{}.toml", t.id));
+    match write_exclusive(&image_path, image) {
+        Err(e) if e.kind() == AlreadyExists => {
+            let age = std::fs::metadata(&image_path).and_then(|m| m.modified()).ok().and_then(|t| t.elapsed().ok());
+            if record.exists() || age.is_none_or(|a| a < ORPHAN_AGE) {
+                return Err(StoreError::Taken);
+            }
+            std::fs::remove_file(&image_path)?;
+            write_exclusive(&image_path, image).map_err(|e| match e.kind() {
+                AlreadyExists => StoreError::Taken,
+                _ => StoreError::Io(e),
+            })?;
+        }
+        other => other?,
+    }
     let mut stored = t.clone();
     stored.exemplar = file;
-    let text = toml::to_string(&stored).map_err(std::io::Error::other)?;
-    write_atomic(&dir.join(format!("{}.toml", t.id)), text.as_bytes())
+    let claimed = toml::to_string(&stored)
+        .map_err(std::io::Error::other)
+        .and_then(|text| write_exclusive(&record, text.as_bytes()));
+    if let Err(e) = claimed {
+        let _ = std::fs::remove_file(&image_path);
+        return Err(if e.kind() == AlreadyExists { StoreError::Taken } else { StoreError::Io(e) });
+    }
+    Ok(())
 }
 
 /// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
@@ -233,32 +271,9 @@ pub fn analysis_bytes(side: u32) -> u64 {
     (16 << 20) + 600 * side as u64 * side as u64
 }
 
-/// Progress of a background analysis: kept on the texture (in percent), stopped when the
-/// texture is removed or the service stops.
-struct Background<'a> {
-    tex: &'a Texture,
-    stopping: &'a Cancel,
-}
-
-impl textile_core::Progress for Background<'_> {
-    fn step(&self, done: u32, total: u32, _: &str) {
-        // Step k is the work between the k-th and the (k+1)-th report: the Gaussian stack, then
-        // one corrected level after another, each about four times the one before (the finest
-        // is about three quarters of the work).
-        let weight = |k: u32| if k == 0 { 1.0 } else { 4f64.powi(k as i32) };
-        let all: f64 = (0..total).map(weight).sum();
-        let finished: f64 = (0..done.min(total)).map(weight).sum();
-        let pct = if done >= total { 100 } else { ((finished / all) * 100.0).floor().min(99.0) as u32 };
-        self.tex.progress.store(pct, std::sync::atomic::Ordering::Relaxed);
-    }
-
-    fn cancelled(&self) -> bool {
-        self.tex.removed.is_set() || self.stopping.is_set()
-    }
-}
-
-/// Analyse an uploaded texture in the background, at most `max_concurrent_analyses` at once,
-/// its progress kept on the texture; it stops if the texture is removed or the service stops.
+/// Analyse an uploaded texture in the background on the analysis pool, at most
+/// `max_concurrent_analyses` at once, its progress kept on the texture; it stops if the texture
+/// is removed or the service stops, and fails once it takes longer than `analysis_timeout_secs`.
 /// A failure is kept on the texture (its status becomes `failed`).
 pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
     tokio::spawn(async move {
@@ -272,19 +287,24 @@ pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
             move || {
                 let data_dir = st.config.data_dir();
                 let log = |s: String| tracing::info!("{s}");
-                let progress = Background { tex: &tex, stopping: &st.stopping };
+                let stop = || st.stopping.is_set();
+                let watch = Watch::new(&tex, &stop, std::time::Duration::from_secs(st.config.analysis_timeout_secs));
                 // The upload was just stored beside it, so the data directory is writable (a
                 // failed save is still only a warning).
-                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    crate::textures::analyse_texture(&data_dir, true, &tex, &log, &progress)
-                }))
+                let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    st.analysis_pool.run(|| crate::textures::analyse_texture(&data_dir, true, &tex, &log, &watch))
+                }));
+                match outcome {
+                    Ok(Err(textile_core::CoreError::Cancelled)) if watch.timed_out() => Some(watch.timeout_message()),
+                    Ok(Ok(())) | Ok(Err(textile_core::CoreError::Cancelled)) => None,
+                    Ok(Err(e)) => Some(e.to_string()),
+                    Err(_) => Some("the analysis failed unexpectedly".to_string()),
+                }
             }
         };
-        let failure = match tokio::task::spawn_blocking(job).await {
-            Ok(Ok(Ok(()))) | Ok(Ok(Err(textile_core::CoreError::Cancelled))) => None,
-            Ok(Ok(Err(e))) => Some(e.to_string()),
-            Ok(Err(_)) | Err(_) => Some("the analysis failed unexpectedly".to_string()),
-        };
+        let failure = tokio::task::spawn_blocking(job)
+            .await
+            .unwrap_or_else(|_| Some("the analysis failed unexpectedly".to_string()));
         if let Some(f) = failure {
             tracing::warn!("texture '{}': analysis failed: {f}", tex.config.id);
             let _ = tex.failure.set(f);

@@ -201,6 +201,15 @@ impl Plan {
         [lon(x0), lat(y1).max(-MAX_LAT), lon(x1), lat(y0).min(MAX_LAT)]
     }
 
+    /// The query of the archive's tiles as a URL suffix: `?QUERY`, or nothing when it is empty.
+    pub fn query_suffix(&self) -> String {
+        if self.query.is_empty() {
+            String::new()
+        } else {
+            format!("?{}", self.query)
+        }
+    }
+
     /// The archive's JSON metadata: what it shows, and how to make the same tiles again.
     pub fn metadata(&self) -> serde_json::Value {
         let c = &self.tex.config;
@@ -227,7 +236,7 @@ impl Plan {
                 "zoom_offset": offset,
                 "engine": engine_version(),
                 "analysis": self.tex.file_hash(),
-                "tile_url": format!("/tiles/{}/{{z+{offset}}}/{{x}}/{{y}}.{}?{}", c.id, self.format.ext(), self.query),
+                "tile_url": format!("/tiles/{}/{{z+{offset}}}/{{x}}/{{y}}.{}{}", c.id, self.format.ext(), self.query_suffix()),
             }
         })
     }

@@ -117,6 +117,9 @@ fn refused(e: LoadError) -> ApiError {
         LoadError::Core { source: CoreError::ExemplarUndecodable(_), .. } => {
             ApiError::bad_request("invalid_image", e.to_string())
         }
+        LoadError::Core { source: CoreError::FlatExemplar { .. }, .. } => {
+            ApiError::bad_request("flat_image", e.to_string())
+        }
         other => ApiError::bad_request("invalid_upload", other.to_string()),
     }
 }
@@ -142,12 +145,13 @@ fn status_body(tex: &crate::textures::Texture) -> serde_json::Value {
     request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). At most max_upload_mib MiB; each side at most max_exemplar_side.",
         content(("image/png"), ("image/jpeg"), ("image/webp"), ("multipart/form-data"))),
     responses((status = 202, description = "accepted: decoded and stored; analysing (Location: the texture's status)"),
-              (status = 400, description = "a field is invalid, or the image is corrupt or of another format"),
+              (status = 400, description = "a field is invalid, the image is corrupt or of another format, or it is flat (code flat_image)"),
               (status = 401, description = "no or wrong bearer token"),
               (status = 404, description = "the admin API is off (no admin token configured)"),
               (status = 409, description = "the id is in use, or the upload limit is reached"),
               (status = 413, description = "the body or the image's dimensions are over the limits"),
               (status = 415, description = "neither an image nor a multipart form"),
+              (status = 507, description = "the data directory could not store the upload (the path is in the server log)"),
               (status = 503, description = "still loading")),
     security(("admin_token" = [])))]
 pub async fn upload(
@@ -208,20 +212,29 @@ pub async fn upload(
         }
         let dir = uploads::dir(&st.config);
         let stored = {
-            let (config, dir, data_dir) = (config.clone(), dir.clone(), st.config.data_dir());
-            tokio::task::spawn_blocking(move || {
-                let r = uploads::store(&dir, &config, &image, ext);
-                if r.is_err() {
-                    let _ = uploads::remove(&dir, &data_dir, &config.id);
-                }
-                r
-            })
-            .await
+            let (config, dir) = (config.clone(), dir.clone());
+            tokio::task::spawn_blocking(move || uploads::store(&dir, &config, &image, ext)).await
         };
         match stored {
             Ok(Ok(())) => {}
-            Ok(Err(e)) => {
-                return Err(ApiError::internal(format!("the upload could not be stored in {}: {e}", dir.display())))
+            Ok(Err(uploads::StoreError::Taken)) => {
+                return Err(ApiError::new(
+                    Kind::Conflict,
+                    "texture_exists",
+                    format!(
+                        "another server sharing this data directory has stored an upload '{id}'; restart this \
+                         one to serve it, or DELETE it there first to replace it"
+                    ),
+                ))
+            }
+            // The path stays in the log: an answer names no part of the server's layout.
+            Ok(Err(uploads::StoreError::Io(e))) => {
+                tracing::error!("texture '{id}': the upload could not be stored in {}: {e}", dir.display());
+                return Err(ApiError::new(
+                    Kind::InsufficientStorage,
+                    "storage_failed",
+                    format!("the upload could not be stored in the data directory ({}); see the server log", e.kind()),
+                ));
             }
             Err(_) => return Err(ApiError::internal("storing the upload failed unexpectedly")),
         }

@@ -75,7 +75,8 @@ pub async fn serve(listener: TcpListener, app: Router, limits: Limits, mut stop:
             req.extensions_mut().insert(ConnectInfo::<SocketAddr>(peer));
             req
         });
-        let conn = builder.serve_connection(TokioIo::new(stream), TowerToHyperService::new(svc));
+        let io = TokioIo::new(super::bare_errors::JsonBareErrors::new(stream));
+        let conn = builder.serve_connection(io, TowerToHyperService::new(svc));
         let conn = graceful.watch(conn);
         tokio::spawn(async move {
             let _ = conn.await;

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use axum::extract::rejection::PathRejection;
 use axum::extract::{Path, RawQuery, State};
-use axum::http::{header, HeaderMap, HeaderValue, Method, Uri};
+use axum::http::{header, HeaderMap, HeaderValue, Uri};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde_json::{json, Map, Value};
@@ -296,11 +296,30 @@ pub async fn not_found(uri: Uri) -> ApiError {
     ApiError::not_found_route(uri.path())
 }
 
-/// 405 for known routes with another method.
-pub async fn method_not_allowed(method: Method, uri: Uri) -> ApiError {
-    ApiError::new(
-        Kind::MethodNotAllowed,
-        "method_not_allowed",
-        format!("{method} is not allowed on '{}'; use GET or HEAD", uri.path()),
-    )
+/// Every 405 as the contract's JSON error naming the methods the route takes: the router (or a
+/// file service) answers a known route asked with another method with its `Allow` header, which
+/// this turns into the message, keeping the header.
+pub async fn method_not_allowed(req: axum::extract::Request, next: axum::middleware::Next) -> Response {
+    let (method, path) = (req.method().clone(), req.uri().path().to_string());
+    let resp = next.run(req).await;
+    if resp.status() != axum::http::StatusCode::METHOD_NOT_ALLOWED {
+        return resp;
+    }
+    let allow = resp.headers().get(header::ALLOW).cloned();
+    let listed: Vec<&str> = allow
+        .as_ref()
+        .and_then(|v| v.to_str().ok())
+        .map(|v| v.split(',').map(str::trim).filter(|m| !m.is_empty()).collect())
+        .unwrap_or_default();
+    let hint = match listed.as_slice() {
+        [] => String::new(),
+        [one] => format!("; use {one}"),
+        [rest @ .., last] => format!("; use {} or {last}", rest.join(", ")),
+    };
+    let message = format!("{method} is not allowed on '{}'{hint}", textile_core::error::clip(&path));
+    let mut fixed = ApiError::new(Kind::MethodNotAllowed, "method_not_allowed", message).into_response();
+    if let Some(v) = allow {
+        fixed.headers_mut().insert(header::ALLOW, v);
+    }
+    fixed
 }

@@ -4,6 +4,7 @@
 //! nothing from each other. Nothing outside this folder names it: the crate root dispatches `textile serve` to [`serve`].
 
 pub mod admin;
+mod bare_errors;
 pub mod content;
 pub mod error;
 pub mod extract;
@@ -51,8 +52,8 @@ pub const MAX_HEADER_BYTES: usize = 64 << 10;
 pub const MAX_URI_BYTES: usize = 16 << 10;
 
 /// Refuse oversized requests with the contract's JSON errors (414, 431) before any route sees
-/// them. What hyper refuses itself — beyond what it reads at all, or a malformed request line —
-/// it answers with a bare status (README: Configuration).
+/// them. What hyper refuses itself — a request line of 64 KiB or more, headers beyond what it
+/// reads at all — it answers with a bare status, which [`bare_errors`] rewrites as JSON too.
 async fn limits(req: Request, next: Next) -> Response {
     let uri = req.uri().path_and_query().map_or(0, |pq| pq.as_str().len());
     if uri > MAX_URI_BYTES {
@@ -132,12 +133,16 @@ fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Route
         } else {
             AllowOrigin::list(state.config.cors_origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()))
         });
-    routes
+    let app = routes
         .fallback(meta::not_found)
-        .method_not_allowed_fallback(meta::method_not_allowed)
         .layer(middleware::from_fn_with_state(state.clone(), track))
         .layer(middleware::from_fn(limits))
-        .with_state(state)
+        .with_state(state);
+    // 405s get their JSON body outside routing: the router adds a route's `Allow` header after
+    // every layer of that route has run.
+    let app = tower::Layer::layer(&middleware::from_fn(meta::method_not_allowed), app);
+    Router::new()
+        .fallback_service(app)
         .layer(CompressionLayer::new())
         .layer(cors)
         .layer(CatchPanicLayer::custom(|_| ApiError::internal("the request handler panicked").into_response()))
@@ -154,7 +159,7 @@ mod tests {
     #[tokio::test]
     async fn a_panicking_handler_becomes_a_500_json_error_and_service_goes_on() {
         let cfg = crate::config::Config::load(None, &Default::default()).unwrap();
-        let state = Arc::new(AppState::new(cfg));
+        let state = Arc::new(AppState::new(cfg).unwrap());
         let routes = Router::new()
             .route(
                 "/boom",

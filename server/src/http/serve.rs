@@ -15,15 +15,7 @@ use super::listen::{self, Limits};
 use crate::cli::{CliResult, ServeArgs};
 use crate::config::{Config, Overrides};
 use crate::state::AppState;
-use crate::textures::{analyse_registry, prepare_registry, LoadError};
-
-struct LogProgress;
-
-impl textile_core::Progress for LogProgress {
-    fn step(&self, done: u32, total: u32, what: &str) {
-        info!("analysis {done}/{total}: {what}");
-    }
-}
+use crate::textures::{analyse_registry, has_current_analysis, prepare_registry, LoadError, Texture};
 
 /// Run the server until a shutdown signal.
 pub fn run(args: ServeArgs) -> CliResult {
@@ -68,7 +60,7 @@ async fn serve(cfg: Config) -> CliResult {
         header_read_timeout: Duration::from_secs(cfg.header_read_timeout_secs),
         shutdown_grace: Duration::from_secs(cfg.shutdown_grace_secs),
     };
-    let state = Arc::new(AppState::new(cfg));
+    let state = Arc::new(AppState::new(cfg)?);
     let app = super::router(state.clone());
     info!("listening on http://{addr}/ (loading textures)");
     // One shutdown signal for everything: the accept loop, and the loading below.
@@ -81,16 +73,20 @@ async fn serve(cfg: Config) -> CliResult {
             let _ = stop_tx.send(true);
         });
     }
-    // Exemplars first (modes that need only the exemplar serve at once), then the analyses.
+    // Exemplars first (modes that need only the exemplar serve at once), then the configured
+    // textures' analyses on the analysis pool, and the stored ones of uploads; uploads whose
+    // analysis must be computed are analysed in the background after them, like new uploads,
+    // so they never hold back readiness.
     let loader = {
         let state = state.clone();
-        let stop = stop.clone();
         tokio::task::spawn_blocking(move || {
             let log = |s: String| info!("{s}");
             let cfg = crate::uploads::with_stored(&state.config, &log);
             let reg = Arc::new(prepare_registry(&cfg, &log)?);
             state.set_registry(reg.clone());
-            analyse_registry(&cfg, &reg, &log, &LogProgress, &|| *stop.borrow())?;
+            let stop = || state.stopping.is_set();
+            let now = |t: &Texture| !t.config.uploaded || has_current_analysis(&cfg.data_dir(), t);
+            state.analysis_pool.run(|| analyse_registry(&cfg, &reg, &now, &log, &stop))?;
             state.loaded.store(true, std::sync::atomic::Ordering::Relaxed);
             Ok(())
         })
@@ -101,6 +97,11 @@ async fn serve(cfg: Config) -> CliResult {
     tokio::select! {
         loaded = loader => match loaded? {
             Ok(()) => {
+                for tex in state.registry().iter().flat_map(|r| r.list.clone()) {
+                    if tex.analysis.get().is_none() && tex.failure.get().is_none() {
+                        crate::uploads::analyse_in_background(state.clone(), tex);
+                    }
+                }
                 let n = state.registry().map(|r| r.list.len()).unwrap_or(0);
                 let plural = if n == 1 { "" } else { "s" };
                 println!("textile ready: viewer at http://{addr}/ ({n} texture{plural})");
