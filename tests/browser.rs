@@ -68,12 +68,20 @@ fn exported_archive_in_headless_chromium() {
         .status()
         .expect("export");
     assert!(status.success());
+    // A part of the world, far from [0, 0]: the page must open on it, not on an empty map.
+    let status = Command::new(support::binary())
+        .args(["export", "--texture", "gravel", "--bbox", "100,40,104,43", "--data-dir", data.to_str().unwrap(), "-o"])
+        .arg(archives.path().join("part.pmtiles"))
+        .status()
+        .expect("export");
+    assert!(status.success());
     let server = Server::builder().env("TEXTILE_ARCHIVES_DIR", archives.path().to_str().unwrap()).start();
     let status = Command::new("node")
         .args(["--test", "pmtiles.test.mjs"])
         .current_dir(&dir)
         .env("TEXTILE_URL", &server.base)
         .env("TEXTILE_ARCHIVE", "/archives/world.pmtiles")
+        .env("TEXTILE_ARCHIVE_PART", "/archives/part.pmtiles")
         .env("CHROMIUM", &chromium)
         .status()
         .expect("run node");

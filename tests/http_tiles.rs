@@ -47,9 +47,28 @@ async fn tilejson_is_valid_and_its_template_fetches_tiles() {
     let path = url.strip_prefix(&s.base).expect("template on this server");
     let via_template = s.get_bytes(path).await;
     assert_eq!(via_template.0, 200);
-    // The same tile without the cache-busting version has the same bytes.
-    let direct = s.get_bytes(&format!("/tiles/grass/{maxz}/-1/2.png?seed=5&randomness=0.40")).await;
+    // The same tile without the cache-busting version has the same bytes; the template repeats
+    // the texture once around the Web-Mercator world its bounds describe (world = 2^native).
+    let native = tj["textile"]["native_zoom"].as_u64().unwrap();
+    assert!(template.contains(&format!("world={}", 1u64 << native)), "{template}");
+    let direct =
+        s.get_bytes(&format!("/tiles/grass/{maxz}/-1/2.png?seed=5&randomness=0.40&world={}", 1u64 << native)).await;
     assert_eq!(direct, via_template);
+    // Seamless at the date line, at every zoom: the tile past the last column is the first one
+    // again (and a column joins its right neighbour seamlessly everywhere).
+    for z in [native, native - 2, minz] {
+        let tile = |x: i64| {
+            let url = template.replace("{z}", &z.to_string()).replace("{x}", &x.to_string()).replace("{y}", "1");
+            url.strip_prefix(&s.base).unwrap().to_string()
+        };
+        let (first, wrapped) = (s.get_bytes(&tile(0)).await, s.get_bytes(&tile(1 << z)).await);
+        assert_eq!(first.0, 200);
+        assert_eq!(first, wrapped, "zoom {z}: the world wraps exactly");
+    }
+    // A period the query names is kept.
+    let tj = s.json("/tiles/grass/tilejson.json?world=256").await;
+    let template = tj["tiles"][0].as_str().unwrap();
+    assert!(template.contains("world=256") && !template.contains(&format!("world={}", 1u64 << native)), "{template}");
 }
 
 #[tokio::test]

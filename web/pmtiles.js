@@ -42,13 +42,23 @@
   });
   const attribution = state.metadata && state.metadata.attribution;
   if (attribution) source.setAttributions(attribution);
-  new ol.Map({
-    target: 'map',
-    layers: [new ol.layer.Tile({ source })],
-    view: new ol.View({ center: [0, 0], zoom: Math.min(h.maxZoom, h.minZoom + 1), minZoom: h.minZoom, maxZoom: h.maxZoom }),
+  // The view starts where the archive says: its centre and centre zoom, and an archive of part
+  // of the world (`textile export --bbox`) fitted to its bounds instead of an empty [0, 0].
+  const view = new ol.View({
+    center: ol.proj.fromLonLat([h.centerLon, h.centerLat]),
+    zoom: Math.max(h.minZoom, Math.min(h.maxZoom, h.centerZoom)),
+    minZoom: h.minZoom,
+    maxZoom: h.maxZoom,
   });
+  const whole = h.minLon <= -179.9 && h.maxLon >= 179.9 && h.minLat <= -85 && h.maxLat >= 85;
+  const map = new ol.Map({ target: 'map', layers: [new ol.layer.Tile({ source })], view });
+  if (!whole && h.minLon < h.maxLon && h.minLat < h.maxLat) {
+    const extent = ol.proj.transformExtent([h.minLon, h.minLat, h.maxLon, h.maxLat], 'EPSG:4326', 'EPSG:3857');
+    view.fit(extent, { size: map.getSize(), maxZoom: h.maxZoom });
+  }
+  state.view = () => ({ center: ol.proj.toLonLat(view.getCenter()), zoom: view.getZoom() });
   const t = (state.metadata && state.metadata.textile) || {};
   info.textContent = `${state.metadata.name || url}: zooms ${h.minZoom}–${h.maxZoom}, ${h.numAddressedTiles} tiles`
-    + (t.texture ? `, texture '${t.texture}' ?${t.query}` : '');
+    + (t.texture ? `, texture '${t.texture}${t.query ? `?${t.query}` : ''}'` : '');
   document.body.dataset.ready = '1';
 })();

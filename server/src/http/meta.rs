@@ -219,7 +219,8 @@ pub async fn exemplar(
     Ok(r)
 }
 
-/// TileJSON 3.0.0 of a texture; query parameters are validated and carried into `tiles`.
+/// TileJSON 3.0.0 of a texture; query parameters are validated and carried into `tiles`, with
+/// `world` = 2^native added when the query has none (one copy around the Web-Mercator world).
 #[utoipa::path(get, path = "/tiles/{id}/tilejson.json", tag = "tiles",
     params(("id" = String, Path, description = "texture id")),
     responses((status = 200, description = "TileJSON"), (status = 404, description = "unknown texture")))]
@@ -257,6 +258,12 @@ pub async fn tilejson(
         None => qs.append_pair("v", version),
     };
     let mut q = q;
+    // TileJSON's bounds are the wrapped Web-Mercator world, which world-wrapping clients
+    // (MapLibre, OpenLayers) draw again past ±180°: unless the query names a period, the tiles
+    // repeat exactly once around it (`world` = 2^native tiles), so the date line is no seam.
+    if !q.iter().any(|(k, _)| k == "world") {
+        q.push(("world".to_string(), (1u64 << t.native_zoom()).to_string()));
+    }
     q.sort();
     for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
         qs.append_pair(k, v);
