@@ -12,6 +12,7 @@ const TARGETS: &[(&str, Entry)] = &[
     ("analysis_file", textile_server::robustness::analysis_file),
     ("samples_body", textile_server::robustness::samples_body),
     ("upload", textile_server::robustness::upload),
+    ("degenerate_exemplar", textile_server::robustness::degenerate_exemplar),
 ];
 
 #[test]

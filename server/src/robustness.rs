@@ -53,6 +53,37 @@ pub fn exemplar(data: &[u8]) {
     let _ = Exemplar::from_bytes(data, &opts);
 }
 
+/// A degenerate exemplar made from the bytes — a few colours (the first byte's low half the
+/// period, its bits 4–5 the layout: flat, checkerboard, stripes, or colours picked by the later
+/// bytes; bit 7 a 64² instead of a 32² exemplar), checked and analysed as an upload is: refused
+/// as flat, or analysed with its ties and repeats in bounded time.
+pub fn degenerate_exemplar(data: &[u8]) {
+    let Some((&shape, rest)) = data.split_first() else { return };
+    let side: u32 = if shape & 0x80 != 0 { 64 } else { 32 };
+    let colours: Vec<[u8; 4]> = rest.chunks_exact(3).take(4).map(|c| [c[0], c[1], c[2], 255]).collect();
+    if colours.is_empty() {
+        return;
+    }
+    let picks = rest.get(colours.len() * 3..).filter(|p| !p.is_empty()).unwrap_or(&[0]);
+    let period = u32::from(shape & 0x0f).max(1);
+    let px: Vec<[u8; 4]> = (0..side * side)
+        .map(|i| {
+            let (x, y) = (i % side, i / side);
+            let k = match (shape >> 4) & 3 {
+                0 => 0,
+                1 => (x / period + y / period) as usize,
+                2 => (x / period) as usize,
+                _ => picks[i as usize % picks.len()] as usize,
+            };
+            colours[k % colours.len()]
+        })
+        .collect();
+    let ex = Exemplar::from_rgba(side, side, &px, &ExemplarOptions::default());
+    if ex.check_not_flat().is_ok() {
+        let _ = Analysis::try_build(&ex, &NoProgress);
+    }
+}
+
 /// An analysis file's bytes, loaded as the server loads one from its data directory.
 pub fn analysis_file(data: &[u8]) {
     let _ = Analysis::from_bytes(data);
