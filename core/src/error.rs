@@ -98,6 +98,20 @@ pub enum CoreError {
         /// What was wrong and what is allowed.
         message: String,
     },
+    /// An analysis's candidate search did far more work than any exemplar of its size needs (a
+    /// search degenerating towards brute force), and was stopped.
+    #[error(
+        "the analysis of a {side}x{side} exemplar was stopped: its candidate search opened {leaves} k-d tree leaves \
+         at one level, over its budget of {budget}"
+    )]
+    AnalysisWork {
+        /// Exemplar side.
+        side: u32,
+        /// Leaves opened when it was stopped.
+        leaves: u64,
+        /// The level's budget.
+        budget: u64,
+    },
     /// The work was abandoned: its requester went away, or the service is stopping.
     #[error("cancelled: the requester went away or the service is stopping")]
     Cancelled,

@@ -103,6 +103,7 @@ impl From<CoreError> for ApiError {
             CoreError::ExemplarUndecodable(_) => Self::new(Kind::Unprocessable, "undecodable_image", msg),
             CoreError::ExemplarSize { .. } => Self::new(Kind::Unprocessable, "image_size", msg),
             CoreError::FlatExemplar { .. } => Self::bad_request("flat_image", msg),
+            CoreError::AnalysisWork { .. } => Self::new(Kind::Unprocessable, "analysis_work", msg),
             CoreError::NotAnalysed { .. } => {
                 ApiError { retry_after: Some(2), ..Self::new(Kind::Unavailable, "not_ready", msg) }
             }

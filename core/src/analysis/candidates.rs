@@ -4,11 +4,13 @@
 //! compares them over their real texels only (`modes::synth::kernel`), so content along an edge
 //! is not lost, where the design note's border zone excluded it.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use rayon::prelude::*;
 
 use crate::analysis::features::SEARCH_DIMS;
 use crate::analysis::kdtree::KdTree;
-use crate::error::Result;
+use crate::error::{CoreError, Result};
 
 /// Geometry of one level's candidate problem.
 pub struct CandidateRules {
@@ -21,12 +23,20 @@ pub struct CandidateRules {
     /// Lattice phase moduli `(px, py)` (design note §1.9, near-regular textures): `C_2(u)` only
     /// among texels `v ≡ u (mod px, py)`; `(1, 1)` without a lattice.
     pub phase: (usize, usize),
+    /// Work budget: k-d tree leaves opened per texel, on average ([`LEAVES_PER_TEXEL`]).
+    pub leaves_per_texel: u64,
 }
 
 impl CandidateRules {
     /// Rules for an `m × m` exemplar (separation `⌈0.05·m⌉`).
     pub fn new(m: usize, toroidal: bool) -> Self {
-        CandidateRules { m, toroidal, separation: (m * 5).div_ceil(100), phase: (1, 1) }
+        CandidateRules {
+            m,
+            toroidal,
+            separation: (m * 5).div_ceil(100),
+            phase: (1, 1),
+            leaves_per_texel: LEAVES_PER_TEXEL,
+        }
     }
 
     /// These rules with second candidates restricted to the lattice phase of their texel
@@ -115,6 +125,12 @@ impl SearchPlan {
 /// progress and may stop, so that even the slowest level answers within a fraction of its time.
 pub const BANDS: usize = 8;
 
+/// The work budget of one level's search: k-d tree leaves opened per texel, on average. Exemplars
+/// of every kind open at most 130 (exact search, 128²) and 56 (coherent, 512²; bench/README.md,
+/// Degenerate exemplars); brute force opens `m²/16` (16 384 at 512²). Past it the analysis
+/// stops with [`CoreError::AnalysisWork`], the same on every machine, however fast.
+pub const LEAVES_PER_TEXEL: u64 = 2000;
+
 /// Compute `[C_1(u), C_2(u)] = [u, C_2(u)]` (texel indices `y·m + x`) for every texel as
 /// `plan` says: searching only the texels of a grid of step `plan.step` in the k-d tree (their
 /// [`GRID_MATCHES`] nearest matches far enough from them, the first of which is `C_2`) and
@@ -134,13 +150,22 @@ pub fn candidate_sets(
 ) -> Result<Vec<[u32; 2]>> {
     let m = rules.m;
     let tree = KdTree::new((0..feats.len()).map(|i| (feats[i], i as u32)).collect());
-    let search = |u: usize| {
-        let c2 = tree
-            .nearest_k_approx(&feats[u], 1, plan.slack, |v| rules.allowed(v as usize, u))
-            .first()
-            .map_or(u as u32, |b| b.1);
-        [u as u32, c2]
+    // The work so far, checked against the budget between bands.
+    let leaves = AtomicU64::new(0);
+    let budget = rules.leaves_per_texel * feats.len() as u64;
+    let between = |done: usize| {
+        let opened = leaves.load(Ordering::Relaxed);
+        if opened > budget {
+            return Err(CoreError::AnalysisWork { side: m as u32, leaves: opened, budget });
+        }
+        between(done)
     };
+    let nearest = |u: usize, k: usize| {
+        let (found, opened) = tree.nearest_k_counted(&feats[u], k, plan.slack, |v| rules.allowed(v as usize, u));
+        leaves.fetch_add(opened, Ordering::Relaxed);
+        found
+    };
+    let search = |u: usize| [u as u32, nearest(u, 1).first().map_or(u as u32, |b| b.1)];
     let step = plan.step.clamp(1, m.max(1));
     if step == 1 {
         between(0)?;
@@ -152,10 +177,7 @@ pub fn candidate_sets(
     let gm = m.div_ceil(step);
     let grid: Vec<Vec<u32>> = in_bands(gm, gm, BANDS, &between, &|_: &mut (), g| {
         let u = (g / gm) * step * m + (g % gm) * step;
-        tree.nearest_k_approx(&feats[u], GRID_MATCHES, plan.slack, |x| rules.allowed(x as usize, u))
-            .into_iter()
-            .map(|b| b.1)
-            .collect()
+        nearest(u, GRID_MATCHES).into_iter().map(|b| b.1).collect()
     })?;
     let sets = in_bands(m, m, BANDS, &|b| between(BANDS + b), &|props: &mut Vec<u32>, u| {
         let (x, y) = (u % m, u / m);
@@ -235,4 +257,56 @@ fn proposals(
 
 fn distance(a: &[f64; SEARCH_DIMS], b: &[f64; SEARCH_DIMS]) -> f64 {
     a.iter().zip(b).map(|(p, q)| (p - q) * (p - q)).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Features of a small random exemplar (deterministic).
+    fn features(n: usize) -> Vec<[f64; SEARCH_DIMS]> {
+        let mut z = 0x2545_F491_4F6C_DD1Du64;
+        (0..n)
+            .map(|_| {
+                std::array::from_fn(|_| {
+                    z ^= z << 13;
+                    z ^= z >> 7;
+                    z ^= z << 17;
+                    (z % 1000) as f64
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_search_over_its_work_budget_stops_with_a_clear_error() {
+        let feats = features(64 * 64);
+        let rules = CandidateRules::new(64, true);
+        assert!(candidate_sets(&feats, &rules, SearchPlan::EXACT, &|_| Ok(())).is_ok());
+        let tight = CandidateRules { leaves_per_texel: 1, ..CandidateRules::new(64, true) };
+        match candidate_sets(&feats, &tight, SearchPlan::EXACT, &|_| Ok(())) {
+            Err(CoreError::AnalysisWork { side: 64, leaves, budget: 4096 }) => assert!(leaves > 4096),
+            other => panic!("expected the work budget's error, got {:?}", other.map(|v| v.len())),
+        }
+    }
+
+    #[test]
+    fn the_search_stops_between_bands_when_asked_and_reports_each() {
+        let feats = features(32 * 32);
+        let rules = CandidateRules::new(32, true);
+        let seen = std::sync::Mutex::new(Vec::new());
+        let stop_at_3 = |done: usize| {
+            seen.lock().unwrap().push(done);
+            if done == 3 {
+                Err(CoreError::Cancelled)
+            } else {
+                Ok(())
+            }
+        };
+        assert!(matches!(
+            candidate_sets(&feats, &rules, SearchPlan::coherent(8), &stop_at_3),
+            Err(CoreError::Cancelled)
+        ));
+        assert_eq!(*seen.lock().unwrap(), [0, 1, 2, 3]);
+    }
 }

@@ -98,12 +98,24 @@ impl<const D: usize> KdTree<D> {
     /// distance to `q` is within the k-th best so far (`slack = (1 + ε)²`: every match returned
     /// is within `1 + ε` of the true one of its rank; `slack = 1`: exact). Deterministic.
     pub fn nearest_k_approx(&self, q: &[f64; D], k: usize, slack: f64, keep: impl Fn(u32) -> bool) -> Vec<(f64, u32)> {
+        self.nearest_k_counted(q, k, slack, keep).0
+    }
+
+    /// [`KdTree::nearest_k_approx`], with the number of leaves it opened: the work of the query.
+    pub fn nearest_k_counted(
+        &self,
+        q: &[f64; D],
+        k: usize,
+        slack: f64,
+        keep: impl Fn(u32) -> bool,
+    ) -> (Vec<(f64, u32)>, u64) {
         let mut best: Vec<(f64, u32)> = Vec::with_capacity(k + 1);
+        let query = Query { k, slack, keep, leaves: std::cell::Cell::new(0) };
         if k > 0 && !self.nodes.is_empty() {
             let mut gap = [0.0; D];
-            self.search(0, q, &Query { k, slack, keep }, &mut best, &mut gap);
+            self.search(0, q, &query, &mut best, &mut gap);
         }
-        best
+        (best, query.leaves.get())
     }
 
     /// Search the subtree `node`; `gap` holds `q`'s distance to the subtree's cell along each
@@ -121,6 +133,7 @@ impl<const D: usize> KdTree<D> {
         let worst = |best: &Vec<(f64, u32)>| if best.len() < k { (f64::INFINITY, u32::MAX) } else { best[k - 1] };
         match self.nodes[node] {
             Node::Leaf { slot, len } => {
+                query.leaves.set(query.leaves.get() + 1);
                 let (slot, len) = (slot as usize, len as usize);
                 let mut dist = [[0.0; LANES]; LEAF / LANES];
                 let mut w = worst(best);
@@ -280,6 +293,8 @@ struct Query<F> {
     k: usize,
     slack: f64,
     keep: F,
+    /// Leaves opened so far.
+    leaves: std::cell::Cell<u64>,
 }
 
 /// Insert `(d, item)` into the sorted `best` (ties by item), keeping at most `k`.
