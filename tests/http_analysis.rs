@@ -80,14 +80,31 @@ async fn until_analysing(s: &Server, id: &str) {
     }
 }
 
-/// After a DELETE: the process's CPU use falls to idle within 2 s, and `/ready` answers 200.
-async fn assert_idle_soon(s: &Server) {
+/// DELETE `id` mid-analysis: the process's CPU use falls to idle within 2 s, and `/ready`
+/// answers 200 throughout (asked every 50 ms from before the DELETE to the end).
+async fn delete_and_assert_idle_soon(s: &Server, id: &str) {
+    let (client, ready) = (s.client.clone(), s.url("/ready"));
+    let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let poller = {
+        let done = done.clone();
+        tokio::spawn(async move {
+            let mut statuses = Vec::new();
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                statuses.push(client.get(&ready).send().await.map_or(0, |r| r.status().as_u16()));
+                tokio::time::sleep(Duration::from_millis(50)).await;
+            }
+            statuses
+        })
+    };
+    assert_eq!(delete(s, id).await, 204);
     tokio::time::sleep(Duration::from_secs(2)).await;
     let before = cpu_seconds(s.pid());
     tokio::time::sleep(Duration::from_secs(1)).await;
     let used = cpu_seconds(s.pid()) - before;
     assert!(used < 0.25, "the analysis went on after DELETE: {used:.2} CPU s in the second after");
-    assert_eq!(s.get("/ready").await.status(), 200);
+    done.store(true, std::sync::atomic::Ordering::Relaxed);
+    let statuses = poller.await.unwrap();
+    assert!(statuses.len() >= 20 && statuses.iter().all(|&st| st == 200), "/ready answered {statuses:?}");
 }
 
 /// Median and 99th percentile (of 30: the largest) of the latencies of cold synth tiles of
@@ -171,8 +188,7 @@ async fn delete_stops_an_analysis_before_and_after_a_restart() {
     assert_eq!(status, 202, "{answer}");
     until_analysing(&s, "slow").await;
     assert_eq!(s.get("/ready").await.status(), 200, "an upload being analysed never makes the service unready");
-    assert_eq!(delete(&s, "slow").await, 204);
-    assert_idle_soon(&s).await;
+    delete_and_assert_idle_soon(&s, "slow").await;
     assert!(!data.path().join("slow.tex").exists());
 
     // Again, with the analysis begun by a restart: uploaded, stopped by SIGTERM mid-analysis,
@@ -185,8 +201,7 @@ async fn delete_stops_an_analysis_before_and_after_a_restart() {
     assert_eq!(s.get("/ready").await.status(), 200);
     until_analysing(&s, "again").await;
     assert_eq!(s.get("/ready").await.status(), 200);
-    assert_eq!(delete(&s, "again").await, 204);
-    assert_idle_soon(&s).await;
+    delete_and_assert_idle_soon(&s, "again").await;
     assert!(!data.path().join("again.tex").exists() && !data.path().join("uploads/again.png").exists());
 }
 
