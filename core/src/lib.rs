@@ -44,6 +44,7 @@ pub mod analysis;
 pub mod cache;
 pub mod error;
 pub mod exemplar;
+pub mod files;
 pub mod geom;
 pub mod hash;
 pub mod image;

@@ -15,10 +15,10 @@ use crate::cli::{AnalyzeArgs, CliResult, ConfigArgs, ExportArgs, InfoArgs, Rende
 use crate::config::{Config, Overrides, TextureConfig};
 use crate::encode::{encode, Effort, Format};
 use crate::export;
-use crate::files::write_atomic;
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::textures::{exemplar_bytes, load_registry, Texture};
+use textile_core::files::write_atomic;
 
 /// A progress bar on the terminal, labelled with what the work is.
 struct Bar(Mutex<Option<ProgressBar>>, &'static str);

@@ -19,7 +19,6 @@ pub mod config;
 pub mod encode;
 pub mod error;
 pub mod export;
-pub mod files;
 pub mod http;
 pub mod loadtest;
 pub mod memory;

@@ -304,7 +304,7 @@ fn remove_stale_temp_files(dir: &std::path::Path, log: &dyn Fn(String)) {
         if !(name.starts_with('.') && (name.contains(".tex.tmp-") || name.contains(".umbrella.tmp-"))) {
             continue;
         }
-        if crate::files::writer_alive(&name) != Some(true) && std::fs::remove_file(e.path()).is_ok() {
+        if textile_core::files::writer_alive(&name) != Some(true) && std::fs::remove_file(e.path()).is_ok() {
             log(format!("removed {}, left by an interrupted analysis", e.path().display()));
         }
     }

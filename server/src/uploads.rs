@@ -16,9 +16,9 @@ use std::sync::Arc;
 use crate::analysing::Watch;
 use crate::config::{Config, TextureConfig, Toroidal};
 use crate::error::ApiError;
-use crate::files::{write_exclusive, writer_alive};
 use crate::state::AppState;
 use crate::textures::Texture;
+use textile_core::files::{write_exclusive, writer_alive};
 
 /// The folder of uploaded textures inside the data directory.
 pub const UPLOADS_DIR: &str = "uploads";

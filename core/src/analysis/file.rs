@@ -4,7 +4,6 @@
 //! wrong is a typed [`AnalysisFileProblem`].
 
 use std::fs;
-use std::io::Write;
 use std::path::Path;
 
 use crate::analysis::features::{RUNTIME_DIMS, TAPS5};
@@ -86,24 +85,13 @@ impl Analysis {
     }
 }
 
-/// Write `bytes` to `path` atomically: a temporary file beside it, fsync, rename (removed
-/// again on failure), so a reader never sees half a file.
+/// Write `bytes` to `path` atomically ([`crate::files::write_atomic`]: a temporary file beside
+/// it, fsync, rename), creating its folder first, so a reader never sees half a file.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let io = |source| CoreError::Io { path: path.to_path_buf(), source };
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     fs::create_dir_all(dir).map_err(io)?;
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result.map_err(io)
+    crate::files::write_atomic(path, bytes).map_err(io)
 }
 
 struct Reader<'a> {

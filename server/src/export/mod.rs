@@ -255,7 +255,7 @@ pub struct Report {
 
 /// Run an export to `output` (`.pmtiles` or `.mbtiles`).
 pub fn run(plan: &Plan, output: &Path) -> Result<Report, String> {
-    let tmp = crate::files::temp_path(output);
+    let tmp = textile_core::files::temp_path(output);
     let started = std::time::Instant::now();
     let result = write(plan, output, &tmp);
     match result {

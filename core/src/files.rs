@@ -1,4 +1,5 @@
-//! Files written whole or not at all: the temporary name a file is written under until it is
+//! Files written whole or not at all — analyses, extractions, uploads, rendered images and
+//! archives, by the library and the service alike: the temporary name a file is written under until it is
 //! complete (`.NAME.tmp-PID` beside it), the atomic write through it (replacing, or only where
 //! no file is: exclusive), and telling whether such a
 //! temporary file belongs to a process that still runs (another replica sharing a directory)
