@@ -9,7 +9,7 @@
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use textile_core::{Analysis, Exemplar, ExemplarOptions, Progress};
+use textile_core::{Analysis, Cancel, Exemplar, ExemplarOptions, Progress};
 
 /// Records the longest time between two progress reports.
 struct Gaps(Mutex<(Instant, Duration, u32)>);
@@ -79,7 +79,7 @@ fn main() {
     for (name, ex) in exemplars(side) {
         let gaps = Gaps(Mutex::new((Instant::now(), Duration::ZERO, 0)));
         let t = Instant::now();
-        Analysis::try_build(&ex, &gaps).expect("analysis");
+        Analysis::try_build(&ex, &gaps, &Cancel::new()).expect("analysis");
         let s = t.elapsed().as_secs_f64();
         let base = *natural.get_or_insert(s);
         let (_, gap, steps) = *gaps.0.lock().unwrap();

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use textile_core::analysis::{IndexChoice, FIRST_CORRECTED_LEVEL};
-use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress};
+use textile_core::{Analysis, Cancel, Exemplar, ExemplarOptions, NoProgress};
 
 fn exemplar(name: &str, side: u32) -> Option<Exemplar> {
     let shared = std::env::var("SHARED")
@@ -53,7 +53,7 @@ fn main() {
             };
             let time = |index| {
                 let t = Instant::now();
-                let a = Analysis::try_build_with(&ex, index, &NoProgress).expect("analysis");
+                let a = Analysis::try_build_with(&ex, index, &NoProgress, &Cancel::new()).expect("analysis");
                 (a, t.elapsed().as_secs_f64())
             };
             let (exact, te) = time(IndexChoice::Exact);

@@ -42,6 +42,7 @@
 
 pub mod analysis;
 pub mod cache;
+pub mod cancel;
 pub mod error;
 pub mod exemplar;
 pub mod files;
@@ -57,6 +58,7 @@ pub mod tsvq;
 
 pub use analysis::{Analysis, AnalysisHeader, NoProgress, Progress, ALGORITHM_VERSION};
 pub use cache::{Pyramid, PyramidStats};
+pub use cancel::Cancel;
 pub use error::{AnalysisFileProblem, CoreError, Result};
 pub use exemplar::{Exemplar, ExemplarOptions};
 pub use geom::Rect;

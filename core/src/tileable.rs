@@ -13,6 +13,7 @@
 use rayon::prelude::*;
 
 use crate::analysis::Progress;
+use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::Exemplar;
 use crate::hash::hash;
@@ -203,7 +204,12 @@ pub fn check(ex: &Exemplar, opts: &TileableOptions) -> Result<u32> {
 }
 
 /// Synthesize a seamless `size × size` texture from `ex`. `progress` hears of every row swept.
-pub fn synthesize(ex: &Exemplar, opts: &TileableOptions, progress: &dyn Progress) -> Result<RgbWindow> {
+pub fn synthesize(
+    ex: &Exemplar,
+    opts: &TileableOptions,
+    progress: &dyn Progress,
+    cancel: &Cancel,
+) -> Result<RgbWindow> {
     let levels = check(ex, opts)? as usize;
     let m = ex.side as usize;
     let mut pyr = vec![Level { w: m, h: m, px: ex.pixels.iter().map(|p| p.map(|c| c as f32)).collect() }];
@@ -246,9 +252,7 @@ pub fn synthesize(ex: &Exemplar, opts: &TileableOptions, progress: &dyn Progress
             let (shape, (cands, tree)) =
                 if sweep + 1 < SWEEPS { (&CAUSAL[..], &searches[0]) } else { (&FULL[..], &searches[1]) };
             for y in 0..s {
-                if progress.cancelled() {
-                    return Err(CoreError::Cancelled);
-                }
+                cancel.check()?;
                 for x in 0..s {
                     neighbourhood(shape, &level, parent, x as i64, y as i64, &mut q);
                     let best = match (tree, opts.search) {
@@ -276,7 +280,7 @@ pub fn synthesize(ex: &Exemplar, opts: &TileableOptions, progress: &dyn Progress
 /// around it with no border rule. Deterministic for a seed.
 pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
     let opts = TileableOptions { size: ex.side, seed, search: Search::Tsvq { backtrack: DEFAULT_BACKTRACK } };
-    let img = synthesize(ex, &opts, &crate::analysis::NoProgress)?;
+    let img = synthesize(ex, &opts, &crate::analysis::NoProgress, &Cancel::new())?;
     let pixels: Vec<[u8; 3]> = img.pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
     let seam_ratio = crate::exemplar::seam_ratio(&pixels, ex.side as usize);
     let preparation = crate::exemplar::Preparation {

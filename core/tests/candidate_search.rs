@@ -5,7 +5,7 @@
 mod common;
 
 use textile_core::analysis::{IndexChoice, SearchIndex};
-use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress};
+use textile_core::{Analysis, Cancel, Exemplar, ExemplarOptions, NoProgress};
 
 /// The embedded gravel at `side`² (non-toroidal, stochastic: the hard case for search).
 fn gravel(side: u32) -> Exemplar {
@@ -25,8 +25,8 @@ fn bytes(a: &Analysis) -> Vec<u8> {
 #[test]
 fn coherent_candidates_keep_the_rules_and_mostly_equal_the_exact_ones() {
     let ex = gravel(256);
-    let exact = Analysis::try_build_with(&ex, IndexChoice::Exact, &NoProgress).unwrap();
-    let fast = Analysis::try_build_with(&ex, IndexChoice::Coherent, &NoProgress).unwrap();
+    let exact = Analysis::try_build_with(&ex, IndexChoice::Exact, &NoProgress, &Cancel::new()).unwrap();
+    let fast = Analysis::try_build_with(&ex, IndexChoice::Coherent, &NoProgress, &Cancel::new()).unwrap();
     assert_eq!(exact.header.index, SearchIndex::Exact);
     assert_eq!(fast.header.index, SearchIndex::Coherent);
     assert_ne!(exact.header.id, fast.header.id, "the search is part of the analysis id");
@@ -58,8 +58,8 @@ fn analyses_are_identical_with_one_thread_and_many() {
     for index in [IndexChoice::Coherent, IndexChoice::Exact] {
         let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
         let many = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
-        let a = one.install(|| Analysis::try_build_with(&ex, index, &NoProgress).unwrap());
-        let b = many.install(|| Analysis::try_build_with(&ex, index, &NoProgress).unwrap());
+        let a = one.install(|| Analysis::try_build_with(&ex, index, &NoProgress, &Cancel::new()).unwrap());
+        let b = many.install(|| Analysis::try_build_with(&ex, index, &NoProgress, &Cancel::new()).unwrap());
         assert_eq!(bytes(&a), bytes(&b), "{index:?}");
     }
 }

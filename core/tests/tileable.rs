@@ -5,7 +5,7 @@
 mod common;
 
 use textile_core::tileable::{synthesize, Search, TileableOptions};
-use textile_core::{CoreError, Exemplar, ExemplarOptions, NoProgress, RgbWindow};
+use textile_core::{Cancel, CoreError, Exemplar, ExemplarOptions, NoProgress, RgbWindow};
 
 fn gravel(side: u32) -> Exemplar {
     let bytes = std::fs::read(common::embedded_exemplar("gravel.png")).unwrap();
@@ -16,7 +16,7 @@ fn gravel(side: u32) -> Exemplar {
 }
 
 fn run(ex: &Exemplar, size: u32, seed: u64, search: Search) -> RgbWindow {
-    synthesize(ex, &TileableOptions { size, seed, search }, &NoProgress).unwrap()
+    synthesize(ex, &TileableOptions { size, seed, search }, &NoProgress, &Cancel::new()).unwrap()
 }
 
 /// Mean absolute difference between horizontally and vertically adjacent pixels: across the
@@ -76,7 +76,9 @@ fn tsvq_with_unlimited_backtracking_equals_exhaustive_search() {
 #[test]
 fn unusable_requests_are_clear_errors() {
     let ex = gravel(128);
-    let err = |size, search| synthesize(&ex, &TileableOptions { size, seed: 0, search }, &NoProgress).unwrap_err();
+    let err = |size, search| {
+        synthesize(&ex, &TileableOptions { size, seed: 0, search }, &NoProgress, &Cancel::new()).unwrap_err()
+    };
     let s = Search::Tsvq { backtrack: 8 };
     for (size, says) in [(100, "multiple of 8"), (16, "outside 32"), (8192, "outside 32")] {
         let e = err(size, s);

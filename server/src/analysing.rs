@@ -1,13 +1,13 @@
 //! Where and how analyses run in the service: a rayon pool of their own whose threads run at the
-//! lowest CPU priority (Linux `SCHED_IDLE`, elsewhere the highest nice value), so an analysis
+//! lowest CPU priority (Linux `SCHED_IDLE`, else the thread's highest nice value), so an analysis
 //! only gets the CPU time that tile work leaves idle and can never starve serving; and the watch
 //! over one analysis — its progress in percent on the texture, and what stops it: the texture's
 //! removal, the service stopping, or its time budget running out.
 
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
-use crate::textures::Texture;
+use textile_core::Cancel;
 
 /// The analysis pool.
 pub struct AnalysisPool(rayon::ThreadPool);
@@ -29,15 +29,12 @@ impl AnalysisPool {
     pub fn run<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
         self.0.install(f)
     }
-
-    /// Its threads.
-    pub fn threads(&self) -> usize {
-        self.0.current_num_threads()
-    }
 }
 
 /// Put the calling thread at the lowest CPU priority there is: it runs only when no other
-/// thread wants the core. Failure is harmless (the pool is still bounded), so it is ignored.
+/// thread wants the core. Linux sets both per thread; elsewhere the same calls would lower the
+/// whole process, serving included, so the pool is only bounded there. Failure is harmless (the
+/// pool is still bounded), so it is ignored.
 fn lowest_priority() {
     #[cfg(target_os = "linux")]
     {
@@ -49,32 +46,36 @@ fn lowest_priority() {
             }
         }
     }
-    #[cfg(all(unix, not(target_os = "linux")))]
-    // SAFETY: a plain system call; on these systems it lowers the whole process's priority.
-    unsafe {
-        libc::setpriority(libc::PRIO_PROCESS, 0, 19);
-    }
 }
 
 /// The watch over one texture's analysis: its progress kept on the texture (percent), and the
-/// answer to whether it should stop — removed, stopping, or past its deadline.
+/// token that stops it — set when the texture is removed, when the service stops, or at its
+/// deadline.
 pub struct Watch<'a> {
-    tex: &'a Texture,
-    stop: &'a (dyn Fn() -> bool + Sync),
+    /// The texture's id, for the log.
+    id: &'a str,
+    /// Where its progress is kept, in percent.
+    progress: &'a AtomicU32,
     budget: Duration,
-    deadline: Instant,
+    cancel: Cancel,
 }
 
 impl<'a> Watch<'a> {
-    /// Watch `tex`'s analysis, started now, for at most `budget`; `stop` says when the service
-    /// is stopping.
-    pub fn new(tex: &'a Texture, stop: &'a (dyn Fn() -> bool + Sync), budget: Duration) -> Self {
-        Watch { tex, stop, budget, deadline: Instant::now() + budget }
+    /// Watch the analysis of texture `id`, started now, for at most `budget`: its progress kept
+    /// in `progress`, stopped once `removed` (the texture's) or `stopping` (the service's) is set.
+    pub fn new(id: &'a str, progress: &'a AtomicU32, removed: &Cancel, stopping: &Cancel, budget: Duration) -> Self {
+        let cancel = Cancel::within(&[removed, stopping], Some(Instant::now() + budget));
+        Watch { id, progress, budget, cancel }
+    }
+
+    /// The token the analysis is run with.
+    pub fn cancel(&self) -> &Cancel {
+        &self.cancel
     }
 
     /// Whether the time budget has run out.
     pub fn timed_out(&self) -> bool {
-        Instant::now() >= self.deadline
+        self.cancel.past_deadline()
     }
 
     /// The failure of an analysis stopped by its time budget.
@@ -91,13 +92,9 @@ impl textile_core::Progress for Watch<'_> {
         // Steps are bands of the candidate search, a level's bands cost alike, so the share of
         // steps done is a fair share of the work.
         let pct = if done >= total { 100 } else { (done as u64 * 100 / total.max(1) as u64).min(99) as u32 };
-        let before = self.tex.progress.swap(pct, Ordering::Relaxed);
+        let before = self.progress.swap(pct, Ordering::Relaxed);
         if pct / 25 != before / 25 || done == 0 {
-            tracing::info!("texture '{}': analysis {pct} % ({what})", self.tex.config.id);
+            tracing::info!("texture '{}': analysis {pct} % ({what})", self.id);
         }
-    }
-
-    fn cancelled(&self) -> bool {
-        self.tex.removed.is_set() || (self.stop)() || self.timed_out()
     }
 }

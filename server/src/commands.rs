@@ -9,7 +9,7 @@ use base64::Engine;
 use indicatif::{ProgressBar, ProgressStyle};
 use textile_core::modes::params::{Scope, COMMON};
 use textile_core::samples::{self, camera::GroundCamera, Footprint};
-use textile_core::{Analysis, Exemplar, ExemplarOptions, ModeParams, ParamReader, Progress, Pyramid};
+use textile_core::{Analysis, Cancel, Exemplar, ExemplarOptions, ModeParams, ParamReader, Progress, Pyramid};
 
 use crate::cli::{AnalyzeArgs, CliResult, ConfigArgs, ExportArgs, InfoArgs, RenderArgs, TileableArgs};
 use crate::config::{Config, Overrides, TextureConfig};
@@ -62,7 +62,7 @@ pub fn analyze(a: AnalyzeArgs) -> CliResult {
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
     ex.check_not_flat().map_err(|e| format!("{}: {e}", a.exemplar.display()))?;
     let t = std::time::Instant::now();
-    let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"))?;
+    let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"), &Cancel::new())?;
     an.save(&a.output)?;
     // The umbrella mode's extraction beside it (`FILE.umbrella`), for `textile info` and for
     // a server whose data directory holds both.
@@ -97,7 +97,7 @@ pub fn tileable(a: TileableArgs) -> CliResult {
     let search = if a.exact { Search::Exact } else { Search::Tsvq { backtrack: a.backtrack } };
     let opts = TileableOptions { size: a.size, seed: a.seed, search };
     let t = std::time::Instant::now();
-    let img = synthesize(&ex, &opts, &Bar(Mutex::new(None), "synthesizing"))?;
+    let img = synthesize(&ex, &opts, &Bar(Mutex::new(None), "synthesizing"), &Cancel::new())?;
     let bytes = encode(&img.pixels, img.width, img.height, format, Effort::Tight)?;
     write_atomic(&a.output, &bytes)?;
     println!(
@@ -251,7 +251,7 @@ pub fn render(a: RenderArgs) -> CliResult {
         if let Some([nx, ny]) = a.lattice {
             ex = ex.with_lattice(nx, ny)?;
         }
-        let an = Analysis::try_build_with(&ex, a.index, &textile_core::NoProgress)?;
+        let an = Analysis::try_build_with(&ex, a.index, &textile_core::NoProgress, &Cancel::new())?;
         Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
     } else {
         configured_texture(&a.config, a.texture.as_deref().unwrap_or_default())?

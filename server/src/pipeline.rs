@@ -9,12 +9,12 @@ use std::sync::Arc;
 
 use axum::body::Bytes;
 use textile_core::modes::{Cost, Needs};
-use textile_core::{ModeParams, Pyramid, Rect, Rendered, RgbWindow, View, TILE_SIZE};
+use textile_core::{Cancel, ModeParams, Pyramid, Rect, Rendered, RgbWindow, View, TILE_SIZE};
 
 use crate::encode::{encode, Effort, Format, ENCODER_VERSION};
 use crate::error::ApiError;
 use crate::request::{TileSpec, WindowSpec};
-use crate::state::{AppState, Cancel};
+use crate::state::AppState;
 use crate::textures::Texture;
 
 /// Version of everything besides the analysis and the mode that determines bytes (each mode's

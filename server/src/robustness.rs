@@ -80,7 +80,7 @@ pub fn degenerate_exemplar(data: &[u8]) {
         .collect();
     let ex = Exemplar::from_rgba(side, side, &px, &ExemplarOptions::default());
     if ex.check_not_flat().is_ok() {
-        let _ = Analysis::try_build(&ex, &NoProgress);
+        let _ = Analysis::try_build(&ex, &NoProgress, &textile_core::Cancel::new());
     }
 }
 

@@ -253,10 +253,9 @@ pub async fn run(
                 &local
             };
             let src = tex.source();
-            let cancelled = || cancel.is_set();
             let s = match &points {
-                Points::Texels(t) => samples::texels_until(&params, &src, cache, t, &cancelled)?,
-                Points::Footprints(f) => samples::footprints_until(&params, &src, cache, f, max_zoom_out, &cancelled)?,
+                Points::Texels(t) => samples::texels_until(&params, &src, cache, t, cancel)?,
+                Points::Footprints(f) => samples::footprints_until(&params, &src, cache, f, max_zoom_out, cancel)?,
             };
             fig[0].store(s.synthesized, Ordering::Relaxed);
             fig[1].store(s.windows, Ordering::Relaxed);

@@ -7,7 +7,7 @@ use std::sync::{Arc, RwLock};
 use std::time::Duration;
 
 use axum::body::Bytes;
-use textile_core::Pyramid;
+use textile_core::{Cancel, Pyramid};
 use tokio::sync::Semaphore;
 
 use crate::analysing::AnalysisPool;
@@ -224,22 +224,6 @@ impl AppState {
             // Timed out: `abandon` goes, and the job stops at its next step.
             Err(_) => Err(ApiError::timeout()),
         }
-    }
-}
-
-/// Set when the requester of a synthesis is gone: work that comes in steps stops at the next.
-#[derive(Debug, Clone, Default)]
-pub struct Cancel(Arc<std::sync::atomic::AtomicBool>);
-
-impl Cancel {
-    /// Whether the work should stop.
-    pub fn is_set(&self) -> bool {
-        self.0.load(std::sync::atomic::Ordering::Relaxed)
-    }
-
-    /// Ask the work to stop.
-    pub fn set(&self) {
-        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
     }
 }
 

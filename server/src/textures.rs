@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, OnceLock};
 
-use textile_core::{Analysis, Defaults, Exemplar, ExemplarOptions, Progress, Source};
+use textile_core::{Analysis, Cancel, Defaults, Exemplar, ExemplarOptions, Progress, Source};
 
 use crate::analysing;
 use crate::config::{Config, TextureConfig};
@@ -17,7 +17,6 @@ use crate::config::{Config, TextureConfig};
 /// Zoom steps served beyond native, magnified (design note §1.8); `@2x` tiles at the highest
 /// zoom are rendered one step further, within [`textile_core::modes::magnify::MAX_ZOOM_IN`].
 pub const MAGNIFY_STEPS: u32 = 3;
-use crate::state::Cancel;
 
 /// Exemplars compiled into the binary (`config/exemplars`; licences in LICENSE.md there).
 const EMBEDDED: &[(&str, &[u8])] = &[
@@ -410,7 +409,7 @@ pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, 
 /// Load or compute the analysis of every texture of a prepared registry that `which` selects,
 /// in configuration order (each texture serves its analysis-needing modes as soon as its own is
 /// attached), each watched by an [`analysing::Watch`]: `stop` is asked between textures and
-/// during each analysis, and ends the loading with [`LoadError::Stopped`] once it answers true;
+/// during each analysis, and ends the loading with [`LoadError::Stopped`] once it is set;
 /// an analysis longer than `analysis_timeout_secs` ends it with [`LoadError::AnalysisTimeout`].
 ///
 /// The data directory is checked first: stale temporary files of interrupted writes are removed,
@@ -421,17 +420,17 @@ pub fn analyse_registry(
     reg: &Registry,
     which: &dyn Fn(&Texture) -> bool,
     log: &dyn Fn(String),
-    stop: &(dyn Fn() -> bool + Sync),
+    stop: &Cancel,
 ) -> Result<(), LoadError> {
     let data_dir = cfg.data_dir();
     let storable = data_dir_storable(cfg, log);
     let budget = std::time::Duration::from_secs(cfg.analysis_timeout_secs);
     for tex in reg.list.iter().filter(|t| which(t)) {
-        if stop() {
+        if stop.is_set() {
             return Err(LoadError::Stopped);
         }
-        let watch = analysing::Watch::new(tex, stop, budget);
-        match analyse_texture(&data_dir, storable, tex, log, &watch) {
+        let watch = analysing::Watch::new(&tex.config.id, &tex.progress, &tex.removed, stop, budget);
+        match analyse_texture(&data_dir, storable, tex, log, &watch, watch.cancel()) {
             Ok(()) => {}
             Err(textile_core::CoreError::Cancelled) if watch.timed_out() => {
                 return Err(LoadError::AnalysisTimeout { id: tex.config.id.clone(), message: watch.timeout_message() })
@@ -479,6 +478,7 @@ pub fn analyse_texture(
     tex: &Texture,
     log: &dyn Fn(String),
     progress: &dyn Progress,
+    cancel: &Cancel,
 ) -> Result<(), textile_core::CoreError> {
     let t = &tex.config;
     let ex = &tex.exemplar;
@@ -498,7 +498,7 @@ pub fn analyse_texture(
                 Err(e) => log(format!("texture '{}': {e}; recomputing", t.id)),
             }
             let started = std::time::Instant::now();
-            let a = Analysis::try_build_with(ex, t.index, progress)?;
+            let a = Analysis::try_build_with(ex, t.index, progress, cancel)?;
             // A texture removed while it was analysed leaves nothing behind.
             let stored = if tex.removed.is_set() {
                 "not stored (the texture was removed)".to_string()
@@ -560,6 +560,6 @@ pub fn analyse_texture(
 /// Both phases: every texture with its analysis.
 pub fn load_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, LoadError> {
     let reg = prepare_registry(cfg, log)?;
-    analyse_registry(cfg, &reg, &|_| true, log, &|| false)?;
+    analyse_registry(cfg, &reg, &|_| true, log, &Cancel::new())?;
     Ok(reg)
 }

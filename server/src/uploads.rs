@@ -287,12 +287,13 @@ pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
             move || {
                 let data_dir = st.config.data_dir();
                 let log = |s: String| tracing::info!("{s}");
-                let stop = || st.stopping.is_set();
-                let watch = Watch::new(&tex, &stop, std::time::Duration::from_secs(st.config.analysis_timeout_secs));
+                let budget = std::time::Duration::from_secs(st.config.analysis_timeout_secs);
+                let watch = Watch::new(&tex.config.id, &tex.progress, &tex.removed, &st.stopping, budget);
                 // The upload was just stored beside it, so the data directory is writable (a
                 // failed save is still only a warning).
                 let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    st.analysis_pool.run(|| crate::textures::analyse_texture(&data_dir, true, &tex, &log, &watch))
+                    st.analysis_pool
+                        .run(|| crate::textures::analyse_texture(&data_dir, true, &tex, &log, &watch, watch.cancel()))
                 }));
                 match outcome {
                     Ok(Err(textile_core::CoreError::Cancelled)) if watch.timed_out() => Some(watch.timeout_message()),

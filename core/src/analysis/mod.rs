@@ -16,6 +16,7 @@ use crate::analysis::features::{
     RUNTIME_DIMS, SEARCH_DIMS,
 };
 use crate::analysis::stack::{build_stack, to_u8};
+use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
 use crate::lattice::Lattice;
@@ -106,12 +107,6 @@ impl IndexChoice {
 pub trait Progress: Sync {
     /// `done` of `total` steps are finished; `what` names the current step.
     fn step(&self, done: u32, total: u32, what: &str);
-
-    /// Whether the work should stop (asked between steps by [`Analysis::try_build`]: at least
-    /// every [`candidates::BANDS`]-th of a level).
-    fn cancelled(&self) -> bool {
-        false
-    }
 }
 
 /// A [`Progress`] that ignores everything.
@@ -187,27 +182,31 @@ pub struct Analysis {
 impl Analysis {
     /// Analyse a prepared exemplar with the search [`IndexChoice::Auto`] picks. Deterministic:
     /// the same exemplar always gives the same analysis, whatever the thread count.
+    ///
+    /// # Panics
+    /// If the search exceeds its work budget ([`CoreError::AnalysisWork`]), which no exemplar
+    /// measured comes near; analyse untrusted exemplars with [`Analysis::try_build`].
     pub fn build(ex: &Exemplar, progress: &dyn Progress) -> Analysis {
-        struct Uncancellable<'a>(&'a dyn Progress);
-        impl Progress for Uncancellable<'_> {
-            fn step(&self, done: u32, total: u32, what: &str) {
-                self.0.step(done, total, what)
-            }
-        }
-        match Self::try_build(ex, &Uncancellable(progress)) {
+        match Self::try_build(ex, progress, &Cancel::new()) {
             Ok(a) => a,
-            Err(_) => unreachable!("an uncancellable build is never cancelled"),
+            Err(e) => panic!("analysis failed: {e}"),
         }
     }
 
-    /// [`Analysis::build`], stopped between steps with [`CoreError::Cancelled`] once
-    /// `progress` says it is [`Progress::cancelled`].
-    pub fn try_build(ex: &Exemplar, progress: &dyn Progress) -> Result<Analysis> {
-        Self::try_build_with(ex, IndexChoice::Auto, progress)
+    /// [`Analysis::build`], stopped between steps (at least every [`candidates::BANDS`]-th of a
+    /// level) with [`CoreError::Cancelled`] once `cancel` is set, or with
+    /// [`CoreError::AnalysisWork`] past its work budget.
+    pub fn try_build(ex: &Exemplar, progress: &dyn Progress, cancel: &Cancel) -> Result<Analysis> {
+        Self::try_build_with(ex, IndexChoice::Auto, progress, cancel)
     }
 
     /// [`Analysis::try_build`] with the candidate search chosen by `index`.
-    pub fn try_build_with(ex: &Exemplar, index: IndexChoice, progress: &dyn Progress) -> Result<Analysis> {
+    pub fn try_build_with(
+        ex: &Exemplar,
+        index: IndexChoice,
+        progress: &dyn Progress,
+        cancel: &Cancel,
+    ) -> Result<Analysis> {
         let search = index.resolve(ex.side);
         let m = ex.side as usize;
         let levels = ex.side.trailing_zeros();
@@ -221,9 +220,7 @@ impl Analysis {
         for l in FIRST_CORRECTED_LEVEL..=levels {
             let first = 1 + (l - FIRST_CORRECTED_LEVEL) * per_level;
             let between = |done: usize| {
-                if progress.cancelled() {
-                    return Err(CoreError::Cancelled);
-                }
+                cancel.check()?;
                 progress.step(first + done as u32, total, "neighbourhoods and candidates");
                 Ok(())
             };

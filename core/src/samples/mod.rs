@@ -22,6 +22,7 @@ pub mod filter;
 use rayon::prelude::*;
 
 use crate::cache::Pyramid;
+use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::geom::Rect;
 use crate::modes::{ModeParams, Source, View};
@@ -148,7 +149,7 @@ fn plan(texels: &[Texel]) -> Vec<Window> {
 /// The colours of `texels` (any order, duplicates allowed) for a mode with its parameters,
 /// through `cache` (for a batch's cones to be shared, it must be on).
 pub fn texels(params: &ModeParams, src: &Source, cache: &Pyramid, texels: &[Texel]) -> Result<Sampled> {
-    texels_until(params, src, cache, texels, &|| false)
+    texels_until(params, src, cache, texels, &Cancel::new())
 }
 
 /// Texels planned and rendered together at most: a bigger batch is cut into spatially sorted
@@ -159,17 +160,17 @@ const CHUNK_TEXELS: usize = 1 << 16;
 /// Footprints filtered together at most (each has up to 8 taps).
 const CHUNK_FOOTPRINTS: usize = CHUNK_TEXELS / 8;
 
-/// [`texels`], giving up with [`CoreError::Cancelled`] between windows once `cancelled`
-/// answers true (the client went away).
+/// [`texels`], giving up with [`CoreError::Cancelled`] between windows once `cancel` is set
+/// (the client went away).
 pub fn texels_until(
     params: &ModeParams,
     src: &Source,
     cache: &Pyramid,
     texels: &[Texel],
-    cancelled: &(dyn Fn() -> bool + Sync),
+    cancel: &Cancel,
 ) -> Result<Sampled> {
     if texels.len() <= CHUNK_TEXELS {
-        return texels_together(params, src, cache, texels, cancelled);
+        return texels_together(params, src, cache, texels, cancel);
     }
     let mut order: Vec<u32> = (0..texels.len() as u32).collect();
     order.sort_unstable_by_key(|&i| cell_order(&texels[i as usize]));
@@ -177,7 +178,7 @@ pub fn texels_until(
     let (mut synthesized, mut windows) = (0, 0);
     for chunk in order.chunks(CHUNK_TEXELS) {
         let part: Vec<Texel> = chunk.iter().map(|&i| texels[i as usize]).collect();
-        let got = texels_together(params, src, cache, &part, cancelled)?;
+        let got = texels_together(params, src, cache, &part, cancel)?;
         for (&i, c) in chunk.iter().zip(got.colors) {
             colors[i as usize] = c;
         }
@@ -193,14 +194,14 @@ fn texels_together(
     src: &Source,
     cache: &Pyramid,
     texels: &[Texel],
-    cancelled: &(dyn Fn() -> bool + Sync),
+    cancel: &Cancel,
 ) -> Result<Sampled> {
     let windows = plan(texels);
     let rendered: Vec<Result<WindowSamples>> = windows
         .par_iter()
         .with_max_len(1)
         .map(|(zoom_out, rect, members)| {
-            if cancelled() {
+            if cancel.is_set() {
                 return Err(CoreError::Cancelled);
             }
             let r = params.render(src, cache, View::out(*zoom_out, *rect))?;
@@ -235,7 +236,7 @@ pub fn footprints(
     points: &[Footprint],
     max_zoom_out: u32,
 ) -> Result<Sampled> {
-    footprints_until(params, src, cache, points, max_zoom_out, &|| false)
+    footprints_until(params, src, cache, points, max_zoom_out, &Cancel::new())
 }
 
 /// [`footprints`] with cancellation (see [`texels_until`]).
@@ -245,7 +246,7 @@ pub fn footprints_until(
     cache: &Pyramid,
     points: &[Footprint],
     max_zoom_out: u32,
-    cancelled: &(dyn Fn() -> bool + Sync),
+    cancel: &Cancel,
 ) -> Result<Sampled> {
     let mut colors = Vec::with_capacity(points.len());
     let (mut synthesized, mut windows) = (0, 0);
@@ -255,7 +256,7 @@ pub fn footprints_until(
             other => other,
         })?;
         let wanted: Vec<Texel> = taps.iter().flat_map(|t| t.iter().map(|&(texel, _)| texel)).collect();
-        let got = texels_until(params, src, cache, &wanted, cancelled)?;
+        let got = texels_until(params, src, cache, &wanted, cancel)?;
         let mut at = 0;
         colors.extend(taps.iter().map(|t| {
             let c = filter::blend(t.iter().map(|&(_, w)| w).zip(&got.colors[at..at + t.len()]));

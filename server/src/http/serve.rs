@@ -84,9 +84,8 @@ async fn serve(cfg: Config) -> CliResult {
             let cfg = crate::uploads::with_stored(&state.config, &log);
             let reg = Arc::new(prepare_registry(&cfg, &log)?);
             state.set_registry(reg.clone());
-            let stop = || state.stopping.is_set();
             let now = |t: &Texture| !t.config.uploaded || has_current_analysis(&cfg.data_dir(), t);
-            state.analysis_pool.run(|| analyse_registry(&cfg, &reg, &now, &log, &stop))?;
+            state.analysis_pool.run(|| analyse_registry(&cfg, &reg, &now, &log, &state.stopping))?;
             state.loaded.store(true, std::sync::atomic::Ordering::Relaxed);
             Ok(())
         })
