@@ -69,21 +69,26 @@ fn the_extraction_is_drawn_and_reported() {
     let dir = tempfile::tempdir().unwrap();
     let sheet = dir.path().join("sheet.png");
     let run = std::process::Command::new(binary())
-        .args(["render", "--texture", "gravel", "--mode", "umbrella", "--debug-umbrellas", "-o"])
+        .args(["render", "--texture", "gravel", "--mode", "umbrella", "--sheet", "-o"])
         .arg(&sheet)
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&run.stdout);
-    assert!(run.status.success() && text.contains("bases of"), "{text}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success() && text.contains("umbrella extraction (") && text.contains(" bases)"),
+        "{text}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let img = image::open(&sheet).unwrap().to_rgb8();
     assert!(img.width() > 64 && img.height() > 64);
-    // Without --mode umbrella the flag is refused.
+    // A mode that prepares nothing has no sheet: refused, naming the mode.
     let run = std::process::Command::new(binary())
-        .args(["render", "--texture", "gravel", "--debug-umbrellas", "-o"])
+        .args(["render", "--texture", "gravel", "--mode", "mosaic", "--sheet", "-o"])
         .arg(dir.path().join("x.png"))
         .output()
         .unwrap();
-    assert!(!run.status.success() && String::from_utf8_lossy(&run.stderr).contains("--mode umbrella"));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && err.contains("mode=mosaic prepares nothing"), "{err}");
     // textile info reports the extraction of an analysis file.
     let file = dir.path().join("gravel.tex");
     let exemplar = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png");
@@ -91,10 +96,10 @@ fn the_extraction_is_drawn_and_reported() {
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let run = std::process::Command::new(binary()).arg("info").arg(&file).output().unwrap();
     let text = String::from_utf8_lossy(&run.stdout);
-    assert!(text.contains("umbrella elements:") && text.contains("bases"), "{text}");
+    assert!(text.contains("umbrella extraction: ") && text.contains("bases "), "{text}");
     // The extraction is stored beside the analysis, and info reads it from there.
     let beside = dir.path().join("gravel.umbrella");
-    assert!(text.contains(&format!("umbrella source:   stored in {}", beside.display())), "{text}");
+    assert!(text.contains(&format!("umbrella extraction source: stored in {}", beside.display())), "{text}");
     // A damaged one is named and the extraction computed instead — same report, no panic.
     let mut bytes = std::fs::read(&beside).unwrap();
     let n = bytes.len();
@@ -103,7 +108,7 @@ fn the_extraction_is_drawn_and_reported() {
     let run = std::process::Command::new(binary()).arg("info").arg(&file).output().unwrap();
     let damaged = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success() && damaged.contains("checksum mismatch"), "{damaged}");
-    let elements = |t: &str| t.lines().find(|l| l.starts_with("umbrella elements:")).map(str::to_string);
+    let elements = |t: &str| t.lines().find(|l| l.starts_with("umbrella extraction:")).map(str::to_string);
     assert_eq!(elements(&damaged), elements(&text));
 }
 
@@ -157,7 +162,10 @@ async fn a_hand_made_umbrella_set_is_configured_and_served() {
         r#"{"bases": [{"image": "red.png", "variants": ["red2.png"]}, {"image": "yellow.png"}], "foreground": 0.8}"#,
     )
     .unwrap();
-    let cfg = support::gravel_textures_config(dir.path(), &[("plain", ""), ("made", "umbrellas = \"set/set.json\"")]);
+    let cfg = support::gravel_textures_config(
+        dir.path(),
+        &[("plain", ""), ("made", "[textures.umbrella]\nset = \"set/set.json\"")],
+    );
     let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
     let made = s.image("/tiles/made/7/2/3.png?mode=umbrella").await;
     let plain = s.image("/tiles/plain/7/2/3.png?mode=umbrella").await;
@@ -182,7 +190,7 @@ async fn a_hand_made_umbrella_set_is_configured_and_served() {
     })
     .unwrap();
     std::fs::write(set.join("bad.json"), r#"{"bases": [{"image": "flat.png"}]}"#).unwrap();
-    let bad = support::gravel_textures_config(dir.path(), &[("bad", "umbrellas = \"set/bad.json\"")]);
+    let bad = support::gravel_textures_config(dir.path(), &[("bad", "[textures.umbrella]\nset = \"set/bad.json\"")]);
     let out = dir.path().join("bad.png");
     let run = std::process::Command::new(binary())
         .args(["render", "--config", bad.to_str().unwrap(), "--texture", "bad", "--mode", "umbrella"])
@@ -190,9 +198,43 @@ async fn a_hand_made_umbrella_set_is_configured_and_served() {
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&run.stderr);
-    assert!(
-        !run.status.success() && err.contains("umbrellas") && err.contains("flat.png") && err.contains("alpha"),
-        "{err}"
-    );
+    assert!(!run.status.success() && err.contains("set") && err.contains("flat.png") && err.contains("alpha"), "{err}");
     assert!(!out.exists());
+}
+
+/// A hand-made set belongs to the umbrella mode's prepared state, not to the exemplar: editing
+/// it changes the umbrella tiles' ETags and nothing else — the synth, mosaic and tiling ETags
+/// stay, and the stored analysis is loaded, not recomputed, its file untouched.
+#[tokio::test]
+async fn editing_a_hand_made_set_changes_only_the_umbrella_etags() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("data");
+    let set = dir.path().join("set");
+    std::fs::create_dir_all(&set).unwrap();
+    std::fs::write(set.join("red.png"), disc_png(18, [220, 30, 30])).unwrap();
+    std::fs::write(set.join("blue.png"), disc_png(16, [30, 40, 220])).unwrap();
+    let cfg = support::gravel_textures_config(dir.path(), &[("made", "[textures.umbrella]\nset = \"set/set.json\"")]);
+    let mut seen = Vec::new();
+    for (round, image) in [(1, "red.png"), (2, "blue.png")] {
+        std::fs::write(set.join("set.json"), format!(r#"{{"bases": [{{"image": "{image}"}}]}}"#)).unwrap();
+        let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).data_dir(&data).start();
+        let meta = s.json("/textures/made").await;
+        assert_eq!(meta["prepared"]["umbrella"]["source"], "hand-made", "{meta}");
+        let analysis = std::fs::read(data.join("made.tex")).unwrap();
+        if round == 2 {
+            assert!(s.log_text().contains("texture 'made': loaded analysis"), "{}", s.log_text());
+        }
+        let mut etags = Vec::new();
+        for mode in ["synth", "mosaic", "tiling", "umbrella"] {
+            let r = s.get(&format!("/tiles/made/8/1/2.png?mode={mode}")).await;
+            assert_eq!(r.status(), 200, "{mode}");
+            etags.push(r.headers()["etag"].to_str().unwrap().to_string());
+        }
+        seen.push((etags, analysis));
+        s.terminate();
+    }
+    let ((before, a1), (after, a2)) = (&seen[0], &seen[1]);
+    assert_eq!(before[..3], after[..3], "synth, mosaic and tiling keep their ETags");
+    assert_ne!(before[3], after[3], "the umbrella tiles change with the set");
+    assert!(a1 == a2, "the analysis file is the same bytes");
 }

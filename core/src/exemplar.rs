@@ -2,14 +2,11 @@
 //! crop to the centred square, bring the side to a power of two with an exact integer area
 //! filter, and decide whether the exemplar wraps around seamlessly (toroidal).
 
-use std::sync::Arc;
-
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
 use crate::lattice::Lattice;
 use crate::mask::RandomnessMask;
-use crate::modes::umbrella::extract::Elements;
 
 /// Smallest exemplar side accepted on input.
 pub const MIN_INPUT_SIDE: u32 = 16;
@@ -78,19 +75,6 @@ pub struct Exemplar {
     pub randomness_mask: Option<RandomnessMask>,
     /// The lattice of a near-regular exemplar ([`Exemplar::with_lattice`]).
     pub lattice: Option<Lattice>,
-    /// A hand-made umbrella set the umbrella mode uses instead of extracting elements
-    /// ([`Exemplar::with_umbrella_set`]).
-    pub umbrella_set: Option<UmbrellaSet>,
-}
-
-/// A hand-made umbrella set ([`crate::modes::umbrella::handmade`]) with the hash of its
-/// stored form, which identifies it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct UmbrellaSet {
-    /// The elements.
-    pub elements: Arc<Elements>,
-    /// BLAKE3 (hex) of its stored form.
-    pub hash: String,
 }
 
 impl Exemplar {
@@ -145,7 +129,6 @@ impl Exemplar {
             hires: None,
             randomness_mask: None,
             lattice: None,
-            umbrella_set: None,
         }
     }
 
@@ -191,10 +174,6 @@ impl Exemplar {
             h.update(&l.nx.to_le_bytes());
             h.update(&l.ny.to_le_bytes());
         }
-        if let Some(set) = &self.umbrella_set {
-            h.update(b"umbrella-set");
-            h.update(set.hash.as_bytes());
-        }
         if let Some(hires) = &self.hires {
             h.update(b"hires");
             h.update(hires.as_flattened());
@@ -224,7 +203,6 @@ impl Exemplar {
             hires: Some(hires.pixels),
             randomness_mask: None,
             lattice: None,
-            umbrella_set: None,
         })
     }
 
@@ -254,14 +232,6 @@ impl Exemplar {
             .collect();
         self.randomness_mask = Some(RandomnessMask::new(self.side, luma, self.toroidal)?);
         Ok(self)
-    }
-
-    /// This exemplar with a hand-made umbrella set: the umbrella mode uses its elements
-    /// instead of extracting them from the pixels (part of the exemplar's content hash).
-    pub fn with_umbrella_set(mut self, elements: Elements) -> Exemplar {
-        let hash = blake3::hash(&crate::modes::umbrella::store::to_bytes("hand-made", &Ok(Arc::new(elements.clone()))));
-        self.umbrella_set = Some(UmbrellaSet { elements: Arc::new(elements), hash: hash.to_hex().to_string() });
-        self
     }
 
     /// This exemplar as a near-regular one (design note §1.9): a rectified exemplar that a

@@ -297,6 +297,5 @@ pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
         hires: None,
         randomness_mask: None,
         lattice: None,
-        umbrella_set: None,
     })
 }

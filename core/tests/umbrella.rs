@@ -11,7 +11,10 @@ mod common;
 use proptest::prelude::*;
 use textile_core::modes::umbrella::extract::{ray, RAYS};
 use textile_core::modes::umbrella::shape::fold_free;
-use textile_core::modes::umbrella::{arrange::Arrangement, elements, umbrella_zooms, Umbrella, UmbrellaParams};
+use textile_core::modes::umbrella::{
+    arrange::Arrangement, elements, extraction_id, umbrella_zooms, Extraction, Umbrella, UmbrellaParams,
+};
+use textile_core::prepare::Prepared;
 use textile_core::{Exemplar, ExemplarOptions, Mode, Pyramid, Rect, RgbWindow, View};
 
 fn fixture(name: &str) -> Exemplar {
@@ -24,9 +27,27 @@ fn gravel() -> Exemplar {
         .unwrap()
 }
 
-fn render(ex: &Exemplar, p: &UmbrellaParams, view: View) -> RgbWindow {
-    let src = textile_core::Source { exemplar: ex, analysis: None };
+/// The umbrella state of `ex` (its extraction), prepared once per exemplar for the test run.
+fn prepared(ex: &Exemplar) -> std::sync::Arc<Prepared> {
+    static KEPT: std::sync::Mutex<Vec<(String, std::sync::Arc<Prepared>)>> = std::sync::Mutex::new(Vec::new());
+    let id = extraction_id(ex);
+    let mut kept = KEPT.lock().unwrap();
+    if let Some((_, p)) = kept.iter().find(|(k, _)| *k == id) {
+        return p.clone();
+    }
+    let p = std::sync::Arc::new(Prepared::new());
+    p.set(Umbrella::NAME, std::sync::Arc::new(Extraction::extract(ex)));
+    kept.push((id, p.clone()));
+    p
+}
+
+fn render_with(ex: &Exemplar, prepared: &Prepared, p: &UmbrellaParams, view: View) -> RgbWindow {
+    let src = textile_core::Source::exemplar(ex).with_prepared(prepared);
     <Umbrella as Mode>::render(p, &src, &Pyramid::off(), view).unwrap().image
+}
+
+fn render(ex: &Exemplar, p: &UmbrellaParams, view: View) -> RgbWindow {
+    render_with(ex, &prepared(ex), p, view)
 }
 
 #[test]
@@ -337,8 +358,9 @@ fn the_orientation_spread_comes_from_the_exemplar_and_bounds_the_rotations() {
 
 #[test]
 fn the_stored_extraction_reads_back_as_extracted_and_damage_is_named() {
-    use textile_core::modes::umbrella::{extraction_id, store};
-    use textile_core::AnalysisFileProblem;
+    use textile_core::modes::umbrella::store;
+    use textile_core::prepare::{load_or_compute, Input, Origin};
+    use textile_core::{AnalysisFileProblem, Cancel, NoProgress};
     let ex = fixture("smallstone.png");
     let (el, id) = elements(&ex).unwrap();
     assert_eq!(id, extraction_id(&ex));
@@ -360,25 +382,31 @@ fn the_stored_extraction_reads_back_as_extracted_and_damage_is_named() {
     let mut version = bytes.clone();
     version[8] = 9;
     assert!(matches!(store::from_bytes(&version), Err(AnalysisFileProblem::UnsupportedVersion { found: 9, .. })));
-    // load_or_extract: a missing file is written, a current one read, a stale or damaged one
-    // replaced; rendering is the same bytes whichever way the extraction came.
+    // The preparation's one path: a missing file is written, a current one read, a stale or
+    // damaged one replaced; rendering is the same bytes whichever way the extraction came.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("smallstone.umbrella");
-    let (a, s1) = store::load_or_extract(&ex, &path, true);
-    assert_eq!(s1, store::Source::Stored);
-    let (b, s2) = store::load_or_extract(&ex, &path, true);
-    assert_eq!(s2, store::Source::Loaded);
-    assert_eq!(a.unwrap(), b.unwrap());
+    let input = Input::exemplar(&ex);
+    let run = |store: bool| {
+        let (state, origin) =
+            load_or_compute::<Extraction>(&input, Some(&path), store, &|| true, &NoProgress, &Cancel::new()).unwrap();
+        (state, origin)
+    };
+    let (a, s1) = run(true);
+    assert!(matches!(&s1, Origin::Stored { why } if why.contains("no stored")), "{s1:?}");
+    let (b, s2) = run(true);
+    assert_eq!(s2, Origin::Loaded);
+    assert_eq!(a.outcome.unwrap(), b.outcome.clone().unwrap());
     std::fs::write(&path, store::to_bytes("another exemplar", &Ok(el.clone()))).unwrap();
-    assert_eq!(store::load_or_extract(&ex, &path, true).1, store::Source::Stored);
+    assert!(matches!(run(true).1, Origin::Stored { why } if why.contains("stale")));
     std::fs::write(&path, &flipped).unwrap();
-    assert_eq!(store::load_or_extract(&ex, &path, true).1, store::Source::Stored);
-    assert_eq!(store::load_or_extract(&ex, &path, false).1, store::Source::Loaded);
+    assert!(matches!(run(true).1, Origin::Stored { why } if why.contains("checksum")));
+    assert_eq!(run(false).1, Origin::Loaded);
     let view = View::native(Rect::new(-40, 17, 96, 64));
     let before = render(&ex, &UmbrellaParams::default(), view);
-    let (_, read) = store::from_bytes(&std::fs::read(&path).unwrap()).unwrap();
-    assert_eq!(*read.unwrap(), *el);
-    assert_eq!(render(&ex, &UmbrellaParams::default(), view), before);
+    let loaded = Prepared::new();
+    loaded.set(Umbrella::NAME, std::sync::Arc::new(b));
+    assert_eq!(render_with(&ex, &loaded, &UmbrellaParams::default(), view), before);
 }
 
 /// An element image with alpha: an ellipse of semi-axes `(a, b)` in colour `rgb` on a
@@ -421,7 +449,7 @@ fn a_hand_made_set_gives_its_bases_and_variants_and_bad_sets_are_named() {
         images
             .get(name)
             .cloned()
-            .ok_or_else(|| textile_core::CoreError::Param { name: "umbrellas", message: format!("no {name}") })
+            .ok_or_else(|| textile_core::CoreError::Param { name: "set", message: format!("no {name}") })
     };
     let json =
         br#"{"bases": [{"image": "red.png", "variants": ["red2.png"]}, {"image": "blue.png"}, {"image": "green.png"}],
@@ -445,10 +473,12 @@ fn a_hand_made_set_gives_its_bases_and_variants_and_bad_sets_are_named() {
         el.bases[0].texture[(el.bases[0].centre[1] as usize) * el.bases[0].w as usize + el.bases[0].centre[0] as usize];
     assert!(c[0] > 0.7 && c[1] < 0.3, "{c:?}");
     // An exemplar with the set renders its elements (deterministically), not gravel's.
-    let ex = gravel().with_umbrella_set(el.clone());
+    let ex = gravel();
+    let set = Prepared::new();
+    set.set(Umbrella::NAME, std::sync::Arc::new(Extraction::hand_made(&ex, el.clone())));
     let view = View::native(Rect::new(-64, 100, 128, 96));
-    let img = render(&ex, &UmbrellaParams::default(), view);
-    assert_eq!(img, render(&ex, &UmbrellaParams::default(), view));
+    let img = render_with(&ex, &set, &UmbrellaParams::default(), view);
+    assert_eq!(img, render_with(&ex, &set, &UmbrellaParams::default(), view));
     let reddish = img.pixels.chunks_exact(3).filter(|p| p[0] > 150 && p[1] < 90 && p[2] < 90).count();
     assert!(reddish * 20 > img.pixels.len() / 3, "{reddish} red pixels");
     assert_ne!(img, render(&gravel(), &UmbrellaParams::default(), view));
@@ -466,6 +496,6 @@ fn a_hand_made_set_gives_its_bases_and_variants_and_bad_sets_are_named() {
         (br#"{"bases": [{"image": "garbage.png"}]}"#, "garbage.png"),
     ] {
         let e = handmade::load(json, &read).unwrap_err().to_string();
-        assert!(e.contains("umbrellas") && e.contains(words), "{e}");
+        assert!(e.contains("set") && e.contains(words), "{e}");
     }
 }

@@ -10,17 +10,14 @@
 //! [`encode`] → [`http::content`] headers. `textile render` goes through the same
 //! [`pipeline::ImageJob`].
 
-pub mod analysing;
 pub mod assets;
 pub mod cache;
-pub mod cli;
-pub mod commands;
+pub mod cmd;
 pub mod config;
 pub mod encode;
 pub mod error;
 pub mod export;
 pub mod http;
-pub mod loadtest;
 pub mod memory;
 pub mod metrics;
 pub mod pipeline;
@@ -34,23 +31,5 @@ pub mod uploads;
 
 /// Parse the command line and run the chosen command; the process exit code.
 pub fn run() -> std::process::ExitCode {
-    use clap::Parser;
-    let cli = cli::Cli::parse();
-    let result = match cli.command {
-        None => http::serve::run(cli.serve),
-        Some(cli::Command::Serve(a)) => http::serve::run(a),
-        Some(cli::Command::Analyze(a)) => commands::analyze(a),
-        Some(cli::Command::Tileable(a)) => commands::tileable(a),
-        Some(cli::Command::Render(a)) => commands::render(a),
-        Some(cli::Command::Info(a)) => commands::info(a),
-        Some(cli::Command::Export(a)) => commands::export(a),
-        Some(cli::Command::Loadtest(a)) => loadtest::run(a),
-    };
-    match result {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("textile: error: {e}");
-            std::process::ExitCode::FAILURE
-        }
-    }
+    cmd::run()
 }

@@ -53,6 +53,10 @@ pub struct Metrics {
     pub level_cache_bytes: IntGauge,
     /// Blocks held by the pyramidal cache.
     pub level_cache_blocks: IntGauge,
+    /// Bytes held by the textures' prepared states (analyses, extractions and their caches).
+    pub prepared_bytes: IntGauge,
+    /// Bytes of caches the textures' prepared states may keep, in all.
+    pub prepared_cache_limit_bytes: IntGauge,
 }
 
 fn must<T>(r: prometheus::Result<T>) -> T {
@@ -107,6 +111,14 @@ impl Metrics {
             )),
             level_cache_bytes: must(IntGauge::new("level_cache_bytes", "bytes held by the pyramidal cache")),
             level_cache_blocks: must(IntGauge::new("level_cache_blocks", "blocks held by the pyramidal cache")),
+            prepared_bytes: must(IntGauge::new(
+                "prepared_bytes",
+                "bytes held by the textures' prepared states (analyses, extractions and their caches)",
+            )),
+            prepared_cache_limit_bytes: must(IntGauge::new(
+                "prepared_cache_limit_bytes",
+                "bytes of caches the textures' prepared states may keep, in all (part of memory_budget_mib)",
+            )),
             pixels_delivered: must(IntCounterVec::new(
                 Opts::new("pixels_delivered_total", "pixels delivered by syntheses, by mode"),
                 &["mode"],
@@ -133,6 +145,8 @@ impl Metrics {
             Box::new(m.level_cache_evictions.clone()),
             Box::new(m.level_cache_bytes.clone()),
             Box::new(m.level_cache_blocks.clone()),
+            Box::new(m.prepared_bytes.clone()),
+            Box::new(m.prepared_cache_limit_bytes.clone()),
         ];
         for c in all {
             must(m.registry.register(c));

@@ -29,14 +29,19 @@ pub fn etag_for(key: &str) -> String {
 }
 
 /// A cache key: everything that determines an answer's bytes — engine, texture, what the mode
-/// renders from (the analysis file, or only the exemplar for modes that need nothing more), the
-/// mode's canonical parameters (name and version included) — then `what` it is.
+/// renders from (the analysis file, or only the exemplar for modes that need nothing more, and
+/// what of the mode's prepared state the exemplar does not determine, such as a hand-made set),
+/// the mode's canonical parameters (name and version included) — then `what` it is.
 pub fn cache_key(tex: &Texture, p: &ModeParams, what: std::fmt::Arguments) -> String {
     let source = match p.info().needs {
         Needs::Analysis => tex.file_hash().unwrap_or("analysing"),
         Needs::Exemplar => &tex.exemplar_hash,
     };
-    format!("{}|{}|{source}|{}|{what}", engine_version(), tex.config.id, p.canonical())
+    // Empty unless the state says otherwise, so that the keys of every other texture and mode
+    // stay as they were.
+    let prepared = tex.prepared.etag(p.name());
+    let prepared = if prepared.is_empty() { String::new() } else { format!("{prepared}|") };
+    format!("{}|{}|{source}|{prepared}{}|{what}", engine_version(), tex.config.id, p.canonical())
 }
 
 /// What part of the texture an image shows.
@@ -272,6 +277,8 @@ mod tests {
             config: a.config.clone(),
             exemplar: a.exemplar.clone(),
             analysis: other,
+            prepared: Default::default(),
+            cache_limit: Default::default(),
             exemplar_hash: a.exemplar_hash.clone(),
             exemplar_png: Vec::new(),
             defaults: a.defaults.clone(),

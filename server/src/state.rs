@@ -10,12 +10,12 @@ use axum::body::Bytes;
 use textile_core::{Cancel, Pyramid};
 use tokio::sync::Semaphore;
 
-use crate::analysing::AnalysisPool;
 use crate::cache::{CacheStats, TileCache};
 use crate::config::Config;
 use crate::error::ApiError;
 use crate::metrics::Metrics;
 use crate::queue::RunQueue;
+use crate::textures::analysing::AnalysisPool;
 use crate::textures::Registry;
 
 /// Waiters per pool thread beyond which the synthesis queue serves the newest first.
@@ -88,7 +88,7 @@ impl AppState {
             pyramid: Arc::new(Pyramid::new(config.level_cache_mib << 20)),
             big_windows: Arc::new(Semaphore::new(rayon::current_num_threads().saturating_sub(1).max(1))),
             analyses: Arc::new(Semaphore::new(config.max_concurrent_analyses)),
-            memory: Arc::new(Semaphore::new(config.memory_budget_mib as usize)),
+            memory: Arc::new(Semaphore::new((config.memory_budget_mib - prepared_share_mib(&config)) as usize)),
             config,
             registry: RwLock::new(None),
             catalogue_writer: tokio::sync::Mutex::new(()),
@@ -121,7 +121,7 @@ impl AppState {
 
     /// Budget permits (MiB) for `bytes`: at least one, at most the whole budget.
     fn mib_of(&self, bytes: u64) -> u32 {
-        bytes.div_ceil(MIB).clamp(1, self.config.memory_budget_mib) as u32
+        bytes.div_ceil(MIB).clamp(1, self.working_mib()) as u32
     }
 
     /// `units` permits of `sem`, waited for at most the queue-wait bound (else 503, counted as
@@ -143,7 +143,7 @@ impl AppState {
 
     /// Working memory reserved now, in bytes.
     pub fn reserved(&self) -> u64 {
-        (self.config.memory_budget_mib - self.memory.available_permits() as u64) * MIB
+        (self.working_mib() - self.memory.available_permits() as u64) * MIB
     }
 
     /// A place in the big-window lane, waited for at most the queue-wait bound (else 503).
@@ -166,9 +166,23 @@ impl AppState {
         self.registry.read().unwrap_or_else(|e| e.into_inner()).clone()
     }
 
-    /// Replace the catalogue (requests already holding the old one finish with it).
+    /// Replace the catalogue (requests already holding the old one finish with it), sharing
+    /// out the part of the memory budget set aside for the textures' prepared caches
+    /// ([`prepared_share_mib`]): each texture's states may keep an equal part of it, at most
+    /// [`PREPARED_CACHE_MIB`].
     pub fn set_registry(&self, reg: Arc<Registry>) {
+        let each =
+            (prepared_share_mib(&self.config) * MIB / reg.list.len().max(1) as u64).min(PREPARED_CACHE_MIB * MIB);
+        for tex in &reg.list {
+            tex.limit_caches(each);
+        }
         *self.registry.write().unwrap_or_else(|e| e.into_inner()) = Some(reg);
+    }
+
+    /// MiB of the memory budget that working memory may reserve (the rest is the textures'
+    /// prepared caches').
+    fn working_mib(&self) -> u64 {
+        self.config.memory_budget_mib - prepared_share_mib(&self.config)
     }
 
     /// Run a synthesis job (counted under `mode`) on the rayon pool (never on a tokio worker),
@@ -258,4 +272,13 @@ impl Drop for InFlight {
     fn drop(&mut self) {
         self.0.dec();
     }
+}
+
+/// Most MiB of caches one texture's prepared states keep.
+pub const PREPARED_CACHE_MIB: u64 = 16;
+
+/// MiB of the memory budget set aside for the textures' prepared caches (the umbrella mode's
+/// cell lists and levels of detail): an eighth of it, at most 256.
+pub fn prepared_share_mib(config: &Config) -> u64 {
+    (config.memory_budget_mib / 8).min(256)
 }

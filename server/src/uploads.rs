@@ -13,10 +13,10 @@ use textile_core::error::clip;
 
 use std::sync::Arc;
 
-use crate::analysing::Watch;
 use crate::config::{Config, TextureConfig, Toroidal};
 use crate::error::ApiError;
 use crate::state::AppState;
+use crate::textures::analysing::Watch;
 use crate::textures::Texture;
 use textile_core::files::{write_exclusive, writer_alive};
 
@@ -96,7 +96,7 @@ pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiE
                     }
                 }
             }
-            "index" => t.index = IndexChoice::parse(v).map_err(|e| bad(e.to_string()))?,
+            "index" => t.candidate_search = IndexChoice::parse(v).map_err(|e| bad(e.to_string()))?,
             other => {
                 let Some((mode, key)) = other.split_once('.') else {
                     return Err(bad(format!(
@@ -173,7 +173,7 @@ pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> Result<(
 
 /// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
 /// orphan that start-up removes, never a half texture), then its exemplar, then its analysis
-/// and umbrella extraction in `data_dir`.
+/// and what its modes prepared in `data_dir`.
 pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
     match std::fs::remove_file(dir.join(format!("{id}.toml"))) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
@@ -182,7 +182,7 @@ pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
     for ext in ["png", "jpg", "webp"] {
         let _ = std::fs::remove_file(dir.join(format!("{id}.{ext}")));
     }
-    for ext in ["tex", "umbrella"] {
+    for ext in crate::textures::stored_extensions() {
         let _ = std::fs::remove_file(data_dir.join(format!("{id}.{ext}")));
     }
     Ok(())
@@ -292,8 +292,17 @@ pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
                 // The upload was just stored beside it, so the data directory is writable (a
                 // failed save is still only a warning).
                 let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    st.analysis_pool
-                        .run(|| crate::textures::analyse_texture(&data_dir, true, &tex, &log, &watch, watch.cancel()))
+                    st.analysis_pool.run(|| {
+                        crate::textures::analyse_texture(
+                            &st.config,
+                            &data_dir,
+                            true,
+                            &tex,
+                            &log,
+                            &watch,
+                            watch.cancel(),
+                        )
+                    })
                 }));
                 match outcome {
                     Ok(Err(textile_core::CoreError::Cancelled)) if watch.timed_out() => Some(watch.timeout_message()),

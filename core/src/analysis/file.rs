@@ -79,9 +79,36 @@ impl Analysis {
         parse(&bytes).map_err(|problem| CoreError::AnalysisFile { path: path.to_path_buf(), problem })
     }
 
-    /// Read only the descriptive header of an analysis file (after full validation).
+    /// Read only the descriptive header of an analysis file: its magic, version and JSON
+    /// header, not the payload (so neither its length nor its checksum is checked: loading
+    /// does that).
     pub fn read_header(path: &Path) -> Result<AnalysisHeader> {
-        Ok(Self::load(path)?.header)
+        use std::io::Read;
+        let bad = |problem| CoreError::AnalysisFile { path: path.to_path_buf(), problem };
+        let io = |source| CoreError::Io { path: path.to_path_buf(), source };
+        let mut f = fs::File::open(path).map_err(io)?;
+        let mut fixed = [0u8; FIXED];
+        let got = f.by_ref().take(FIXED as u64).read(&mut fixed).map_err(io)?;
+        if got < 8 || &fixed[..8] != MAGIC {
+            return Err(bad(AnalysisFileProblem::BadMagic));
+        }
+        if got < FIXED {
+            return Err(bad(AnalysisFileProblem::Truncated { actual: got as u64, declared: FIXED as u64 }));
+        }
+        let version = u32::from_le_bytes([fixed[8], fixed[9], fixed[10], fixed[11]]);
+        if version != FORMAT_VERSION {
+            return Err(bad(AnalysisFileProblem::UnsupportedVersion { found: version, expected: FORMAT_VERSION }));
+        }
+        let json_len = u32::from_le_bytes([fixed[20], fixed[21], fixed[22], fixed[23]]) as u64;
+        let mut json = Vec::new();
+        f.take(json_len).read_to_end(&mut json).map_err(io)?;
+        if (json.len() as u64) < json_len {
+            return Err(bad(AnalysisFileProblem::Truncated {
+                actual: (FIXED + json.len()) as u64,
+                declared: FIXED as u64 + json_len,
+            }));
+        }
+        serde_json::from_slice(&json).map_err(|e| bad(AnalysisFileProblem::Corrupt(format!("header: {e}"))))
     }
 }
 
@@ -117,7 +144,7 @@ impl<'a> Reader<'a> {
     }
 }
 
-fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
+pub(crate) fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
     if bytes.len() < MAGIC.len() || &bytes[..8] != MAGIC {
         return Err(AnalysisFileProblem::BadMagic);
     }

@@ -6,6 +6,9 @@ pub mod candidates;
 pub mod features;
 pub mod file;
 pub mod kdtree;
+mod preparation;
+
+pub use preparation::INDEX;
 pub mod stack;
 
 use serde::{Deserialize, Serialize};
@@ -79,6 +82,15 @@ pub enum IndexChoice {
 }
 
 impl IndexChoice {
+    /// As settings write it: `auto`, `exact` or `coherent`.
+    pub fn name(self) -> &'static str {
+        match self {
+            IndexChoice::Auto => "auto",
+            IndexChoice::Exact => "exact",
+            IndexChoice::Coherent => "coherent",
+        }
+    }
+
     /// Parse `auto`, `exact` or `coherent`.
     pub fn parse(s: &str) -> Result<IndexChoice> {
         match s {
@@ -103,18 +115,7 @@ impl IndexChoice {
     }
 }
 
-/// Receives progress from long computations (analysis), so front ends can show it.
-pub trait Progress: Sync {
-    /// `done` of `total` steps are finished; `what` names the current step.
-    fn step(&self, done: u32, total: u32, what: &str);
-}
-
-/// A [`Progress`] that ignores everything.
-pub struct NoProgress;
-
-impl Progress for NoProgress {
-    fn step(&self, _: u32, _: u32, _: &str) {}
-}
+pub use crate::progress::{NoProgress, Progress};
 
 /// One candidate: an exemplar coordinate and its runtime feature vector.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -263,7 +264,6 @@ impl Analysis {
             hires: None,
             randomness_mask: None,
             lattice: h.lattice,
-            umbrella_set: None,
         }
     }
 

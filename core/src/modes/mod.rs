@@ -21,7 +21,8 @@ use crate::cache::Pyramid;
 use crate::error::{CoreError, Result};
 use crate::exemplar::Exemplar;
 use crate::geom::Rect;
-use crate::image::Rendered;
+use crate::image::{Rendered, RgbWindow};
+use crate::prepare::{Prepared, Step};
 use params::{Common, ParamReader, ParamSpec};
 
 /// What a mode needs from a texture.
@@ -42,19 +43,43 @@ pub enum Cost {
     Light,
 }
 
-/// What a texture offers a mode: its prepared exemplar, and its analysis once computed.
-#[derive(Debug, Clone, Copy)]
+/// What a texture offers a mode: its prepared exemplar, its analysis once computed, and what
+/// its modes prepared ([`Mode::preparation`]).
+#[derive(Clone, Copy)]
 pub struct Source<'a> {
     /// The prepared (square, power-of-two) exemplar.
     pub exemplar: &'a Exemplar,
     /// The analysis, when available.
     pub analysis: Option<&'a Analysis>,
+    /// The modes' prepared states, when the caller keeps them (a mode whose state is missing
+    /// prepares it for the request).
+    pub prepared: Option<&'a Prepared>,
+}
+
+impl std::fmt::Debug for Source<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Source")
+            .field("side", &self.exemplar.side)
+            .field("analysis", &self.analysis.map(|a| &a.header.id))
+            .field("prepared", &self.prepared.map(|p| p.all().into_iter().map(|(m, _)| m).collect::<Vec<_>>()))
+            .finish()
+    }
 }
 
 impl<'a> Source<'a> {
     /// A source with both exemplar and analysis.
     pub fn new(exemplar: &'a Exemplar, analysis: &'a Analysis) -> Self {
-        Source { exemplar, analysis: Some(analysis) }
+        Source { exemplar, analysis: Some(analysis), prepared: None }
+    }
+
+    /// A source with the exemplar only.
+    pub fn exemplar(exemplar: &'a Exemplar) -> Self {
+        Source { exemplar, analysis: None, prepared: None }
+    }
+
+    /// This source with the modes' prepared states.
+    pub fn with_prepared(self, prepared: &'a Prepared) -> Self {
+        Source { prepared: Some(prepared), ..self }
     }
 
     /// Exemplar side `m`.
@@ -141,6 +166,18 @@ pub trait Mode {
     fn values(p: &Self::Params, src: &Source) -> Map<String, Value>;
     /// Canonical text of every field, for cache keys and ETags.
     fn canonical(p: &Self::Params) -> String;
+    /// What the mode prepares per texture and keeps (see [`crate::prepare`]): none by default.
+    /// A mode that prepares something reads it back from [`Source::prepared`] under its name.
+    fn preparation() -> Option<&'static dyn Step> {
+        None
+    }
+
+    /// A picture of what the mode prepared for the texture, as parameters `p` use it
+    /// (`textile render --sheet`): none by default.
+    fn sheet(_p: &Self::Params, _src: &Source) -> Option<Result<RgbWindow>> {
+        None
+    }
+
     /// Render a view that is not magnified (`view.zoom_in = 0`); `cache` is the shared
     /// pyramidal cache (modes that keep nothing ignore it).
     fn render(p: &Self::Params, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered>;
@@ -155,7 +192,7 @@ pub trait Mode {
 }
 
 /// A mode as data: what the server, the CLI and the viewer describe.
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct ModeInfo {
     /// Name.
     pub name: &'static str,
@@ -169,12 +206,42 @@ pub struct ModeInfo {
     pub cost: Cost,
     /// Its own parameters.
     pub specs: &'static [ParamSpec],
+    /// What it prepares per texture, if anything.
+    pub preparation: Option<&'static dyn Step>,
+}
+
+impl std::fmt::Debug for ModeInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ModeInfo")
+            .field("name", &self.name)
+            .field("version", &self.version)
+            .field("preparation", &self.preparation.map(|p| p.what()))
+            .finish_non_exhaustive()
+    }
 }
 
 impl ModeInfo {
-    const fn of<M: Mode>(specs: &'static [ParamSpec]) -> ModeInfo {
-        ModeInfo { name: M::NAME, version: M::VERSION, summary: M::SUMMARY, needs: M::NEEDS, cost: M::COST, specs }
+    fn of<M: Mode>(specs: &'static [ParamSpec]) -> ModeInfo {
+        ModeInfo {
+            name: M::NAME,
+            version: M::VERSION,
+            summary: M::SUMMARY,
+            needs: M::NEEDS,
+            cost: M::COST,
+            specs,
+            preparation: M::preparation(),
+        }
     }
+
+    /// Whether `key` is one of the texture settings its preparation reads.
+    pub fn prepares_with(&self, key: &str) -> bool {
+        self.preparation.is_some_and(|p| p.settings().iter().any(|s| s.name == key))
+    }
+}
+
+/// What every mode prepares per texture: `(mode name, preparation)`, in [`MODE_NAMES`] order.
+pub fn preparations() -> Vec<(&'static str, &'static dyn Step)> {
+    all().into_iter().filter_map(|m| m.preparation.map(|p| (m.name, p))).collect()
 }
 
 /// The list of modes: `Variant => folder::Type`. Adding a mode is a folder and a line here.
@@ -240,6 +307,13 @@ macro_rules! modes {
                         <$module::$ty as Mode>::VERSION,
                         <$module::$ty as Mode>::canonical(p)
                     ),)+
+                }
+            }
+
+            /// A picture of what the mode prepared (see [`Mode::sheet`]).
+            pub fn sheet(&self, src: &Source) -> Option<Result<RgbWindow>> {
+                match self {
+                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::sheet(p, src),)+
                 }
             }
 
@@ -331,7 +405,11 @@ impl Defaults {
         for name in MODE_NAMES {
             let fail = |source| DefaultsError { mode: Some(name.to_string()), source };
             let Some(base) = ModeParams::defaults(name) else { continue };
-            let mut r = ParamReader::texture(tables.get(*name).cloned().unwrap_or_default()).map_err(fail)?;
+            // Settings of the mode's preparation are its, not its parameters'.
+            let info = base.info();
+            let table: Vec<(String, String)> =
+                tables.get(*name).into_iter().flatten().filter(|(k, _)| !info.prepares_with(k)).cloned().collect();
+            let mut r = ParamReader::texture(table).map_err(fail)?;
             let p = base.parse(&common, &mut r, src).map_err(fail)?;
             r.finish(name, &all_specs()).map_err(fail)?;
             out.push(p);

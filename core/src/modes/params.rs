@@ -344,6 +344,17 @@ impl ParamReader {
     }
 }
 
+/// Where a texture key of older configurations went, now that it belongs to one mode's table
+/// (for the error that names it).
+pub fn moved_setting(key: &str) -> Option<&'static str> {
+    match key {
+        "kappa" => Some("[textures.synth] kappa = …"),
+        "default_randomness" => Some("[textures.synth] randomness = …"),
+        "umbrellas" => Some("[textures.umbrella] set = …"),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

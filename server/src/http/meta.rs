@@ -39,7 +39,11 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
             "misses": st.cache.stats.misses.get(),
             "evictions": st.cache.stats.evictions.get(),
         },
-        "memory": { "budget_bytes": st.config.memory_budget_mib << 20, "reserved_bytes": st.reserved() },
+        "memory": {
+            "budget_bytes": st.config.memory_budget_mib << 20,
+            "reserved_bytes": st.reserved(),
+            "prepared_caches_bytes": crate::state::prepared_share_mib(&st.config) << 20,
+        },
         "level_cache": {
             "blocks": pyr.blocks, "bytes": pyr.bytes, "limit_bytes": st.config.level_cache_mib << 20,
             "hits": pyr.hits, "misses": pyr.misses, "evictions": pyr.evictions,
@@ -76,6 +80,26 @@ pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap, peer: 
         })
         .collect();
     Ok(Json(json!({ "textures": textures, "uploads": !st.config.admin_token.is_empty() })))
+}
+
+/// What each mode prepared for a texture, by mode: its description, with `what` it is and the
+/// bytes it holds (caches included); `{"status": "preparing"}` until it is ready.
+fn prepared(t: &crate::textures::Texture) -> Value {
+    let mut out = serde_json::Map::new();
+    for (mode, step) in textile_core::modes::preparations() {
+        let v = match t.prepared.all().into_iter().find(|(m, _)| *m == mode) {
+            Some((_, state)) => {
+                let mut d = state.describe();
+                d.insert("status".into(), json!("ready"));
+                d.insert("what".into(), json!(state.what()));
+                d.insert("memory_bytes".into(), json!(state.memory_bytes()));
+                Value::Object(d)
+            }
+            None => json!({ "status": "preparing", "what": step.what() }),
+        };
+        out.insert(mode.to_string(), v);
+    }
+    Value::Object(out)
 }
 
 /// Metadata of one texture.
@@ -116,6 +140,7 @@ pub async fn texture_meta(
             "lattice": ex.lattice.map(|l| [l.nx, l.ny]),
         },
         "analysis": analysis,
+        "prepared": prepared(&t),
         "modes": MODE_NAMES,
         "default_mode": t.defaults.mode,
         "mode_info": mode_info(),
@@ -293,6 +318,20 @@ pub async fn tilejson(
 #[utoipa::path(get, path = "/metrics", tag = "service", responses((status = 200, description = "Prometheus text format")))]
 pub async fn metrics(State(st): State<Arc<AppState>>) -> Response {
     st.metrics.observe_pyramid(&st.pyramid.stats());
+    if let Some(reg) = st.registry() {
+        let held: u64 = reg
+            .list
+            .iter()
+            .map(|t| {
+                t.prepared.memory_bytes()
+                    + t.analysis()
+                        .map_or(0, |a| <textile_core::Analysis as textile_core::prepare::Preparation>::memory_bytes(a))
+            })
+            .sum();
+        st.metrics.prepared_bytes.set(held as i64);
+        let limits: u64 = reg.list.iter().map(|t| t.cache_limit.load(std::sync::atomic::Ordering::Relaxed)).sum();
+        st.metrics.prepared_cache_limit_bytes.set(limits as i64);
+    }
     let mut r = st.metrics.render().into_response();
     r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("text/plain; version=0.0.4; charset=utf-8"));
     r

@@ -14,7 +14,6 @@ pub mod meta;
 pub mod models;
 pub mod openapi;
 pub mod samples;
-pub mod serve;
 pub mod static_files;
 
 use std::sync::Arc;

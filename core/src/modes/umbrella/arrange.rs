@@ -3,17 +3,16 @@
 //! a hash-drawn number of them (position, rotation, scale, depth); every cell's list holds, front
 //! to back, the umbrellas that cover part of it (an exact polygon–square test) up to the `k`-th,
 //! with those in front of it that may shade the cell, positions relative to the cell so that
-//! far-away cells lose no precision. Lists are built a window at a time and kept in an LRU
-//! shared by all requests.
+//! far-away cells lose no precision. Lists are built a window at a time and kept in the
+//! texture's caches ([`super::prepared::Caches`]), shared by its requests.
 
 use std::cell::OnceCell;
-use std::num::NonZeroUsize;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::Arc;
 
-use lru::LruCache;
 use rayon::prelude::*;
 
 use super::extract::{ray, Elements, RAYS};
+use super::prepared::Caches;
 use super::shape::{fold_free, Rim};
 use super::UmbrellaParams;
 use crate::hash::hash;
@@ -33,8 +32,6 @@ pub const MIN_COVER: f64 = 0.3;
 pub const MAX_COVER: f64 = 0.9;
 /// Most umbrellas one spawn cell places.
 pub const MAX_PER_SPAWN: u64 = 48;
-/// Cell lists kept in the LRU.
-const LIST_CACHE: usize = 16384;
 
 /// A modified umbrella (§5.2): a base with a variant's colour offsets and a morph towards its
 /// shape.
@@ -102,8 +99,10 @@ pub struct Arrangement {
     pub max_reach: f64,
     seed: u64,
     period_cells: Option<i64>,
-    /// Identity of this arrangement for the list cache.
+    /// Identity of this arrangement in the caches.
     key: u64,
+    /// Where its cell lists (and merged levels of detail) are kept.
+    caches: Arc<Caches>,
     /// Spawn cells to look at around a cell.
     spawn_reach: i64,
     /// The rays' directions ([`ray`], computed once).
@@ -112,8 +111,15 @@ pub struct Arrangement {
 }
 
 impl Arrangement {
-    /// The arrangement of `el` with parameters `p`; `ident` names the texture (its content hash).
+    /// The arrangement of `el` with parameters `p`; `ident` names the texture (its content
+    /// hash). It keeps what it builds in caches of its own.
     pub fn new(el: &Elements, p: &UmbrellaParams, ident: &str) -> Arrangement {
+        Self::cached(el, p, ident, Arc::new(Caches::default()))
+    }
+
+    /// [`Arrangement::new`], keeping what it builds in `caches` (a texture's, shared by its
+    /// requests).
+    pub fn cached(el: &Elements, p: &UmbrellaParams, ident: &str, caches: Arc<Caches>) -> Arrangement {
         let rays: [[f32; 2]; RAYS] = std::array::from_fn(ray);
         let shape = p.shape as f32 / ONE_Q16 as f32;
         let strength = p.colour as f32 / ONE_Q16 as f32;
@@ -185,6 +191,7 @@ impl Arrangement {
             seed: p.seed,
             period_cells: p.period.map(|n| (n / g).max(1)),
             key,
+            caches,
             spawn_reach,
             rays,
             angles: super::shape::ray_angles(),
@@ -195,6 +202,16 @@ impl Arrangement {
     /// cached of it.
     pub fn key(&self) -> u64 {
         self.key
+    }
+
+    /// Where what is built of it is kept.
+    pub fn caches(&self) -> &Caches {
+        &self.caches
+    }
+
+    /// The same, shared.
+    pub fn caches_arc(&self) -> Arc<Caches> {
+        self.caches.clone()
     }
 
     /// The umbrellas spawn cell `(sx, sy)` places: centres `(x, y)` in 1/256 texels (absolute),
@@ -379,10 +396,8 @@ impl Arrangement {
     pub fn lists(&self, cx0: i64, cy0: i64, cx1: i64, cy1: i64) -> Vec<Arc<Vec<Placed>>> {
         let (w, h) = ((cx1 - cx0).max(0) as usize, (cy1 - cy0).max(0) as usize);
         let mut out: Vec<Option<Arc<Vec<Placed>>>> = vec![None; w * h];
-        if let Ok(mut c) = lists().lock() {
-            for (n, slot) in out.iter_mut().enumerate() {
-                *slot = c.get(&(self.key, cx0 + (n % w.max(1)) as i64, cy0 + (n / w.max(1)) as i64)).cloned();
-            }
+        for (n, slot) in out.iter_mut().enumerate() {
+            *slot = self.caches.lists.get(&(self.key, cx0 + (n % w.max(1)) as i64, cy0 + (n / w.max(1)) as i64));
         }
         if out.iter().all(Option::is_some) {
             return out.into_iter().flatten().collect();
@@ -398,15 +413,13 @@ impl Arrangement {
                 self.build(cx0, y0, cx1, y0 + (have.len() / w.max(1)) as i64, have)
             })
             .collect();
-        let mut cache = lists().lock().ok();
         out.into_iter()
             .zip(built.into_iter().flatten())
             .enumerate()
             .map(|(n, (have, new))| {
                 have.unwrap_or_else(|| {
-                    if let Some(c) = cache.as_mut() {
-                        c.put((self.key, cx0 + (n % w) as i64, cy0 + (n / w) as i64), new.clone());
-                    }
+                    let bytes = (new.len() * std::mem::size_of::<Placed>()) as u64 + LIST_OVERHEAD;
+                    self.caches.lists.put((self.key, cx0 + (n % w) as i64, cy0 + (n / w) as i64), new.clone(), bytes);
                     new
                 })
             })
@@ -473,12 +486,8 @@ impl Arrangement {
     }
 }
 
-type ListKey = (u64, i64, i64);
+/// Bytes charged for a cached list besides its umbrellas (key, slot, allocation).
+const LIST_OVERHEAD: u64 = 96;
 
 /// An umbrella's rim in absolute texels and its bounding box (`x0, x1, y0, y1`).
 type Outline = ([(f64, f64); RAYS], [f64; 4]);
-
-fn lists() -> &'static Mutex<LruCache<ListKey, Arc<Vec<Placed>>>> {
-    static L: OnceLock<Mutex<LruCache<ListKey, Arc<Vec<Placed>>>>> = OnceLock::new();
-    L.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(LIST_CACHE).unwrap_or(NonZeroUsize::MIN))))
-}

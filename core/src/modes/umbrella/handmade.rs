@@ -44,7 +44,7 @@ struct BaseFile {
 }
 
 fn bad(message: String) -> CoreError {
-    CoreError::Param { name: "umbrellas", message }
+    CoreError::Param { name: "set", message }
 }
 
 /// One decoded element image: RGB and alpha mask.

@@ -18,10 +18,8 @@
 //! as much as what they summarise (measured: 4.6 thousand level-1 cells under one tile at
 //! level 2, 0.2 s), while clustering the placed umbrellas needs only the spawn cells.
 
-use std::num::NonZeroUsize;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::Arc;
 
-use lru::LruCache;
 
 use super::arrange::{Arrangement, Placed};
 use super::extract::{Elements, RAYS};
@@ -36,8 +34,6 @@ pub const LOD_PIXELS: i64 = 8;
 /// Rim vertices of a merged umbrella at most.
 pub const MERGED_VERTICES: usize = 12;
 const KMEANS_ITERATIONS: usize = 10;
-/// Merged cells kept.
-const CACHE: usize = 32768;
 
 /// A merged umbrella: a convex rim around its centre, colours at the centre and the vertices
 /// (no texture).
@@ -342,18 +338,14 @@ fn merge(members: &[&Member], palette: &Palette, background: [f32; 3]) -> Option
     Some(Merged { reach: reach_of(o, &rim), o, rim, colour, centre, depth, id, single: None })
 }
 
-type CellKey = (u64, u32, i64, i64);
-
-fn cache() -> &'static Mutex<LruCache<CellKey, Arc<Vec<Merged>>>> {
-    static C: OnceLock<Mutex<LruCache<CellKey, Arc<Vec<Merged>>>>> = OnceLock::new();
-    C.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(CACHE).unwrap_or(NonZeroUsize::MIN))))
-}
+/// Bytes charged for a cached cell besides its merged umbrellas' own (key, slot, allocations).
+const CELL_OVERHEAD: u64 = 96;
 
 /// The merged umbrellas of level-`j` cell `(cx, cy)` (`j ≥ 1`), front to back: the umbrellas
 /// its `2^j × 2^j` spawn cells place, clustered.
 pub fn cell(el: &Elements, arr: &Arrangement, sectors: &SectorTable, j: u32, cx: i64, cy: i64) -> Arc<Vec<Merged>> {
     let key = (arr.key(), j, cx, cy);
-    if let Some(c) = cache().lock().ok().and_then(|mut c| c.get(&key).cloned()) {
+    if let Some(c) = arr.caches().cells.get(&key) {
         return c;
     }
     let n = 1i64 << j;
@@ -379,10 +371,10 @@ pub fn cell(el: &Elements, arr: &Arrangement, sectors: &SectorTable, j: u32, cx:
         out.sort_by(|a, b| b.depth.cmp(&a.depth).then(a.id.cmp(&b.id)));
         out
     };
+    let bytes = merged.iter().map(|m| (std::mem::size_of::<Merged>() + m.rim.len() * 16 + m.colour.len() * 12) as u64).sum::<u64>()
+        + CELL_OVERHEAD;
     let merged = Arc::new(merged);
-    if let Ok(mut c) = cache().lock() {
-        c.put(key, merged.clone());
-    }
+    arr.caches().cells.put(key, merged.clone(), bytes);
     merged
 }
 

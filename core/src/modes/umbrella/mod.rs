@@ -13,23 +13,24 @@ pub mod arrange;
 pub mod extract;
 pub mod handmade;
 pub mod lod;
+pub mod prepared;
 pub mod raster;
 pub mod shape;
 pub mod sheet;
 pub mod store;
 
-use std::num::NonZeroUsize;
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::Arc;
 
-use lru::LruCache;
 
 use rayon::prelude::*;
 use serde_json::{json, Map, Value};
 
 use crate::cache::Pyramid;
-use crate::error::{CoreError, Result};
+use crate::error::Result;
 use crate::exemplar::Exemplar;
 use crate::image::{Rendered, RgbWindow};
+use crate::memo::Memo;
+use crate::prepare::{Step, StepOf};
 use crate::modes::mosaic::{self, MosaicParams};
 use crate::modes::params::{check_period, Common, Kind, ParamReader, ParamSpec, Scope, ONE_Q16};
 use crate::modes::synth::{Synth, SynthParams};
@@ -38,6 +39,7 @@ use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
 use arrange::{Arrangement, Placed};
 use extract::{Elements, RAYS};
+pub use prepared::{extraction_id, Extraction};
 
 /// Largest window, in pixels, one call may render (2^24: sub-sampling makes pixels dear).
 pub const MAX_PIXELS: i64 = 1 << 24;
@@ -264,22 +266,38 @@ impl Mode for Umbrella {
         p.canonical()
     }
 
+    fn preparation() -> Option<&'static dyn Step> {
+        Some(&StepOf::<Extraction>::NEW)
+    }
+
+    /// The extraction: each base umbrella magnified with its rim and centre, and modified
+    /// umbrellas of it below.
+    fn sheet(p: &UmbrellaParams, src: &Source) -> Option<Result<RgbWindow>> {
+        let sheet = || {
+            let (el, id) = state(src)?.elements()?;
+            Ok(sheet::debug_sheet(&el, &Arrangement::new(&el, p, &id)))
+        };
+        Some(sheet())
+    }
+
     fn render(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
-        let (elements, ident) = elements(src.exemplar)?;
-        let arr = Arrangement::new(&elements, p, &ident);
+        let state = state(src)?;
+        let (elements, ident) = state.elements()?;
+        let caches = &state.caches;
+        let arr = Arrangement::cached(&elements, p, &ident, caches.clone());
         // Level 0 (every umbrella) while a cell is at least `lod::LOD_PIXELS` wide, then the
         // merged levels of detail, then the background's own zoomed-out pixels.
         let level = lod::level(&arr, view.zoom_out);
         let Some(level) = level else {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
-            let shift = colour_shift(&elements, p, &ident, src, cache, umbrella_zooms(&arr))?;
+            let shift = colour_shift(&arr, &elements, p, &ident, src, cache, umbrella_zooms(&arr))?;
             let image = shifted(background(p, src, cache, view)?, shift);
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
         };
-        let gaps = gap_shift(&elements, p, &ident, src, cache)?;
+        let gaps = gap_shift(&arr, &elements, p, &ident, src, cache)?;
         let image = paint(&elements, &arr, p, view, level, || Ok(shifted(background(p, src, cache, view)?, gaps)))?;
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
     }
@@ -305,12 +323,22 @@ fn shifted(mut image: RgbWindow, shift: [f32; 3]) -> RgbWindow {
     image
 }
 
-/// A colour calibration of texture `ident` with parameters `p`, memoised: `f` is given the
-/// parameters it is measured with — `p` with seed 0, since a calibration is a statistic of the
-/// arrangement that another seed changes only by chance, and a new seed should not pay for it
-/// again — and their arrangement.
+/// The texture's umbrella state: prepared with it, or (for a caller that prepared none) extracted
+/// now.
+fn state(src: &Source) -> Result<Arc<Extraction>> {
+    if let Some(s) = src.prepared.and_then(|p| p.get::<Extraction>(Umbrella::NAME)) {
+        return Ok(s);
+    }
+    Ok(Arc::new(Extraction::extract(src.exemplar)))
+}
+
+/// A colour calibration of texture `ident` with parameters `p`, memoised in `memo` (one of
+/// the texture's caches, beside `arr`'s): `f` is given the parameters it is measured with —
+/// `p` with seed 0, since a calibration is a statistic of the arrangement that another seed
+/// changes only by chance, and a new seed should not pay for it again — and their arrangement.
 fn calibrated(
-    memo: &'static OnceLock<Mutex<LruCache<String, [f32; 3]>>>,
+    memo: &Memo<String, [f32; 3]>,
+    arr: &Arrangement,
     el: &Elements,
     p: &UmbrellaParams,
     ident: &str,
@@ -318,14 +346,12 @@ fn calibrated(
 ) -> Result<[f32; 3]> {
     let p = UmbrellaParams { seed: 0, ..p.clone() };
     let key = format!("{ident};{}", p.canonical());
-    let memo = memo.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(64).unwrap_or(NonZeroUsize::MIN))));
-    if let Some(s) = memo.lock().ok().and_then(|mut m| m.get(&key).copied()) {
+    if let Some(s) = memo.get(&key) {
         return Ok(s);
     }
-    let s = f(&p, &Arrangement::new(el, &p, ident))?;
-    if let Ok(mut m) = memo.lock() {
-        m.put(key, s);
-    }
+    let caches = arr.caches_arc();
+    let s = f(&p, &Arrangement::cached(el, &p, ident, caches))?;
+    memo.put(key.clone(), s, key.len() as u64 + 64);
     Ok(s)
 }
 
@@ -341,9 +367,15 @@ const MAX_GAP_SHIFT: f32 = 48.0;
 /// white background less the view with a black one); the difference to the exemplar's mean
 /// over that weight, at most [`MAX_GAP_SHIFT`]. Elements keep their colours. Measured with
 /// seed 0 and memoised ([`calibrated`]).
-fn gap_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, cache: &Pyramid) -> Result<[f32; 3]> {
-    static MEMO: OnceLock<Mutex<LruCache<String, [f32; 3]>>> = OnceLock::new();
-    calibrated(&MEMO, el, p, ident, |p, arr| {
+fn gap_shift(
+    arr: &Arrangement,
+    el: &Elements,
+    p: &UmbrellaParams,
+    ident: &str,
+    src: &Source,
+    cache: &Pyramid,
+) -> Result<[f32; 3]> {
+    calibrated(&arr.caches().gaps, arr, el, p, ident, |p, arr| {
         let Some(level) = lod::level(arr, 0) else {
             return Ok([0.0; 3]);
         };
@@ -376,10 +408,17 @@ fn gap_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, cache
 /// per channel, at the last zoom where umbrellas are drawn, over a fixed 128² window at the
 /// origin (measured with seed 0 and memoised, [`calibrated`]): what the background is shifted
 /// by further out.
-fn colour_shift(el: &Elements, p: &UmbrellaParams, ident: &str, src: &Source, cache: &Pyramid, zooms: u32) -> Result<[f32; 3]> {
-    static MEMO: OnceLock<Mutex<LruCache<String, [f32; 3]>>> = OnceLock::new();
-    let gaps = gap_shift(el, p, ident, src, cache)?;
-    calibrated(&MEMO, el, p, ident, |p, arr| {
+fn colour_shift(
+    arr: &Arrangement,
+    el: &Elements,
+    p: &UmbrellaParams,
+    ident: &str,
+    src: &Source,
+    cache: &Pyramid,
+    zooms: u32,
+) -> Result<[f32; 3]> {
+    let gaps = gap_shift(arr, el, p, ident, src, cache)?;
+    calibrated(&arr.caches().colours, arr, el, p, ident, |p, arr| {
         let view = View::out(zooms, crate::geom::Rect::new(0, 0, 128, 128));
         let level = lod::level(arr, zooms).unwrap_or(0);
         let raw = background(p, src, cache, view)?;
@@ -434,56 +473,10 @@ fn mean_colour(ex: &Exemplar) -> [f64; 3] {
     s.map(|v| v as f64 / n as f64)
 }
 
-/// The extraction id of an exemplar: a hash of its content and [`extract::EXTRACTION_VERSION`]
-/// (what a stored extraction must match).
-pub fn extraction_id(ex: &Exemplar) -> String {
-    let mut h = blake3::Hasher::new();
-    h.update(b"textile-umbrella-elements");
-    h.update(&extract::EXTRACTION_VERSION.to_le_bytes());
-    ex.hash_content(&mut h);
-    h.finalize().to_hex()[..16].to_string()
-}
-
-/// Extractions in use, by extraction id — elements or why there are none (deterministic, so
-/// computing one twice gives the same).
-fn memo() -> &'static Mutex<LruCache<String, store::Outcome>> {
-    static MEMO: OnceLock<Mutex<LruCache<String, store::Outcome>>> = OnceLock::new();
-    MEMO.get_or_init(|| Mutex::new(LruCache::new(NonZeroUsize::new(32).unwrap_or(NonZeroUsize::MIN))))
-}
-
-/// Keep an extraction (read from a file) for the process.
-fn remember(id: &str, outcome: store::Outcome) {
-    if let Ok(mut m) = memo().lock() {
-        m.put(id.to_string(), outcome);
-    }
-}
-
-/// Extract `ex` (id `id`) and remember the outcome.
-fn extracted(ex: &Exemplar, id: &str) -> store::Outcome {
-    let outcome = match extract::extract(&ex.pixels, ex.side as usize, ex.toroidal) {
-        Ok(e) => Ok(Arc::new(e)),
-        Err(CoreError::Param { message, .. }) => Err(message),
-        Err(e) => Err(e.to_string()),
-    };
-    remember(id, outcome.clone());
-    outcome
-}
-
-/// The extraction of an exemplar — its hand-made set if it has one, else remembered, read from its stored file by
-/// [`store::load_or_extract`], or computed now — with its id. No elements → a parameter error
-/// naming the mode.
+/// The elements of an exemplar, extracted now, with the id that names them; none → a
+/// parameter error naming the mode.
 pub fn elements(ex: &Exemplar) -> Result<(Arc<Elements>, String)> {
-    let id = extraction_id(ex);
-    if let Some(set) = &ex.umbrella_set {
-        return Ok((set.elements.clone(), id));
-    }
-    let known = memo().lock().ok().and_then(|mut m| m.get(&id).cloned());
-    Ok((outcome_result(known.unwrap_or_else(|| extracted(ex, &id)))?, id))
-}
-
-/// An extraction outcome as a result: no elements → a parameter error naming the mode.
-pub fn outcome_result(outcome: store::Outcome) -> Result<Arc<Elements>> {
-    outcome.map_err(|message| CoreError::Param { name: "umbrella", message })
+    Extraction::extract(ex).elements()
 }
 
 /// Render a view at level of detail `level` (whose cells are at least two pixels wide) over a

@@ -1,27 +1,25 @@
-//! The stored extraction: what [`extract`](super::extract) found for an exemplar — its base
-//! umbrellas and arrangement statistics, or why it found none — in a file beside the texture's
-//! analysis (`<texture>.umbrella`), so that it is computed once per exemplar, not per process.
-//! Layout: magic, format version, a JSON body (the exemplar's extraction id — content hash and
-//! extraction version — then the outcome; base textures and masks as base64 of bytes, exact
-//! since textures are 8-bit texels / 255), and a trailing BLAKE3 checksum of everything before
-//! it. Written atomically; every way a file can be wrong is an [`AnalysisFileProblem`].
+//! The stored extraction's file format: what [`extract`](super::extract) found for an exemplar
+//! — its base umbrellas and arrangement statistics, or why it found none — kept beside the
+//! texture's analysis (`<texture>.umbrella`, [`super::prepared`]), so that it is computed once
+//! per exemplar, not per process. Layout: a [`crate::prepare::envelope`] (magic, format
+//! version, body, BLAKE3 checksum) around a JSON body (the exemplar's extraction id — content
+//! hash and extraction version — then the outcome; base textures and masks as base64 of bytes,
+//! exact since textures are 8-bit texels / 255). Every way a file can be wrong is an
+//! [`AnalysisFileProblem`].
 
-use std::path::Path;
 use std::sync::Arc;
 
 use base64::Engine;
 use serde::{Deserialize, Serialize};
 
 use super::extract::{mipmap, BaseUmbrella, Elements, Variant, RAYS};
-use crate::analysis::file::write_atomically;
-use crate::error::{AnalysisFileProblem, CoreError, Result};
-use crate::exemplar::Exemplar;
+use crate::error::AnalysisFileProblem;
+use crate::prepare::{envelope, open_envelope};
 
 /// First bytes of every stored extraction.
 pub const MAGIC: &[u8; 8] = b"TXTLUMB\0";
 /// Layout version.
 pub const FORMAT_VERSION: u32 = 1;
-const CHECKSUM: usize = 32;
 
 /// What extraction gave for an exemplar: the elements, or why there are none.
 pub type Outcome = std::result::Result<Arc<Elements>, String>;
@@ -163,85 +161,16 @@ fn from_stored(s: StoredElements) -> std::result::Result<Elements, AnalysisFileP
 /// The file's bytes for extraction id `id` and its outcome.
 pub fn to_bytes(id: &str, outcome: &Outcome) -> Vec<u8> {
     let body = Body { id: id.to_string(), outcome: outcome.as_ref().map(|e| to_stored(e)).map_err(Clone::clone) };
-    let json = serde_json::to_vec(&body).unwrap_or_default();
-    let mut b = Vec::with_capacity(12 + json.len() + CHECKSUM);
-    b.extend_from_slice(MAGIC);
-    b.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    b.extend_from_slice(&json);
-    let sum = blake3::hash(&b);
-    b.extend_from_slice(sum.as_bytes());
-    b
+    envelope(MAGIC, FORMAT_VERSION, &serde_json::to_vec(&body).unwrap_or_default())
 }
 
 /// Parse a stored extraction: its id and outcome.
 pub fn from_bytes(bytes: &[u8]) -> std::result::Result<(String, Outcome), AnalysisFileProblem> {
-    if bytes.len() < MAGIC.len() || &bytes[..8] != MAGIC {
-        return Err(AnalysisFileProblem::BadMagic);
-    }
-    if bytes.len() < 12 + CHECKSUM {
-        return Err(AnalysisFileProblem::Truncated { actual: bytes.len() as u64, declared: (12 + CHECKSUM) as u64 });
-    }
-    let version = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
-    if version != FORMAT_VERSION {
-        return Err(AnalysisFileProblem::UnsupportedVersion { found: version, expected: FORMAT_VERSION });
-    }
-    let (body, sum) = bytes.split_at(bytes.len() - CHECKSUM);
-    if blake3::hash(body).as_bytes() != sum {
-        return Err(AnalysisFileProblem::ChecksumMismatch);
-    }
-    let body: Body = serde_json::from_slice(&body[12..]).map_err(|e| corrupt(format!("body: {e}")))?;
+    let body: Body = serde_json::from_slice(open_envelope(MAGIC, FORMAT_VERSION, bytes)?)
+        .map_err(|e| corrupt(format!("body: {e}")))?;
     let outcome = match body.outcome {
         Ok(s) => Ok(Arc::new(from_stored(s)?)),
         Err(why) => Err(why),
     };
     Ok((body.id, outcome))
-}
-
-/// Where an exemplar's extraction came from, for logs.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Source {
-    /// Read from the file.
-    Loaded,
-    /// Computed, and written to the file.
-    Stored,
-    /// Computed; not written (not asked to, or the write failed: the message).
-    Computed(Option<String>),
-    /// The exemplar's hand-made set (nothing extracted, nothing written).
-    HandMade,
-}
-
-/// The extraction of `ex`: its hand-made set if it has one; else from the file at `path` when it holds this exemplar's (current
-/// extraction version), else computed and, if `store`, written there. Either way remembered
-/// for the process ([`super::elements`] then finds it). A missing, stale or damaged file is
-/// replaced; the outcome may be "no elements" (kept too, so it is not recomputed).
-pub fn load_or_extract(ex: &Exemplar, path: &Path, store: bool) -> (Outcome, Source) {
-    if let Some(set) = &ex.umbrella_set {
-        return (Ok(set.elements.clone()), Source::HandMade);
-    }
-    let id = super::extraction_id(ex);
-    if let Ok(bytes) = std::fs::read(path) {
-        if let Ok((found, outcome)) = from_bytes(&bytes) {
-            if found == id {
-                super::remember(&id, outcome.clone());
-                return (outcome, Source::Loaded);
-            }
-        }
-    }
-    let outcome = super::extracted(ex, &id);
-    let source = if store {
-        match write_atomically(path, &to_bytes(&id, &outcome)) {
-            Ok(()) => Source::Stored,
-            Err(e) => Source::Computed(Some(e.to_string())),
-        }
-    } else {
-        Source::Computed(None)
-    };
-    (outcome, source)
-}
-
-/// Read a stored extraction for inspection (`textile info`): its id and outcome, problems
-/// named with the path.
-pub fn read(path: &Path) -> Result<(String, Outcome)> {
-    let bytes = std::fs::read(path).map_err(|source| CoreError::Io { path: path.to_path_buf(), source })?;
-    from_bytes(&bytes).map_err(|problem| CoreError::AnalysisFile { path: path.to_path_buf(), problem })
 }

@@ -14,7 +14,7 @@ use std::io::Write;
 
 use serde_json::json;
 
-use crate::cli::{CliResult, LoadtestArgs};
+use crate::cmd::args::{CliResult, LoadtestArgs};
 
 type Paths = Box<dyn Iterator<Item = String> + Send>;
 

@@ -193,10 +193,11 @@ pub struct RenderArgs {
     /// `--param iterations=0` (mosaic). `textile render --list-params` lists them all.
     #[arg(long = "param", short = 'p', value_name = "KEY=VALUE")]
     pub params: Vec<String>,
-    /// With `--mode umbrella`: instead of the texture, draw what extraction found — each base
-    /// umbrella magnified with its rim and centre, and modified umbrellas of it below.
+    /// Instead of the texture, draw what the mode prepared for it (modes that prepare
+    /// something: `--mode umbrella` draws each extracted base umbrella magnified with its rim
+    /// and centre, and modified umbrellas of it below).
     #[arg(long)]
-    pub debug_umbrellas: bool,
+    pub sheet: bool,
     /// List every mode's parameters (name, range, description) and exit.
     #[arg(long)]
     pub list_params: bool,

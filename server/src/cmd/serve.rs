@@ -11,9 +11,9 @@ use tokio::net::TcpListener;
 use tokio::sync::watch;
 use tracing::{info, warn};
 
-use super::listen::{self, Limits};
-use crate::cli::{CliResult, ServeArgs};
+use crate::cmd::args::{CliResult, ServeArgs};
 use crate::config::{Config, Overrides};
+use crate::http::listen::{self, Limits};
 use crate::state::AppState;
 use crate::textures::{analyse_registry, has_current_analysis, prepare_registry, LoadError, Texture};
 
@@ -61,7 +61,7 @@ async fn serve(cfg: Config) -> CliResult {
         shutdown_grace: Duration::from_secs(cfg.shutdown_grace_secs),
     };
     let state = Arc::new(AppState::new(cfg)?);
-    let app = super::router(state.clone());
+    let app = crate::http::router(state.clone());
     info!("listening on http://{addr}/ (loading textures)");
     // One shutdown signal for everything: the accept loop, and the loading below.
     let (stop_tx, stop) = watch::channel(false);

@@ -1,0 +1,44 @@
+//! `textile analyze EXEMPLAR -o FILE`: the analysis, with a progress bar, and what each mode
+//! prepares beside it (`FILE.<extension>`).
+
+use textile_core::prepare::{Input, Origin};
+use textile_core::{Analysis, Cancel, ExemplarOptions};
+
+use super::args::{AnalyzeArgs, CliResult};
+use super::{read_exemplar, toroidal_flag, Bar};
+use std::sync::Mutex;
+
+/// `textile analyze EXEMPLAR -o FILE`.
+pub fn run(a: AnalyzeArgs) -> CliResult {
+    let toroidal = toroidal_flag(&a.toroidal);
+    let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
+    ex.check_not_flat().map_err(|e| format!("{}: {e}", a.exemplar.display()))?;
+    let t = std::time::Instant::now();
+    let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"), &Cancel::new())?;
+    an.save(&a.output)?;
+    // What each mode prepares, beside it (`FILE.<extension>`), for `textile info` and for a
+    // server whose data directory holds them all.
+    for (_, step) in textile_core::modes::preparations() {
+        let beside = a.output.with_extension(step.extension());
+        let input = Input::exemplar(&ex);
+        if let (_, Origin::Computed { not_stored: Some(e), .. }) =
+            step.run(&input, Some(&beside), true, &|| true, &textile_core::NoProgress, &Cancel::new())?
+        {
+            return Err(format!("{}: {e}", beside.display()).into());
+        }
+    }
+    println!(
+        "analysed {} ({}x{} → {}x{}, toroidal {}, {} search) in {:.2}s → {} (id {})",
+        a.exemplar.display(),
+        ex.preparation.input_width,
+        ex.preparation.input_height,
+        ex.side,
+        ex.side,
+        ex.toroidal,
+        an.header.index.name(),
+        t.elapsed().as_secs_f64(),
+        a.output.display(),
+        an.header.id
+    );
+    Ok(())
+}

@@ -1,0 +1,187 @@
+//! `textile render`: a tile, a window, a perspective camera view (through per-sample queries)
+//! or a picture of what a mode prepared (`--sheet`), to an image file; `--list-params` lists
+//! every mode's parameters.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use base64::Engine;
+use textile_core::files::write_atomic;
+use textile_core::modes::params::{Scope, COMMON};
+use textile_core::samples::{self, camera::GroundCamera, Footprint};
+use textile_core::{Analysis, Cancel, ExemplarOptions, ModeParams, ParamReader, Pyramid};
+
+use super::args::{CliResult, RenderArgs};
+use super::{configured_texture, output_format, param_pairs, read_exemplar};
+use crate::config::TextureConfig;
+use crate::encode::{encode, Effort};
+use crate::pipeline::{ImageJob, Target};
+use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
+use crate::textures::Texture;
+
+/// `textile render --sheet`: a picture of what the mode prepared for the texture.
+fn sheet(tex: &Texture, params: &ModeParams, output: &Path) -> CliResult {
+    let format = output_format(output)?;
+    let Some(img) = params.sheet(&tex.source()) else {
+        return Err(format!("--sheet: mode={} prepares nothing to draw", params.name()).into());
+    };
+    let img = img?;
+    write_atomic(output, &encode(&img.pixels, img.width, img.height, format, Effort::Tight)?)?;
+    let what: Vec<String> = tex
+        .prepared
+        .all()
+        .iter()
+        .filter(|(m, _)| *m == params.name())
+        .map(|(_, s)| format!("{} ({})", s.what(), s.summary()))
+        .collect();
+    println!("wrote {} ({}x{}): {}", output.display(), img.width, img.height, what.join(", "));
+    Ok(())
+}
+
+/// Every mode's parameters, one per line, for `textile render --list-params` (a closed pipe,
+/// as with `| head`, ends the listing quietly).
+fn list_params() -> std::io::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let line = |out: &mut std::io::StdoutLock, s: &textile_core::ParamSpec, who: &str| {
+        let d = s.describe();
+        let range = match (d.get("min"), d.get("max"), d.get("values")) {
+            (_, _, Some(v)) if v.is_array() => format!("one of {v}"),
+            (Some(lo), Some(hi), _) => format!("{lo}..={hi}"),
+            _ => String::new(),
+        };
+        let scope = if s.scope == Scope::Texture { ", texture setting" } else { "" };
+        let kind = d["type"].as_str().unwrap_or("");
+        writeln!(out, "  {:<12} {who:<8} {kind} {range}{scope}\n               {}", s.name, s.help)
+    };
+    writeln!(out, "common (--mode, --seed, --world, or --param):")?;
+    for s in COMMON {
+        line(&mut out, s, "")?;
+    }
+    for m in textile_core::modes::all() {
+        writeln!(out, "mode={} (v{}): {}", m.name, m.version, m.summary)?;
+        for s in m.specs {
+            line(&mut out, s, m.name)?;
+        }
+    }
+    Ok(())
+}
+
+/// `textile render`.
+pub fn run(a: RenderArgs) -> CliResult {
+    if a.list_params {
+        return match list_params() {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+            _ => Ok(()),
+        };
+    }
+    let output = a.output.clone().ok_or("--output is required")?;
+    let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
+        let toroidal = a.lattice.map(|_| true);
+        let mut ex = read_exemplar(path, &ExemplarOptions { toroidal, ..ExemplarOptions::default() })?;
+        if let Some([nx, ny]) = a.lattice {
+            ex = ex.with_lattice(nx, ny)?;
+        }
+        let an = Analysis::try_build_with(&ex, a.index, &textile_core::NoProgress, &Cancel::new())?;
+        Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
+    } else {
+        configured_texture(&a.config, a.texture.as_deref().unwrap_or_default())?
+    };
+    // The flags and `--param` pairs are read like a query string, with texture settings allowed.
+    let mut pairs = param_pairs(&a.params, &a.mode, a.seed, a.world)?;
+    if let Some(file) = &a.controls {
+        let text = std::fs::read(file).map_err(|e| format!("--controls {}: {e}", file.display()))?;
+        let json: serde_json::Value =
+            serde_json::from_slice(&text).map_err(|e| format!("--controls {}: not JSON: {e}", file.display()))?;
+        // As a client would send it: compact JSON, base64url.
+        let compact = serde_json::to_vec(&json).map_err(|e| e.to_string())?;
+        pairs.push(("controls".into(), base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(compact)));
+    }
+    let params = tex.defaults.request(&tex.source(), ParamReader::texture(pairs)?)?;
+    if a.sheet {
+        return sheet(&tex, &params, &output);
+    }
+    let z = a.z.unwrap_or(tex.native_zoom());
+    if z > tex.max_zoom() {
+        return Err(format!("--z {z} is outside 0..={}", tex.max_zoom()).into());
+    }
+    if let Some(cam) = &a.camera {
+        return render_camera(&tex, &params, cam, &a.at, &a.size, &output);
+    }
+    let format = output_format(&output)?;
+    let target = if let Some(win) = &a.window {
+        let v: Vec<i64> = win
+            .split(',')
+            .map(|s| s.trim().parse::<i64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| "--window must be X,Y,W,H integers")?;
+        let [x, y, w, h] = v[..] else {
+            return Err("--window must be X,Y,W,H".into());
+        };
+        if !(1..=MAX_WINDOW_SIDE).contains(&w) || !(1..=MAX_WINDOW_SIDE).contains(&h) {
+            return Err(format!("--window width and height must be 1..={MAX_WINDOW_SIDE}").into());
+        }
+        Target::Window(WindowSpec { z, x, y, w, h, format })
+    } else {
+        let (x, y) = (a.x.unwrap_or(0), a.y.unwrap_or(0));
+        if !(COORD_MIN..=COORD_MAX).contains(&x) || !(COORD_MIN..=COORD_MAX).contains(&y) {
+            return Err("--x and --y must be in [-2^31, 2^31-1]".into());
+        }
+        Target::Tile(TileSpec { z, x, y, scale: 1, format })
+    };
+    let (bytes, r) = ImageJob { tex, params, target }.bytes(&Pyramid::off())?;
+    write_atomic(&output, &bytes)?;
+    println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
+    Ok(())
+}
+
+/// Sky above the horizon of a camera view.
+const SKY: [u8; 3] = [196, 214, 232];
+
+/// Largest camera image side.
+const MAX_CAMERA_SIDE: u32 = 4096;
+
+/// `textile render --camera`: a perspective view of the ground plane, every pixel a filtered
+/// per-sample query (the same sampler as `POST /samples`), through one pyramidal cache.
+fn render_camera(tex: &Texture, params: &ModeParams, cam: &str, at: &str, size: &str, output: &Path) -> CliResult {
+    let nums = |s: &str, n: usize, what: &str| -> Result<Vec<f64>, String> {
+        let v: Vec<f64> = s.split(',').map(|t| t.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| what)?;
+        if v.len() == n {
+            Ok(v)
+        } else {
+            Err(what.to_string())
+        }
+    };
+    let c = nums(cam, 4, "--camera must be HEIGHT,PITCH,YAW,FOV numbers")?;
+    let p = nums(at, 2, "--at must be X,Y numbers")?;
+    let (w, h) = size
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)))
+        .filter(|&(w, h)| (1..=MAX_CAMERA_SIDE).contains(&w) && (1..=MAX_CAMERA_SIDE).contains(&h))
+        .ok_or(format!("--size must be WxH with sides 1..={MAX_CAMERA_SIDE}"))?;
+    let camera =
+        GroundCamera { x: p[0], y: p[1], height: c[0], pitch: c[1], yaw: c[2], fov: c[3], width: w, height_px: h };
+    camera.check()?;
+    let format = output_format(output)?;
+    let started = std::time::Instant::now();
+    let view = camera.footprints();
+    let ground: Vec<Footprint> = view.iter().flatten().copied().collect();
+    let cache = Pyramid::new(64 << 20);
+    let max_zoom_out = tex.native_zoom() - tex.min_zoom();
+    let s = samples::footprints(params, &tex.source(), &cache, &ground, max_zoom_out)?;
+    let mut colors = s.colors.iter();
+    let pixels: Vec<u8> =
+        view.iter().flat_map(|f| if f.is_some() { *colors.next().unwrap_or(&SKY) } else { SKY }).collect();
+    let bytes = encode(&pixels, w, h, format, Effort::Tight)?;
+    write_atomic(output, &bytes)?;
+    println!(
+        "wrote {} ({w}x{h}): {} ground samples in {:.2} s, {} pixels computed ({:.2} per sample, {} windows)",
+        output.display(),
+        ground.len(),
+        started.elapsed().as_secs_f64(),
+        s.synthesized,
+        s.synthesized as f64 / ground.len().max(1) as f64,
+        s.windows
+    );
+    Ok(())
+}

@@ -1,0 +1,220 @@
+//! A texture's configuration: one `[[textures]]` entry — its exemplar, its flags, its defaults
+//! and its per-mode tables (mode parameters, and settings of a mode's preparation) — with the
+//! checks that name the key at fault.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+use textile_core::analysis::IndexChoice;
+use textile_core::error::clip;
+use textile_core::MODE_NAMES;
+
+/// Tri-state toroidal setting of a texture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Toroidal {
+    /// Detect from the wrap-around seam.
+    Auto,
+    /// The exemplar wraps seamlessly.
+    True,
+    /// The exemplar does not wrap.
+    False,
+    /// The exemplar does not wrap: replace it by a seamless texture of the same size
+    /// synthesized from it (Wei & Levoy 2000, as `textile tileable`), which wraps.
+    Synthesize,
+}
+
+impl Toroidal {
+    /// As the core's option.
+    pub fn as_option(self) -> Option<bool> {
+        match self {
+            Toroidal::Auto => None,
+            Toroidal::True => Some(true),
+            Toroidal::False | Toroidal::Synthesize => Some(false),
+        }
+    }
+}
+
+/// One served texture.
+///
+/// Besides the keys below, a texture may hold one table per mode (`[textures.synth]`,
+/// `[textures.mosaic]`, …) of that mode's parameters: request parameters as the texture's
+/// defaults (`randomness = "0.5"`) and texture settings (`kappa = 0.5`). The keys and their
+/// ranges are the modes' own parameter specs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TextureConfig {
+    /// URL id: 1–64 of `a-z 0-9 _ -`.
+    pub id: String,
+    /// Display name (default: the id).
+    #[serde(default)]
+    pub name: String,
+    /// Exemplar path (relative to the config file) or `embedded:NAME`.
+    #[serde(default)]
+    pub exemplar: String,
+    /// Instead of `exemplar`: a high-resolution image (path or `embedded:NAME`); the exemplar
+    /// is its 2× reduction, and magnified zooms show the image's own detail.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub exemplar_hires: Option<String>,
+    /// Randomness mask over the exemplar (`R_E`): a greyscale image the size of the exemplar
+    /// image (path or `embedded:NAME`), white where synthesis moves content freely, black
+    /// where it keeps the exemplar as it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub randomness_mask: Option<String>,
+    /// Near-regular texture: `[nx, ny]` lattice cells that tile the (rectified) exemplar; the
+    /// output keeps the exemplar's grid while the cells vary. Makes the exemplar toroidal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lattice: Option<[u32; 2]>,
+    /// Toroidal flag.
+    #[serde(default = "default_toroidal")]
+    pub toroidal: Toroidal,
+    /// Candidate search of the analysis: `auto` (coherent from 256² up), `exact`, `coherent`
+    /// (the key `index`).
+    #[serde(default, rename = "index")]
+    pub candidate_search: IndexChoice,
+    /// Mode used when a request names none.
+    #[serde(default = "default_mode")]
+    pub default_mode: String,
+    /// Seed used when a request names none (every mode).
+    #[serde(default)]
+    pub default_seed: u64,
+    /// Attribution shown in TileJSON.
+    #[serde(default)]
+    pub attribution: String,
+    /// Per-mode tables, and any other key (refused by validation, naming it).
+    #[serde(flatten)]
+    pub modes: BTreeMap<String, toml::Value>,
+    /// Added through the admin API (kept in the data directory), not configured.
+    #[serde(skip)]
+    pub uploaded: bool,
+}
+
+impl TextureConfig {
+    /// The image file the texture is made from: `exemplar_hires` when given, else `exemplar`.
+    pub fn image(&self) -> &str {
+        self.exemplar_hires.as_deref().unwrap_or(&self.exemplar)
+    }
+
+    /// A texture of this id and exemplar with every other key at its default.
+    pub fn new(id: &str, exemplar: &str) -> Self {
+        TextureConfig {
+            id: id.into(),
+            name: id.into(),
+            exemplar: exemplar.into(),
+            exemplar_hires: None,
+            randomness_mask: None,
+            lattice: None,
+            toroidal: Toroidal::Auto,
+            candidate_search: IndexChoice::Auto,
+            default_mode: default_mode(),
+            default_seed: 0,
+            attribution: String::new(),
+            modes: BTreeMap::new(),
+            uploaded: false,
+        }
+    }
+
+    /// Check the id, the default mode and every per-mode setting against the modes' specs;
+    /// on failure, the key (under `at`, e.g. `textures[2]`) and what is wrong with it.
+    pub fn validate(&self, at: &str) -> Result<(), (String, String)> {
+        let bad = |key: String, msg: String| Err((key, msg));
+        if !valid_id(&self.id) {
+            return bad(format!("{at}.id"), format!("'{}' must be 1-64 of a-z 0-9 _ -", clip(&self.id)));
+        }
+        match (self.exemplar.is_empty(), &self.exemplar_hires) {
+            (false, Some(_)) => {
+                return bad(format!("{at}.exemplar_hires"), "replaces exemplar: give one of the two".into())
+            }
+            _ if self.randomness_mask.is_some() && self.toroidal == Toroidal::Synthesize => {
+                return bad(
+                    format!("{at}.toroidal"),
+                    "\"synthesize\" remakes the exemplar, which randomness_mask could no longer follow".into(),
+                )
+            }
+            _ if self.lattice.is_some() && !matches!(self.toroidal, Toroidal::Auto | Toroidal::True) => {
+                return bad(
+                    format!("{at}.toroidal"),
+                    "a lattice tiles the exemplar, which therefore wraps around: use auto or true".into(),
+                )
+            }
+            (true, Some(_)) if self.toroidal == Toroidal::Synthesize => {
+                return bad(
+                    format!("{at}.toroidal"),
+                    "\"synthesize\" would not match exemplar_hires's detail; use auto, true or false".into(),
+                )
+            }
+            _ => {}
+        }
+        if !MODE_NAMES.contains(&self.default_mode.as_str()) {
+            return bad(
+                format!("{at}.default_mode"),
+                format!("'{}' is not one of {}", clip(&self.default_mode), MODE_NAMES.join(", ")),
+            );
+        }
+        for (key, value) in &self.modes {
+            let at = format!("{at}.{}", clip(key));
+            if let Some(moved) = textile_core::modes::params::moved_setting(key) {
+                return bad(at, format!("is now written per mode: {moved}"));
+            }
+            let Some(info) = textile_core::modes::all().into_iter().find(|m| m.name == key) else {
+                return bad(at, format!("unknown key; per-mode tables are {}", MODE_NAMES.join(", ")));
+            };
+            let Some(table) = value.as_table() else {
+                return bad(at, format!("must be a table of mode={key}'s parameters ([textures.{key}])"));
+            };
+            for (k, v) in table {
+                // A setting of the mode's preparation: a file name.
+                if info.prepares_with(k) {
+                    if !v.is_str() {
+                        return bad(format!("{at}.{k}"), "must be a file name (a string)".into());
+                    }
+                    continue;
+                }
+                let Some(spec) = info.specs.iter().find(|s| s.name == k) else {
+                    let known: Vec<&str> = info.specs.iter().map(|s| s.name).collect();
+                    return bad(
+                        format!("{at}.{}", clip(k)),
+                        format!("mode={key} has no parameter '{}'; it has: {}", clip(k), known.join(", ")),
+                    );
+                };
+                if let Err(e) = spec.check(&text(v)) {
+                    return bad(format!("{at}.{k}"), e.to_string());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The per-mode tables as `key = value` text pairs (lists joined with commas).
+    pub fn mode_tables(&self) -> BTreeMap<String, Vec<(String, String)>> {
+        self.modes
+            .iter()
+            .filter_map(|(m, v)| {
+                v.as_table().map(|t| (m.clone(), t.iter().map(|(k, v)| (k.clone(), text(v))).collect()))
+            })
+            .collect()
+    }
+}
+
+/// A configuration value as the text a query string would carry.
+pub(crate) fn text(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Array(a) => a.iter().map(text).collect::<Vec<_>>().join(","),
+        other => other.to_string(),
+    }
+}
+
+fn default_toroidal() -> Toroidal {
+    Toroidal::Auto
+}
+
+fn default_mode() -> String {
+    "synth".into()
+}
+
+/// Texture ids: 1–64 characters of `a-z 0-9 _ -`.
+pub fn valid_id(id: &str) -> bool {
+    !id.is_empty()
+        && id.len() <= 64
+        && id.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_' || b == b'-')
+}

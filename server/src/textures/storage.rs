@@ -1,0 +1,110 @@
+//! Where a texture's files are: its exemplar (embedded in the binary or a regular file of
+//! bounded size, relative to the configuration), files its settings name, and the data
+//! directory that keeps what its preparations computed (`<texture>.<extension>`), checked
+//! writable at start, with temporary files of interrupted writes removed.
+
+use super::LoadError;
+use crate::config::{Config, TextureConfig};
+use textile_core::Analysis;
+
+/// Exemplars compiled into the binary (`config/exemplars`; licences in LICENSE.md there).
+const EMBEDDED: &[(&str, &[u8])] = &[
+    ("gravel.png", include_bytes!("../../../config/exemplars/gravel.png")),
+    ("grass.png", include_bytes!("../../../config/exemplars/grass.png")),
+    ("brick.png", include_bytes!("../../../config/exemplars/brick.png")),
+    ("corkboard.png", include_bytes!("../../../config/exemplars/corkboard.png")),
+];
+
+/// The bytes of an embedded exemplar.
+pub fn embedded(name: &str) -> Option<&'static [u8]> {
+    EMBEDDED.iter().find(|(n, _)| *n == name).map(|(_, b)| *b)
+}
+
+/// Read the exemplar bytes a texture config names.
+pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadError> {
+    image_bytes(cfg, t, t.image())
+}
+
+/// Read the bytes of an image a texture config names (`embedded:NAME` or a path).
+pub(crate) fn image_bytes(cfg: &Config, t: &TextureConfig, image: &str) -> Result<Vec<u8>, LoadError> {
+    if let Some(name) = image.strip_prefix("embedded:") {
+        return embedded(name)
+            .map(|b| b.to_vec())
+            .ok_or_else(|| LoadError::NoEmbedded { id: t.id.clone(), name: name.into() });
+    }
+    let path = cfg.base_dir.join(image);
+    // Regular files only (a FIFO or device would block the read or never end), of a bounded size.
+    let meta =
+        std::fs::metadata(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path: path.clone(), source })?;
+    let bad = |message: String| LoadError::NotAnImageFile { id: t.id.clone(), path: path.clone(), message };
+    if !meta.is_file() {
+        return Err(bad("is not a regular file".into()));
+    }
+    if meta.len() > MAX_EXEMPLAR_FILE {
+        return Err(bad(format!("is {} bytes; exemplar files are at most {MAX_EXEMPLAR_FILE}", meta.len())));
+    }
+    std::fs::read(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path, source })
+}
+
+/// Largest exemplar file read (bytes): far beyond any accepted exemplar side, compressed.
+const MAX_EXEMPLAR_FILE: u64 = 256 << 20;
+
+/// The extensions of the files a texture's preparations keep in the data directory
+/// (`<texture>.<extension>`): the analysis's, then each mode's.
+pub fn stored_extensions() -> Vec<&'static str> {
+    let modes = textile_core::modes::preparations();
+    std::iter::once(<Analysis as textile_core::prepare::Preparation>::EXTENSION)
+        .chain(modes.iter().map(|(_, p)| p.extension()))
+        .collect()
+}
+
+/// Remove temporary files of preparations (`.ID.tex.tmp-PID`) left by processes that no longer
+/// run (killed while writing); those of live processes (another replica sharing the directory)
+/// stay.
+pub(crate) fn remove_stale_temp_files(dir: &std::path::Path, log: &dyn Fn(String)) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let extensions = stored_extensions();
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !(name.starts_with('.') && extensions.iter().any(|x| name.contains(&format!(".{x}.tmp-")))) {
+            continue;
+        }
+        if textile_core::files::writer_alive(&name) != Some(true) && std::fs::remove_file(e.path()).is_ok() {
+            log(format!("removed {}, left by an interrupted analysis", e.path().display()));
+        }
+    }
+}
+
+/// Whether analyses can be stored in `dir` (created if missing): a probe file is written and
+/// removed.
+pub(crate) fn writable(dir: &std::path::Path) -> Result<(), std::io::Error> {
+    std::fs::create_dir_all(dir)?;
+    let probe = dir.join(format!(".probe-{}", std::process::id()));
+    std::fs::write(&probe, b"textile")?;
+    std::fs::remove_file(&probe)
+}
+
+/// Whether analyses can be stored in the data directory (checked first, with stale temporary
+/// files of interrupted writes removed); if not, a warning is logged.
+pub(crate) fn data_dir_storable(cfg: &Config, log: &dyn Fn(String)) -> bool {
+    let data_dir = cfg.data_dir();
+    match writable(&data_dir) {
+        Ok(()) => {
+            remove_stale_temp_files(&data_dir, log);
+            true
+        }
+        Err(e) => {
+            log(format!(
+                "warning: analyses cannot be stored in {} ({e}); computing them and keeping them in memory only",
+                data_dir.display()
+            ));
+            false
+        }
+    }
+}
+
+/// Read the bytes of a file a texture setting names (relative to the configuration), as a
+/// preparation's [`Input::read`] asks.
+pub(crate) fn setting_file(cfg: &Config, t: &TextureConfig, name: &str) -> Result<Vec<u8>, textile_core::CoreError> {
+    image_bytes(cfg, t, name).map_err(|e| textile_core::CoreError::Param { name: "file", message: e.to_string() })
+}
