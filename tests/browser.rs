@@ -3,25 +3,25 @@
 //! runs `npm ci` in `tests/browser` itself when its packages are missing. Without them the test
 //! says on the terminal that it skipped, and why; under CI it fails instead.
 
-mod support;
+mod common;
 
 use std::path::PathBuf;
 use std::process::Command;
 
-use support::Server;
+use common::Server;
 
 #[test]
 fn viewer_in_headless_chromium() {
     let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/browser");
     if !PathBuf::from(&chromium).exists() {
-        return support::skip(
+        return common::skip(
             "viewer_in_headless_chromium",
             &format!("no Chromium at {chromium} (Debian: apt-get install chromium; or set CHROMIUM=PATH)"),
         );
     }
-    if let Err(why) = support::npm_ready(&dir, "playwright-core") {
-        return support::skip("viewer_in_headless_chromium", &why);
+    if let Err(why) = common::npm_ready(&dir, "playwright-core") {
+        return common::skip("viewer_in_headless_chromium", &why);
     }
     // The viewer opens with a burst of cold tiles; on a slow machine some would wait out the
     // default 1 s queue bound and be shed. Shedding is the second server's subject, so the first
@@ -54,22 +54,22 @@ fn exported_archive_in_headless_chromium() {
     let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/browser");
     if !PathBuf::from(&chromium).exists() {
-        return support::skip("exported_archive_in_headless_chromium", &format!("no Chromium at {chromium}"));
+        return common::skip("exported_archive_in_headless_chromium", &format!("no Chromium at {chromium}"));
     }
-    if let Err(why) = support::npm_ready(&dir, "playwright-core") {
-        return support::skip("exported_archive_in_headless_chromium", &why);
+    if let Err(why) = common::npm_ready(&dir, "playwright-core") {
+        return common::skip("exported_archive_in_headless_chromium", &why);
     }
     let archives = tempfile::tempdir().unwrap();
-    let data = support::shared_data_dir();
+    let data = common::shared_data_dir();
     let out = archives.path().join("world.pmtiles");
-    let status = Command::new(support::binary())
+    let status = Command::new(common::binary())
         .args(["export", "--texture", "gravel", "--world", "8", "--data-dir", data.to_str().unwrap(), "-o"])
         .arg(&out)
         .status()
         .expect("export");
     assert!(status.success());
     // A part of the world, far from [0, 0]: the page must open on it, not on an empty map.
-    let status = Command::new(support::binary())
+    let status = Command::new(common::binary())
         .args(["export", "--texture", "gravel", "--bbox", "100,40,104,43", "--data-dir", data.to_str().unwrap(), "-o"])
         .arg(archives.path().join("part.pmtiles"))
         .status()

@@ -1,11 +1,11 @@
 //! The command line: `analyze` (with its file), `info`, `render` (same bytes as the server's
 //! tile), and clear errors with nothing half-written.
 
-mod support;
+mod common;
 
 use std::process::Command;
 
-use support::{binary, shared_data_dir, Server};
+use common::{binary, shared_data_dir, Server};
 
 fn run(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(binary()).args(args).output().expect("run textile");

@@ -5,17 +5,17 @@
 //! headers. Requests the schema allows but a texture refuses (a zoom beyond its native one, say)
 //! are legitimately 4xx, so the check that every schema-valid request is accepted is left out.
 
-mod support;
+mod common;
 
 use std::process::Command;
 
-use support::Server;
+use common::Server;
 
 #[test]
 fn the_api_keeps_its_openapi_contract() {
     let st = Command::new("st").arg("--version").output();
     if !st.is_ok_and(|o| o.status.success()) {
-        return support::skip(
+        return common::skip(
             "the_api_keeps_its_openapi_contract",
             "Schemathesis is not installed (pip install -r tests/contract/requirements.txt)",
         );

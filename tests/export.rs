@@ -3,13 +3,13 @@
 //! whose tiles equal the running server's answers for the same URLs; world and bbox areas;
 //! clear errors; and an interrupted export leaves nothing under the target name.
 
-mod support;
+mod common;
 
 use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use support::{binary, shared_data_dir, skip, Server};
+use common::{binary, shared_data_dir, skip, Server};
 
 fn textile(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(binary()).args(args).output().expect("run textile");

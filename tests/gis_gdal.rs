@@ -2,11 +2,11 @@
 //! `GDAL_WMS` TMS description, pixel-exactly — a 1024² read at any offset equals the server's
 //! `/windows` of the same texels.
 
-mod support;
+mod common;
 
 use std::process::Command;
 
-use support::Server;
+use common::Server;
 
 /// The README's GDAL_WMS description of a texture at its native zoom `z`: a raster of
 /// `2^z × 256` pixels a side whose pixel `(x, y)` is texel `(x, y)` of the infinite plane.
@@ -39,7 +39,7 @@ fn gdal_wms(base: &str, id: &str, z: u32, query: &str) -> String {
 #[tokio::test]
 async fn gdal_reads_tiles_pixel_exactly() {
     if Command::new("gdal_translate").arg("--version").output().is_err() {
-        return support::skip("gdal_reads_tiles_pixel_exactly", "no gdal_translate (Debian: apt-get install gdal-bin)");
+        return common::skip("gdal_reads_tiles_pixel_exactly", "no gdal_translate (Debian: apt-get install gdal-bin)");
     }
     let s = Server::builder().start();
     let native = s.json("/textures/gravel").await["native_zoom"].as_u64().unwrap() as u32;

@@ -4,18 +4,18 @@
 //! in `tests/gltf` itself when its packages are missing. Without node it says on the terminal
 //! that it skipped, and why; under CI it fails instead.
 
-mod support;
+mod common;
 
 use std::path::PathBuf;
 use std::process::Command;
 
-use support::Server;
+use common::Server;
 
 #[test]
 fn khronos_validator_accepts_every_gltf_answer() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/gltf");
-    if let Err(why) = support::npm_ready(&dir, "gltf-validator") {
-        return support::skip("khronos_validator_accepts_every_gltf_answer", &why);
+    if let Err(why) = common::npm_ready(&dir, "gltf-validator") {
+        return common::skip("khronos_validator_accepts_every_gltf_answer", &why);
     }
     let s = Server::builder().start();
     let out = Command::new("node")

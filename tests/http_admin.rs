@@ -4,12 +4,12 @@
 //! the same file, per-texture settings travel with it, concurrent uploads of one id have one
 //! winner, deletion removes configured-or-not correctly, and uploads survive a restart.
 
-mod support;
+mod common;
 
 use std::path::Path;
 use std::time::Duration;
 
-use support::Server;
+use common::Server;
 
 const TOKEN: &str = "test-admin-token-0123456789";
 
@@ -169,7 +169,7 @@ async fn refused_uploads_leave_nothing_behind() {
     assert!(answer.contains("\"body_too_large\""), "{answer}");
     assert!(files_in(&uploads).is_empty(), "left behind: {:?}", files_in(&uploads));
     assert_eq!(catalog_ids(&s).await, before);
-    support::assert_error(&s, "/textures/nope", 404, "unknown_texture").await;
+    common::assert_error(&s, "/textures/nope", 404, "unknown_texture").await;
     let (status, body) = delete(&s, "gravel", Some(TOKEN)).await;
     assert_eq!((status, body["error"].as_str()), (409, Some("configured_texture")), "{body}");
     let (status, body) = delete(&s, "nosuch", Some(TOKEN)).await;
@@ -201,7 +201,7 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     assert_eq!(status, 200);
     let out = tempfile::tempdir().unwrap();
     let rendered = out.path().join("tile.png");
-    let done = std::process::Command::new(support::binary())
+    let done = std::process::Command::new(common::binary())
         .args(["render", "--exemplar", &exemplar_path("brick.png"), "--x", "1", "--y", "2", "--seed", "3", "-o"])
         .arg(&rendered)
         .output()
@@ -257,8 +257,8 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     // Deletion: gone from the catalogue, its files and analysis removed.
     let (status, _) = delete(&s, "brick2", Some(TOKEN)).await;
     assert_eq!(status, 204);
-    support::assert_error(&s, "/textures/brick2", 404, "unknown_texture").await;
-    support::assert_error(&s, "/tiles/brick2/7/0/0.png", 404, "unknown_texture").await;
+    common::assert_error(&s, "/textures/brick2", 404, "unknown_texture").await;
+    common::assert_error(&s, "/tiles/brick2/7/0/0.png", 404, "unknown_texture").await;
     assert!(!data.path().join("brick2.tex").exists() && !data.path().join("brick2.umbrella").exists());
     assert!(data.path().join("mine.umbrella").exists(), "the kept uploads keep their extraction");
     assert_eq!(files_in(&uploads), ["mine.png", "mine.toml", "race.png", "race.toml"]);
@@ -356,7 +356,7 @@ async fn a_data_directory_that_cannot_store_uploads_is_a_507_naming_no_path() {
     assert!(msg.contains("could not be stored in the data directory") && !msg.contains(&dir), "{msg}");
     assert!(!msg.contains('/'), "no path at all: {msg}");
     assert!(s.log_text().contains(&dir), "the path is in the log");
-    support::assert_error(&s, "/textures/nowhere", 404, "unknown_texture").await;
+    common::assert_error(&s, "/textures/nowhere", 404, "unknown_texture").await;
 }
 
 #[tokio::test]
@@ -373,7 +373,7 @@ async fn two_servers_on_one_data_directory_cannot_both_store_an_id() {
     assert_eq!(status, 409, "{body}");
     assert_eq!(body["error"], "texture_exists", "{body}");
     assert!(body["message"].as_str().unwrap().contains("another server sharing this data directory"), "{body}");
-    support::assert_error(&b, "/textures/shared", 404, "unknown_texture").await;
+    common::assert_error(&b, "/textures/shared", 404, "unknown_texture").await;
     assert_eq!(files_in(&data.path().join("uploads")), ["shared.png", "shared.toml"]);
     until_ready(&a, "/textures/shared").await;
     // Restarted, the second serves the first's upload, byte for byte.

@@ -4,12 +4,12 @@
 //! latency; DELETE stops an analysis at once, whether it began before or after a restart, and
 //! `/ready` stays 200 throughout; an analysis over its time budget fails with a message.
 
-mod support;
+mod common;
 
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use support::Server;
+use common::Server;
 
 const TOKEN: &str = "test-admin-token-0123456789";
 
@@ -142,7 +142,7 @@ async fn degenerate_uploads_are_refused_or_bounded_and_tiles_keep_their_latency(
         assert_eq!(answer["error"], "flat_image", "{id}: {answer}");
         let msg = answer["message"].as_str().unwrap();
         assert!(msg.contains("flat") && msg.contains("standard deviation") && msg.contains("under the 2"), "{msg}");
-        support::assert_error(&s, &format!("/textures/{id}"), 404, "unknown_texture").await;
+        common::assert_error(&s, &format!("/textures/{id}"), 404, "unknown_texture").await;
     }
     assert!(!data.path().join("uploads/black.png").exists(), "a refused upload leaves nothing");
 
@@ -226,5 +226,5 @@ async fn an_analysis_over_its_time_budget_fails_with_a_message() {
     assert_eq!(m["status"], "failed", "{m}");
     let why = m["analysis"]["error"].as_str().or(m["error"].as_str()).unwrap_or_default().to_string();
     assert!(why.contains("budget of 1 s") && why.contains("analysis_timeout_secs"), "{m}");
-    support::assert_error(&s, "/tiles/slow/9/0/0.png", 503, "not_ready").await;
+    common::assert_error(&s, "/tiles/slow/9/0/0.png", 503, "not_ready").await;
 }

@@ -8,9 +8,9 @@
 //! shown in its metadata, part of its identity, the same as `textile render --lattice`, and a
 //! lattice that does not divide the exemplar a clear configuration error.
 
-mod support;
+mod common;
 
-use support::{binary, Server};
+use common::{binary, Server};
 
 /// Write a 128×128 greyscale mask (`value(x, y)`) into `dir` as `name`.
 fn mask(dir: &std::path::Path, name: &str, side: u32, value: impl Fn(u32, u32) -> u8) {
@@ -51,7 +51,7 @@ async fn a_randomness_mask_keeps_black_parts_of_the_exemplar_and_is_part_of_the_
     let mut stitched = image::RgbImage::new(512, 256);
     for i in 0..2 {
         let tile = s.image(&format!("/tiles/half/7/{}/-1.png", 5 + i)).await;
-        support::paste(&mut stitched, &tile, 256 * i, 0);
+        common::paste(&mut stitched, &tile, 256 * i, 0);
     }
     assert!(stitched == s.image("/windows/half.png?x=1280&y=-256&w=512&h=256").await);
     // A mask that is not the exemplar's size is refused, naming it.
@@ -81,7 +81,7 @@ async fn a_lattice_is_configured_served_and_checked() {
     let mut stitched = image::RgbImage::new(512, 256);
     for i in 0..2 {
         let tile = s.image(&format!("/tiles/corkboard/7/{}/3.png?seed=4", i - 1)).await;
-        support::paste(&mut stitched, &tile, 256 * i as u32, 0);
+        common::paste(&mut stitched, &tile, 256 * i as u32, 0);
     }
     assert!(stitched == s.image("/windows/corkboard.png?x=-256&y=768&w=512&h=256&seed=4").await);
     let exemplar = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/corkboard.png");
@@ -149,7 +149,7 @@ async fn request_controls_modulate_randomness_in_the_url_and_in_the_cli() {
     let mut stitched = image::RgbImage::new(512, 256);
     for i in 0..2 {
         let tile = s.image(&format!("/tiles/gravel/7/{i}/0.png?controls={c}")).await;
-        support::paste(&mut stitched, &tile, 256 * i, 0);
+        common::paste(&mut stitched, &tile, 256 * i, 0);
     }
     assert!(stitched == s.image(&format!("/windows/gravel.png?x=0&y=0&w=512&h=256&controls={c}")).await);
     // Bad controls: 400 naming the parameter.
@@ -181,7 +181,7 @@ async fn request_controls_modulate_randomness_in_the_url_and_in_the_cli() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("c.json"), json).unwrap();
     let out = dir.path().join("t.png");
-    let data = support::shared_data_dir();
+    let data = common::shared_data_dir();
     let run = std::process::Command::new(binary())
         .args(["render", "--texture", "gravel", "--x", "0", "--y", "0", "--data-dir", data.to_str().unwrap()])
         .args(["--controls", dir.path().join("c.json").to_str().unwrap(), "-o", out.to_str().unwrap()])

@@ -2,9 +2,9 @@
 //! same across processes, thread counts and request orders, far and negative tiles work, zoomed-out
 //! tiles are reduced views of their children, and `world` makes the texture exactly periodic.
 
-mod support;
+mod common;
 
-use support::{paste, Server};
+use common::{paste, Server};
 
 /// A 2×2 block of native tiles at `(tx, ty)` stitched into one 512 image.
 async fn block(s: &Server, id: &str, z: u32, tx: i64, ty: i64, q: &str) -> image::RgbImage {

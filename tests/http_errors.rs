@@ -2,11 +2,11 @@
 //! analyses at start-up are recomputed; an invalid configuration stops start-up with a message
 //! naming the key; SIGTERM drains and exits 0.
 
-mod support;
+mod common;
 
 use std::process::Command;
 
-use support::{assert_error, binary, Server};
+use common::{assert_error, binary, Server};
 
 #[tokio::test]
 async fn bad_requests_are_json_4xx() {
@@ -154,7 +154,7 @@ async fn sigterm_exits_cleanly() {
 #[tokio::test]
 async fn bare_binary_serves_with_environment_configuration() {
     // `textile` with no sub-command is `textile serve`; configured here only through TEXTILE_*.
-    let data = support::shared_data_dir();
+    let data = common::shared_data_dir();
     let s = Server::builder()
         .bare()
         .env("TEXTILE_BIND", "127.0.0.1:0")

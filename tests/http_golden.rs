@@ -4,9 +4,9 @@
 //! mode's `VERSION` (core/tests/golden.rs says which), encoded bytes with `ENCODER_VERSION`
 //! (server/src/encode.rs), and ETags with either or with the package version.
 
-mod support;
+mod common;
 
-use support::Server;
+use common::Server;
 
 /// `(path, blake3 of the body (16 hex), ETag)`.
 #[rustfmt::skip]

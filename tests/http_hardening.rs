@@ -4,14 +4,14 @@
 //! loading without announcing ready; exemplar reads are bounded (a FIFO is refused); a data
 //! directory that cannot store analyses is survived; stale temporary files are removed.
 
-mod support;
+mod common;
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use support::{binary, shared_data_dir, Server};
+use common::{binary, shared_data_dir, Server};
 
 /// Wait for `child` to exit within `limit`; its exit code.
 fn exit_within(child: &mut std::process::Child, limit: Duration) -> Option<i32> {
@@ -283,7 +283,7 @@ async fn big_windows_are_rendered_in_pieces_and_leave_a_worker_for_tiles() {
     for tx in -1..4i64 {
         for ty in 0..4i64 {
             let t = s.image(&format!("/tiles/gravel/7/{tx}/{ty}.png?seed=6")).await;
-            support::paste(&mut tiles, &t, (256 * (tx + 1)) as u32, (256 * ty) as u32);
+            common::paste(&mut tiles, &t, (256 * (tx + 1)) as u32, (256 * ty) as u32);
         }
     }
     assert!(win == tiles, "pieces stitched differ from the tiles");

@@ -1,9 +1,9 @@
 //! Caching under concurrency: one synthesis for 100 simultaneous requests of one uncached
 //! tile, all with identical bodies; beyond the in-flight limit only 200 or 503 + Retry-After.
 
-mod support;
+mod common;
 
-use support::Server;
+use common::Server;
 
 async fn synthesized(s: &Server) -> u64 {
     s.json("/health").await["tiles_synthesized"].as_u64().unwrap()

@@ -2,11 +2,11 @@
 //! server: every pattern runs, reports statuses and the server's cache hit ratio, and refuses
 //! non-loopback targets.
 
-mod support;
+mod common;
 
 use std::process::Command;
 
-use support::{binary, Server};
+use common::{binary, Server};
 
 fn value(text: &str, series: &str) -> f64 {
     text.lines()

@@ -2,10 +2,10 @@
 //! embedded image is the tile's bytes, .gltf images resolve to the tile, patches have one node
 //! per tile, X3D is well-formed with the expected nodes, ETags and bad inputs as for tiles.
 
-mod support;
+mod common;
 
 use serde_json::Value;
-use support::{assert_error, Server};
+use common::{assert_error, Server};
 
 fn u32le(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])

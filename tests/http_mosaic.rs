@@ -1,9 +1,9 @@
 //! `mode=mosaic` served exactly like `synth`: tiles equal windows, bytes are stable across
 //! processes, parameters are validated, and a texture can default to it in the config.
 
-mod support;
+mod common;
 
-use support::{assert_error, gravel_textures_config, paste, Server};
+use common::{assert_error, gravel_textures_config, paste, Server};
 
 #[tokio::test]
 async fn mosaic_tiles_equal_windows_and_differ_from_synth() {

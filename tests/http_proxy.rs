@@ -2,9 +2,9 @@
 //! extras, X3D textures) follow `X-Forwarded-Proto`/`X-Forwarded-Host` or `Forwarded` only from
 //! trusted proxies, and a configured `public_url` wins over everything.
 
-mod support;
+mod common;
 
-use support::Server;
+use common::Server;
 
 async fn tiles_url(s: &Server, headers: &[(&str, &str)]) -> String {
     let mut req = s.client.get(s.url("/tiles/gravel/tilejson.json"));
@@ -63,7 +63,7 @@ async fn a_configured_public_url_wins() {
     let x3d = body(&s, "/x3d/gravel/7/0/0.x3d", &[]).await;
     assert!(x3d.contains("https://cdn.example.com/textile/tiles/gravel/7/0/0.png"), "{x3d}");
     // A bad one is refused at start, naming the key.
-    let out = std::process::Command::new(support::binary())
+    let out = std::process::Command::new(common::binary())
         .args(["serve", "--bind", "127.0.0.1:0"])
         .env("TEXTILE_PUBLIC_URL", "ftp://nope")
         .output()

@@ -4,10 +4,10 @@
 //! equal integer samples, and malformed or oversized bodies get the documented 4xx JSON while
 //! the server keeps serving.
 
-mod support;
+mod common;
 
 use serde_json::{json, Value};
-use support::Server;
+use common::Server;
 
 /// A deterministic pseudo-random sequence (splitmix64).
 struct Rng(u64);

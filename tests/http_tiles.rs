@@ -2,9 +2,9 @@
 //! catalog consistency, ETag/304, X-Cache, HEAD, CORS, the OpenAPI document, and a texture's
 //! configured κ.
 
-mod support;
+mod common;
 
-use support::{binary, gravel_textures_config, shared_data_dir, Server};
+use common::{binary, gravel_textures_config, shared_data_dir, Server};
 
 #[tokio::test]
 async fn tiles_decode_to_the_right_size_in_every_format() {
@@ -221,7 +221,7 @@ async fn every_listed_mode_is_served_and_its_tiles_equal_one_window() {
             let mut stitched = image::RgbImage::new(512, 512);
             for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                 let tile = s.image(&format!("/tiles/brick/{z}/{}/{}.png?mode={mode}&seed=5", x0 + i, y0 + j)).await;
-                support::paste(&mut stitched, &tile, 256 * i as u32, 256 * j as u32);
+                common::paste(&mut stitched, &tile, 256 * i as u32, 256 * j as u32);
             }
             let window = s
                 .image(&format!(
@@ -264,7 +264,7 @@ async fn magnified_zooms_are_served_up_to_maxzoom_and_stay_true_to_native() {
     let mut children = image::RgbImage::new(512, 512);
     for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
         let tile = s.image(&format!("/tiles/gravel/{}/{}/{}.png", native + 1, 6 + i, -4 + j)).await;
-        support::paste(&mut children, &tile, 256 * i as u32, 256 * j as u32);
+        common::paste(&mut children, &tile, 256 * i as u32, 256 * j as u32);
     }
     let mad = box_difference(&children, &parent);
     assert!(mad < 14.0, "mean absolute difference {mad:.2}");
@@ -341,7 +341,7 @@ async fn a_high_resolution_exemplar_gives_magnified_tiles_its_own_detail() {
         let mut children = image::RgbImage::new(512, 512);
         for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
             let tile = s.image(&format!("/tiles/{id}/7/{}/{}.png", 4 + i, -2 + j)).await;
-            support::paste(&mut children, &tile, 256 * i as u32, 256 * j as u32);
+            common::paste(&mut children, &tile, 256 * i as u32, 256 * j as u32);
         }
         close.push(box_difference(&children, &native));
     }

@@ -4,9 +4,9 @@
 //! `textile render --debug-umbrellas` draws the extraction and `textile info` reports it; the
 //! extraction is stored beside the analysis; a hand-made set in the configuration is served.
 
-mod support;
+mod common;
 
-use support::{assert_error, binary, paste, Server};
+use common::{assert_error, binary, paste, Server};
 
 #[tokio::test]
 async fn umbrella_tiles_equal_windows_and_processes_agree() {
@@ -162,7 +162,7 @@ async fn a_hand_made_umbrella_set_is_configured_and_served() {
         r#"{"bases": [{"image": "red.png", "variants": ["red2.png"]}, {"image": "yellow.png"}], "foreground": 0.8}"#,
     )
     .unwrap();
-    let cfg = support::gravel_textures_config(
+    let cfg = common::gravel_textures_config(
         dir.path(),
         &[("plain", ""), ("made", "[textures.umbrella]\nset = \"set/set.json\"")],
     );
@@ -190,7 +190,7 @@ async fn a_hand_made_umbrella_set_is_configured_and_served() {
     })
     .unwrap();
     std::fs::write(set.join("bad.json"), r#"{"bases": [{"image": "flat.png"}]}"#).unwrap();
-    let bad = support::gravel_textures_config(dir.path(), &[("bad", "[textures.umbrella]\nset = \"set/bad.json\"")]);
+    let bad = common::gravel_textures_config(dir.path(), &[("bad", "[textures.umbrella]\nset = \"set/bad.json\"")]);
     let out = dir.path().join("bad.png");
     let run = std::process::Command::new(binary())
         .args(["render", "--config", bad.to_str().unwrap(), "--texture", "bad", "--mode", "umbrella"])
@@ -213,7 +213,7 @@ async fn editing_a_hand_made_set_changes_only_the_umbrella_etags() {
     std::fs::create_dir_all(&set).unwrap();
     std::fs::write(set.join("red.png"), disc_png(18, [220, 30, 30])).unwrap();
     std::fs::write(set.join("blue.png"), disc_png(16, [30, 40, 220])).unwrap();
-    let cfg = support::gravel_textures_config(dir.path(), &[("made", "[textures.umbrella]\nset = \"set/set.json\"")]);
+    let cfg = common::gravel_textures_config(dir.path(), &[("made", "[textures.umbrella]\nset = \"set/set.json\"")]);
     let mut seen = Vec::new();
     for (round, image) in [(1, "red.png"), (2, "blue.png")] {
         std::fs::write(set.join("set.json"), format!(r#"{{"bases": [{{"image": "{image}"}}]}}"#)).unwrap();

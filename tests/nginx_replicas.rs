@@ -4,7 +4,7 @@
 //! replica under load with zero failures, one synthesis for 100 concurrent identical requests,
 //! 304 through nginx). Needs nginx (installed by `.ci/run`).
 
-mod support;
+mod common;
 
 use std::process::Command;
 
@@ -12,10 +12,10 @@ use std::process::Command;
 fn replicas_behind_nginx() {
     let nginx = ["/usr/sbin/nginx", "/usr/bin/nginx"].iter().any(|p| std::path::Path::new(p).exists());
     if !nginx {
-        return support::skip("replicas_behind_nginx", "nginx is not installed (apt-get install nginx)");
+        return common::skip("replicas_behind_nginx", "nginx is not installed (apt-get install nginx)");
     }
     let script = format!("{}/../deploy/test.sh", env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("bash").arg(&script).arg(support::binary()).output().expect("run deploy/test.sh");
+    let out = Command::new("bash").arg(&script).arg(common::binary()).output().expect("run deploy/test.sh");
     let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "deploy/test.sh failed:\n{text}");
     for check in ["(a)", "(b)", "(c)", "(d)", "(e)", "all checks passed"] {
