@@ -4,8 +4,8 @@
 
 mod common;
 
-use serde_json::Value;
 use common::{assert_error, Server};
+use serde_json::Value;
 
 fn u32le(b: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])

@@ -6,8 +6,8 @@
 
 mod common;
 
-use serde_json::{json, Value};
 use common::Server;
+use serde_json::{json, Value};
 
 /// A deterministic pseudo-random sequence (splitmix64).
 struct Rng(u64);

@@ -1,98 +1,11 @@
-//! The correction kernel (design note §1.3): for one pixel, its 5×5 neighbourhood projected to
-//! the runtime feature space, compared with the 18 k-coherence candidates of its 3×3 neighbours
-//! — a candidate within `2h` of a non-toroidal exemplar's edge over the taps inside the exemplar
-//! only; written twice — portable, and with AVX2 intrinsics (candidates found by vector gathers,
-//! a 16-bit multiply-add projection, both candidates of a neighbour compared in one register by
-//! a 16-bit multiply-add, the first minima by vector compares), chosen at run time — in integer
-//! arithmetic, so both give identical results.
+//! The AVX2 copy of the correction kernel (x86-64 only, chosen at run time): candidates found by
+//! vector gathers, the projection by 16-bit multiply-adds, both candidates of a neighbour
+//! compared in one register, the first minima by vector compares — the same integers as the
+//! portable copy.
 
-use crate::analysis::Candidate;
-use crate::analysis::features::{InnerTaps, FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
-
-/// Distances are scaled by `WEIGHT_ONE / taps compared`, so a candidate near an exemplar edge,
-/// compared over fewer taps, competes on its mean squared tap difference (the least common
-/// multiple of every possible count: 9, 12, 15, 16, 20, 25) ...
-const WEIGHT_ONE: u64 = 3600;
-/// ... times this factor: a match over part of the neighbourhood is weaker evidence than one
-/// over all of it. 2 keeps exemplar-likeness (texq `nn_err`) better than excluding edge texels
-/// did while a band along an edge still reaches the output (1: more edge content, worse
-/// `nn_err`; 3: less; bench/README.md).
-const PARTIAL_FACTOR: u64 = 2;
-/// The largest `φ` whose product with every distance scale stays below 2³¹ (the largest
-/// scale is that of 9 taps compared), so that a u32 distance times it stays below 2⁶³;
-/// κ ≤ 1 keeps `φ` at most `4 · 2¹⁶`, far below.
-const MAX_PHI_NARROW: u64 = i32::MAX as u64 / (PARTIAL_FACTOR * WEIGHT_ONE / 9);
-/// The distance scale of a candidate compared over all taps.
-const FULL_WEIGHT: u64 = WEIGHT_ONE / TAPS5 as u64;
-
-/// The distance scale of a candidate compared over `inner` only.
-#[inline(always)]
-fn partial_weight(inner: &InnerTaps) -> u64 {
-    const BY_COUNT: [u64; TAPS5 + 1] = {
-        let mut t = [0; TAPS5 + 1];
-        let mut n = 1;
-        while n <= TAPS5 {
-            t[n] = PARTIAL_FACTOR * WEIGHT_ONE / n as u64;
-            n += 1;
-        }
-        t
-    };
-    BY_COUNT[inner.count() as usize]
-}
-
-/// The correction kernel of one level: everything a pixel's correction reads besides the
-/// snapshot buffers.
-pub(crate) struct Kernel<'a> {
-    /// Buffer offsets of the 5×5 neighbourhood, raster order.
-    pub taps: [isize; TAPS5],
-    /// Buffer offset and exemplar shift `−h·Δ mod m` (x, y) of the 9 candidate neighbours.
-    pub nb_off: [(isize, u32, u32); 9],
-    /// Projection widened to i32, `[tap][channel][dim]`.
-    pub proj: &'a [i32],
-    /// The same projection as i16 pairs for multiply-add (`vpmaddwd`): per tap, one row of
-    /// `(red, green)` weights per dimension and one of `(blue, 0)`.
-    pub pairs: [[i16; 2 * RUNTIME_DIMS]; 2 * TAPS5],
-    /// The projection of two adjacent taps as i16 pairs: per row of taps, for columns (0, 1)
-    /// and then (2, 3), one row of `(left, right)` weights per dimension for each channel.
-    pub run_pairs: [[i16; 2 * RUNTIME_DIMS]; 30],
-    pub cands: &'a [[Candidate; 2]],
-    pub m: usize,
-    pub mask: u32,
-    pub phi: [u64; 2],
-    /// Stride `h` of the level.
-    pub h: u32,
-    /// Whether the exemplar has edges (not toroidal): candidates within `2h` of one are
-    /// compared over their real texels only.
-    pub edged: bool,
-    /// Per exemplar coordinate `v` along either axis, the first and one past the last tap (of
-    /// five, stride `h`) around `v` inside the exemplar (read only when `edged`).
-    pub span: Vec<[u8; 2]>,
-}
-
-/// [`Kernel::span`] for an `m × m` exemplar at stride `h`.
-pub(crate) fn tap_spans(m: u32, h: u32) -> Vec<[u8; 2]> {
-    (0..m).map(|v| InnerTaps::around(v, 0, h, m)).map(|t| [t.c0, t.c1]).collect()
-}
-
-// The gathers of `Kernel::candidates_avx2` address candidate pairs 40 bytes apart.
-const _: () = assert!(std::mem::size_of::<[Candidate; 2]>() == 40);
+use super::*;
 
 impl Kernel<'_> {
-    /// Correct the pixels `start, start + step, …` of one row (one per `out` entry). Runs a copy
-    /// compiled for AVX2 when the processor has it; integer arithmetic makes both copies give
-    /// identical results.
-    pub fn row(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") && !portable_forced() {
-                // SAFETY: the processor supports AVX2 (checked just above).
-                unsafe { self.row_avx2(s, col, start, step, out) };
-                return;
-            }
-        }
-        self.row_portable(s, col, start, step, out);
-    }
-
     /// The AVX2 copy. The projection — most of the work — multiplies the 8-bit channels as
     /// 16-bit pairs with `vpmaddwd` (every product and pair sum exact in i32): for a pixel
     /// whose candidates are all away from an exemplar edge, one channel of two adjacent taps
@@ -100,7 +13,7 @@ impl Kernel<'_> {
     /// 2-D prefix sums of the taps' terms for [`Kernel::edge_distances_avx2`]. Both give the same sum.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn row_avx2(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
+    pub(super) fn row_avx2(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
         use std::arch::x86_64::*;
         // SAFETY (both): `[i16; 16]` and `__m256i` have the same size; unaligned loads.
         let w: [__m256i; 2 * TAPS5] =
@@ -351,87 +264,6 @@ impl Kernel<'_> {
             }
         }
     }
-
-    #[inline(always)]
-    fn row_portable(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            let idx = start + i * step;
-            let terms = self.tap_terms(idx, col);
-            *o = self.best(idx, s, &terms, sum_taps(&terms, 0..5, 0..5));
-        }
-    }
-
-    /// Each tap's term of the projection of the synthesized 5×5 neighbourhood around buffer
-    /// index `idx` (before the shift), raster order.
-    #[inline(always)]
-    fn tap_terms(&self, idx: usize, col: &[u32]) -> [[i32; RUNTIME_DIMS]; TAPS5] {
-        let mut tp = [[0i32; RUNTIME_DIMS]; TAPS5];
-        for ((&off, pr), acc) in self.taps.iter().zip(self.proj.chunks_exact(3 * RUNTIME_DIMS)).zip(tp.iter_mut()) {
-            let c = col[(idx as isize + off) as usize];
-            let (r, g, b) = ((c & 255) as i32, ((c >> 8) & 255) as i32, ((c >> 16) & 255) as i32);
-            for d in 0..RUNTIME_DIMS {
-                acc[d] = pr[d] * r + pr[RUNTIME_DIMS + d] * g + pr[2 * RUNTIME_DIMS + d] * b;
-            }
-        }
-        tp
-    }
-
-    /// Whether a candidate at packed exemplar coordinate `coord` lies within `2h` of an edge of
-    /// a non-toroidal exemplar (branch-free: the common case is a no).
-    #[inline(always)]
-    fn near_edge(&self, coord: u32) -> bool {
-        let (x, y) = (coord & 0xFFFF, coord >> 16);
-        let (b, inner) = (2 * self.h, self.m as u32 - 4 * self.h);
-        self.edged & ((x.wrapping_sub(b) >= inner) | (y.wrapping_sub(b) >= inner))
-    }
-
-    /// Which taps a candidate at packed exemplar coordinate `coord` is compared over: `None`
-    /// for all of them (toroidal exemplars, and texels at least `2h` from every edge).
-    #[inline(always)]
-    fn inner_taps(&self, coord: u32) -> Option<InnerTaps> {
-        self.near_edge(coord).then(|| self.inner_of(coord))
-    }
-
-    /// The taps inside the exemplar around the candidate at packed coordinate `coord` of a
-    /// non-toroidal exemplar ([`InnerTaps::around`], looked up per axis).
-    #[inline(always)]
-    fn inner_of(&self, coord: u32) -> InnerTaps {
-        let ([r0, r1], [c0, c1]) = (self.span[(coord >> 16) as usize], self.span[(coord & 0xFFFF) as usize]);
-        InnerTaps { r0, r1, c0, c1 }
-    }
-
-    /// The best of the 18 k-coherence candidates for the pixel at buffer index `idx`, whose
-    /// neighbourhood's per-tap terms are `terms` and feature `ns`: the smallest squared feature
-    /// distance, scaled by `φ` of the candidate's rank and by the share of taps compared.
-    #[inline(always)]
-    fn best(&self, idx: usize, s: &[u32], terms: &[[i32; RUNTIME_DIMS]; TAPS5], ns: [i32; RUNTIME_DIMS]) -> u32 {
-        let mut best = (u64::MAX, s[idx]);
-        for (k, &phi_k) in self.phi.iter().enumerate() {
-            for &(off, subx, suby) in &self.nb_off {
-                let v = s[(idx as isize + off) as usize];
-                let vx = ((v & 0xFFFF) + subx) & self.mask;
-                let vy = ((v >> 16) + suby) & self.mask;
-                let cand = &self.cands[vy as usize * self.m + vx as usize][k];
-                let (q, weight) = match self.inner_taps(cand.coord) {
-                    None => (ns, FULL_WEIGHT),
-                    Some(t) => (
-                        sum_taps(terms, t.r0 as usize..t.r1 as usize, t.c0 as usize..t.c1 as usize),
-                        partial_weight(&t),
-                    ),
-                };
-                let mut d = 0u32;
-                for (a, &b) in q.iter().zip(&cand.feat) {
-                    let e = a - b as i32;
-                    d = d.wrapping_add((e * e) as u32);
-                }
-                let dd = d as u64 * phi_k * weight;
-                if dd < best.0 {
-                    best = (dd, cand.coord);
-                }
-            }
-        }
-        best.1
-    }
 }
 
 /// The eight neighbours around the centre of [`Kernel::nb_off`] as vectors, for
@@ -466,24 +298,6 @@ impl Neighbours {
             log2m: _mm_cvtsi32_si128(k.m.trailing_zeros() as i32),
         }
     }
-}
-
-/// The feature of the taps in `rows × cols` of a neighbourhood's per-tap terms (raster order).
-#[inline(always)]
-fn sum_taps(
-    terms: &[[i32; RUNTIME_DIMS]; TAPS5],
-    rows: std::ops::Range<usize>,
-    cols: std::ops::Range<usize>,
-) -> [i32; RUNTIME_DIMS] {
-    let mut q = [0i32; RUNTIME_DIMS];
-    for r in rows {
-        for t in &terms[5 * r + cols.start..5 * r + cols.end] {
-            for d in 0..RUNTIME_DIMS {
-                q[d] += t[d];
-            }
-        }
-    }
-    q.map(|a| a >> FEAT_SHIFT)
 }
 
 /// A pixel's feature (eight i32 lanes, each within i16) as eight i16 lanes, in both halves.
@@ -574,111 +388,6 @@ fn first_smallest_product(d: &[u32; 18], scale: &[u32; 18]) -> usize {
         bits | (_mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(x, m))) as u32) << (4 * j)
     });
     bits.trailing_zeros() as usize
-}
-
-/// The multiply-add layout of a `[tap][channel][dim]` projection (see [`Kernel::pairs`]).
-pub(crate) fn projection_pairs(proj: &[i16]) -> [[i16; 2 * RUNTIME_DIMS]; 2 * TAPS5] {
-    let mut pairs = [[0i16; 2 * RUNTIME_DIMS]; 2 * TAPS5];
-    let at = |t: usize, c: usize, d: usize| proj.get((t * 3 + c) * RUNTIME_DIMS + d).copied().unwrap_or(0);
-    for (t, two) in pairs.chunks_mut(2).enumerate() {
-        for d in 0..RUNTIME_DIMS {
-            two[0][2 * d] = at(t, 0, d);
-            two[0][2 * d + 1] = at(t, 1, d);
-            two[1][2 * d] = at(t, 2, d);
-        }
-    }
-    pairs
-}
-
-/// The two-tap multiply-add layout of a `[tap][channel][dim]` projection (see
-/// [`Kernel::run_pairs`]).
-pub(crate) fn projection_run_pairs(proj: &[i16]) -> [[i16; 2 * RUNTIME_DIMS]; 30] {
-    let mut pairs = [[0i16; 2 * RUNTIME_DIMS]; 30];
-    let at = |t: usize, c: usize, d: usize| proj.get((t * 3 + c) * RUNTIME_DIMS + d).copied().unwrap_or(0);
-    for (i, row) in pairs.iter_mut().enumerate() {
-        // Row of taps `r`, first column `2p`, channel `c`.
-        let (r, p, c) = (i / 6, i % 6 / 3, i % 3);
-        let left = 5 * r + 2 * p;
-        for d in 0..RUNTIME_DIMS {
-            row[2 * d] = at(left, c, d);
-            row[2 * d + 1] = at(left + 1, c, d);
-        }
-    }
-    pairs
-}
-
-/// Whether the portable kernel must run where AVX2 is there: only the kernel tests ask for it.
-#[cfg(all(not(test), target_arch = "x86_64"))]
-#[inline(always)]
-const fn portable_forced() -> bool {
-    false
-}
-
-#[cfg(all(test, target_arch = "x86_64"))]
-use tests::portable_forced;
-
-/// A test that needs AVX2 on a processor without it: a notice the test output shows (written
-/// past the harness's capture), so the test is not read as having checked anything.
-#[cfg(test)]
-fn skip_without_avx2(test: &str) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        return false;
-    }
-    use std::io::Write;
-    let _ = writeln!(std::io::stderr(), "\n    SKIPPED {test}: this processor has no AVX2, so there is no SIMD kernel to compare\n");
-    true
-}
-
-#[cfg(test)]
-mod tests {
-    use std::sync::atomic::{AtomicBool, Ordering};
-
-    use crate::geom::Rect;
-    use crate::modes::synth::params::SynthParams;
-    use crate::modes::synth::window::synthesize;
-    use crate::{Analysis, Exemplar, ExemplarOptions, NoProgress};
-
-    static FORCE_PORTABLE: AtomicBool = AtomicBool::new(false);
-
-    pub(super) fn portable_forced() -> bool {
-        FORCE_PORTABLE.load(Ordering::Relaxed)
-    }
-
-    #[test]
-    fn simd_and_portable_kernels_agree() {
-        if super::skip_without_avx2("simd_and_portable_kernels_agree") {
-            return;
-        }
-        let pattern: Vec<[u8; 4]> = (0..64 * 64u32)
-            .map(|i| {
-                let (x, y) = (i % 64, i / 64);
-                [((x * 7 + y * 3) % 256) as u8, ((x * y) % 251) as u8, ((x ^ y) * 5 % 256) as u8, 255]
-            })
-            .collect();
-        // Black-and-white noise per channel: neighbourhoods of the largest energy, so features
-        // and their differences near the i16 bound the SIMD kernel relies on.
-        let noise: Vec<[u8; 4]> = (0..64 * 64u64)
-            .map(|i| {
-                let z = (i + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-                let bit = |k: u32| if (z >> (40 + k)) & 1 == 1 { 255 } else { 0 };
-                [bit(0), bit(1), bit(2), 255]
-            })
-            .collect();
-        let other = SynthParams { seed: 9, passes: 3, subpasses: 1, kappa: 1 << 16, ..SynthParams::default() };
-        for (px, toroidal) in [(&pattern, None), (&noise, Some(false)), (&noise, Some(true))] {
-            let opts = ExemplarOptions { toroidal, ..ExemplarOptions::default() };
-            let an = Analysis::build(&Exemplar::from_rgba(64, 64, px, &opts), &NoProgress);
-            for p in [SynthParams::default(), other.clone()] {
-                let r = Rect::new(-70, 33, 150, 90);
-                let fast = synthesize(&an, &p, 6, r).unwrap();
-                FORCE_PORTABLE.store(true, Ordering::Relaxed);
-                let portable = synthesize(&an, &p, 6, r).unwrap();
-                FORCE_PORTABLE.store(false, Ordering::Relaxed);
-                assert_eq!(fast, portable, "{p:?} toroidal {toroidal:?}");
-            }
-        }
-    }
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]

@@ -1,0 +1,205 @@
+//! The correction kernel (design note §1.3): for one pixel, its 5×5 neighbourhood projected to
+//! the runtime feature space, compared with the 18 k-coherence candidates of its 3×3 neighbours
+//! — a candidate within `2h` of a non-toroidal exemplar's edge over the taps inside the exemplar
+//! only; written twice — portable, and with AVX2 intrinsics (candidates found by vector gathers,
+//! a 16-bit multiply-add projection, both candidates of a neighbour compared in one register by
+//! a 16-bit multiply-add, the first minima by vector compares), chosen at run time — in integer
+//! arithmetic, so both give identical results. The shared rules and the dispatch are here; the
+//! two copies are [`portable`] and [`avx2`].
+
+use crate::analysis::Candidate;
+use crate::analysis::features::{InnerTaps, FEAT_SHIFT, RUNTIME_DIMS, TAPS5};
+
+/// Distances are scaled by `WEIGHT_ONE / taps compared`, so a candidate near an exemplar edge,
+/// compared over fewer taps, competes on its mean squared tap difference (the least common
+/// multiple of every possible count: 9, 12, 15, 16, 20, 25) ...
+const WEIGHT_ONE: u64 = 3600;
+/// ... times this factor: a match over part of the neighbourhood is weaker evidence than one
+/// over all of it. 2 keeps exemplar-likeness (texq `nn_err`) better than excluding edge texels
+/// did while a band along an edge still reaches the output (1: more edge content, worse
+/// `nn_err`; 3: less; bench/README.md).
+const PARTIAL_FACTOR: u64 = 2;
+/// The largest `φ` whose product with every distance scale stays below 2³¹ (the largest
+/// scale is that of 9 taps compared), so that a u32 distance times it stays below 2⁶³;
+/// κ ≤ 1 keeps `φ` at most `4 · 2¹⁶`, far below.
+const MAX_PHI_NARROW: u64 = i32::MAX as u64 / (PARTIAL_FACTOR * WEIGHT_ONE / 9);
+/// The distance scale of a candidate compared over all taps.
+const FULL_WEIGHT: u64 = WEIGHT_ONE / TAPS5 as u64;
+
+/// The distance scale of a candidate compared over `inner` only.
+#[inline(always)]
+fn partial_weight(inner: &InnerTaps) -> u64 {
+    const BY_COUNT: [u64; TAPS5 + 1] = {
+        let mut t = [0; TAPS5 + 1];
+        let mut n = 1;
+        while n <= TAPS5 {
+            t[n] = PARTIAL_FACTOR * WEIGHT_ONE / n as u64;
+            n += 1;
+        }
+        t
+    };
+    BY_COUNT[inner.count() as usize]
+}
+
+/// The correction kernel of one level: everything a pixel's correction reads besides the
+/// snapshot buffers.
+pub(crate) struct Kernel<'a> {
+    /// Buffer offsets of the 5×5 neighbourhood, raster order.
+    pub taps: [isize; TAPS5],
+    /// Buffer offset and exemplar shift `−h·Δ mod m` (x, y) of the 9 candidate neighbours.
+    pub nb_off: [(isize, u32, u32); 9],
+    /// Projection widened to i32, `[tap][channel][dim]`.
+    pub proj: &'a [i32],
+    /// The same projection as i16 pairs for multiply-add (`vpmaddwd`): per tap, one row of
+    /// `(red, green)` weights per dimension and one of `(blue, 0)`.
+    pub pairs: [[i16; 2 * RUNTIME_DIMS]; 2 * TAPS5],
+    /// The projection of two adjacent taps as i16 pairs: per row of taps, for columns (0, 1)
+    /// and then (2, 3), one row of `(left, right)` weights per dimension for each channel.
+    pub run_pairs: [[i16; 2 * RUNTIME_DIMS]; 30],
+    pub cands: &'a [[Candidate; 2]],
+    pub m: usize,
+    pub mask: u32,
+    pub phi: [u64; 2],
+    /// Stride `h` of the level.
+    pub h: u32,
+    /// Whether the exemplar has edges (not toroidal): candidates within `2h` of one are
+    /// compared over their real texels only.
+    pub edged: bool,
+    /// Per exemplar coordinate `v` along either axis, the first and one past the last tap (of
+    /// five, stride `h`) around `v` inside the exemplar (read only when `edged`).
+    pub span: Vec<[u8; 2]>,
+}
+
+/// [`Kernel::span`] for an `m × m` exemplar at stride `h`.
+pub(crate) fn tap_spans(m: u32, h: u32) -> Vec<[u8; 2]> {
+    (0..m).map(|v| InnerTaps::around(v, 0, h, m)).map(|t| [t.c0, t.c1]).collect()
+}
+
+// The gathers of `Kernel::candidates_avx2` address candidate pairs 40 bytes apart.
+const _: () = assert!(std::mem::size_of::<[Candidate; 2]>() == 40);
+
+mod portable;
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+
+impl Kernel<'_> {
+    /// Correct the pixels `start, start + step, …` of one row (one per `out` entry). Runs a copy
+    /// compiled for AVX2 when the processor has it; integer arithmetic makes both copies give
+    /// identical results.
+    pub fn row(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") && !portable_forced() {
+                // SAFETY: the processor supports AVX2 (checked just above).
+                unsafe { self.row_avx2(s, col, start, step, out) };
+                return;
+            }
+        }
+        self.row_portable(s, col, start, step, out);
+    }
+}
+
+/// The multiply-add layout of a `[tap][channel][dim]` projection (see [`Kernel::pairs`]).
+pub(crate) fn projection_pairs(proj: &[i16]) -> [[i16; 2 * RUNTIME_DIMS]; 2 * TAPS5] {
+    let mut pairs = [[0i16; 2 * RUNTIME_DIMS]; 2 * TAPS5];
+    let at = |t: usize, c: usize, d: usize| proj.get((t * 3 + c) * RUNTIME_DIMS + d).copied().unwrap_or(0);
+    for (t, two) in pairs.chunks_mut(2).enumerate() {
+        for d in 0..RUNTIME_DIMS {
+            two[0][2 * d] = at(t, 0, d);
+            two[0][2 * d + 1] = at(t, 1, d);
+            two[1][2 * d] = at(t, 2, d);
+        }
+    }
+    pairs
+}
+
+/// The two-tap multiply-add layout of a `[tap][channel][dim]` projection (see
+/// [`Kernel::run_pairs`]).
+pub(crate) fn projection_run_pairs(proj: &[i16]) -> [[i16; 2 * RUNTIME_DIMS]; 30] {
+    let mut pairs = [[0i16; 2 * RUNTIME_DIMS]; 30];
+    let at = |t: usize, c: usize, d: usize| proj.get((t * 3 + c) * RUNTIME_DIMS + d).copied().unwrap_or(0);
+    for (i, row) in pairs.iter_mut().enumerate() {
+        // Row of taps `r`, first column `2p`, channel `c`.
+        let (r, p, c) = (i / 6, i % 6 / 3, i % 3);
+        let left = 5 * r + 2 * p;
+        for d in 0..RUNTIME_DIMS {
+            row[2 * d] = at(left, c, d);
+            row[2 * d + 1] = at(left + 1, c, d);
+        }
+    }
+    pairs
+}
+
+/// Whether the portable kernel must run where AVX2 is there: only the kernel tests ask for it.
+#[cfg(all(not(test), target_arch = "x86_64"))]
+#[inline(always)]
+const fn portable_forced() -> bool {
+    false
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+use tests::portable_forced;
+
+/// A test that needs AVX2 on a processor without it: a notice the test output shows (written
+/// past the harness's capture), so the test is not read as having checked anything.
+#[cfg(test)]
+fn skip_without_avx2(test: &str) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        return false;
+    }
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "\n    SKIPPED {test}: this processor has no AVX2, so there is no SIMD kernel to compare\n");
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    use crate::geom::Rect;
+    use crate::modes::synth::params::SynthParams;
+    use crate::modes::synth::window::synthesize;
+    use crate::{Analysis, Exemplar, ExemplarOptions, NoProgress};
+
+    static FORCE_PORTABLE: AtomicBool = AtomicBool::new(false);
+
+    pub(super) fn portable_forced() -> bool {
+        FORCE_PORTABLE.load(Ordering::Relaxed)
+    }
+
+    #[test]
+    fn simd_and_portable_kernels_agree() {
+        if super::skip_without_avx2("simd_and_portable_kernels_agree") {
+            return;
+        }
+        let pattern: Vec<[u8; 4]> = (0..64 * 64u32)
+            .map(|i| {
+                let (x, y) = (i % 64, i / 64);
+                [((x * 7 + y * 3) % 256) as u8, ((x * y) % 251) as u8, ((x ^ y) * 5 % 256) as u8, 255]
+            })
+            .collect();
+        // Black-and-white noise per channel: neighbourhoods of the largest energy, so features
+        // and their differences near the i16 bound the SIMD kernel relies on.
+        let noise: Vec<[u8; 4]> = (0..64 * 64u64)
+            .map(|i| {
+                let z = (i + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+                let bit = |k: u32| if (z >> (40 + k)) & 1 == 1 { 255 } else { 0 };
+                [bit(0), bit(1), bit(2), 255]
+            })
+            .collect();
+        let other = SynthParams { seed: 9, passes: 3, subpasses: 1, kappa: 1 << 16, ..SynthParams::default() };
+        for (px, toroidal) in [(&pattern, None), (&noise, Some(false)), (&noise, Some(true))] {
+            let opts = ExemplarOptions { toroidal, ..ExemplarOptions::default() };
+            let an = Analysis::build(&Exemplar::from_rgba(64, 64, px, &opts), &NoProgress);
+            for p in [SynthParams::default(), other.clone()] {
+                let r = Rect::new(-70, 33, 150, 90);
+                let fast = synthesize(&an, &p, 6, r).unwrap();
+                FORCE_PORTABLE.store(true, Ordering::Relaxed);
+                let portable = synthesize(&an, &p, 6, r).unwrap();
+                FORCE_PORTABLE.store(false, Ordering::Relaxed);
+                assert_eq!(fast, portable, "{p:?} toroidal {toroidal:?}");
+            }
+        }
+    }
+}
