@@ -213,3 +213,36 @@ fn tileable_writes_a_seamless_texture_deterministically_and_refuses_bad_input() 
         assert!(!dir.path().join("c.png").exists() && !dir.path().join("c.txt").exists());
     }
 }
+
+/// The settings table drives `--print-config` (each service key preceded by what it does, its
+/// range, default and environment variable), the environment keys, and the upload fields the
+/// OpenAPI document lists.
+#[tokio::test]
+async fn settings_are_declared_once_and_shown_everywhere() {
+    let (code, out, err) = run(&["serve", "--print-config"]);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    let at = lines.iter().position(|l| l.starts_with("cache_mib = ")).expect("cache_mib");
+    assert_eq!(lines[at - 1], "# tile cache size in MiB (1..=65536; default 256; env TEXTILE_CACHE_MIB)");
+    let at = lines.iter().position(|l| l.starts_with("worker_threads = ")).expect("worker_threads");
+    assert!(lines[at - 1].contains("0 = one per core"), "{}", lines[at - 1]);
+    // The environment variable it names is read, and its range checked.
+    let bad = std::process::Command::new(common::binary())
+        .args(["serve", "--print-config"])
+        .env("TEXTILE_MAX_UPLOAD_MIB", "5000")
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success() && e.contains("max_upload_mib") && e.contains("1..=4096"), "{e}");
+    // The upload's fields in the OpenAPI document, with their types and ranges.
+    let s = common::Server::builder().start();
+    let doc = s.json("/openapi.json").await;
+    for path in ["/admin/textures", "/textures"] {
+        let params = doc["paths"][path]["post"]["parameters"].as_array().expect("parameters");
+        let field = |n: &str| params.iter().find(|p| p["name"] == n).cloned().unwrap_or_default();
+        assert_eq!(field("toroidal")["schema"]["enum"], serde_json::json!(["auto", "true", "false", "synthesize"]));
+        assert_eq!(field("index")["schema"]["enum"], serde_json::json!(["auto", "exact", "coherent"]));
+        assert!(field("default_mode")["schema"]["enum"].as_array().is_some_and(|m| m.len() >= 4), "{path}");
+        assert!(field("id")["description"].as_str().is_some_and(|d| d.contains("required")), "{path}");
+    }
+}

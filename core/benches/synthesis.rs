@@ -139,11 +139,14 @@ fn mosaic(c: &mut Criterion) {
 }
 
 fn umbrella(c: &mut Criterion) {
-    use textile_core::modes::umbrella::{Umbrella, UmbrellaParams};
+    use textile_core::modes::umbrella::{Extraction, Umbrella, UmbrellaParams};
     use textile_core::View;
     let ex = exemplar(128);
     let an = Analysis::build(&ex, &NoProgress);
-    let src = Source::new(&ex, &an);
+    // The texture's prepared state, as the server keeps it: the extraction and its caches.
+    let prepared = textile_core::prepare::Prepared::new();
+    prepared.set(<Umbrella as Mode>::NAME, std::sync::Arc::new(Extraction::extract(&ex)));
+    let src = Source::new(&ex, &an).with_prepared(&prepared);
     let p = UmbrellaParams::default();
     let mut g = c.benchmark_group("umbrella");
     g.sample_size(20).measurement_time(Duration::from_secs(5));

@@ -13,7 +13,7 @@ use textile_core::error::clip;
 
 use std::sync::Arc;
 
-use crate::config::{Config, TextureConfig, Toroidal};
+use crate::config::{settings, Config, TextureConfig};
 use crate::error::ApiError;
 use crate::state::AppState;
 use crate::textures::analysing::Watch;
@@ -74,35 +74,27 @@ pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiE
             return Err(bad(format!("field '{}' is given twice", clip(k))));
         }
         let long = |max: usize| bad(format!("field '{}' is over {max} characters", clip(k)));
+        // The texture's own fields, checked against their declared type and range.
+        if let Some(spec) = settings::TEXTURE_FIELDS.iter().find(|s| s.name == k) {
+            spec.check(v).map_err(|e| bad(e.to_string()))?;
+        }
         match k.as_str() {
             "id" => id = Some(v.clone()),
-            "name" if v.chars().count() > 200 => return Err(long(200)),
             "name" => t.name = v.clone(),
-            "attribution" if v.chars().count() > 1000 => return Err(long(1000)),
             "attribution" => t.attribution = v.clone(),
             "default_mode" => t.default_mode = v.clone(),
-            "default_seed" => {
-                t.default_seed =
-                    v.parse().map_err(|_| bad(format!("default_seed '{}' is not an integer in 0..2^64", clip(v))))?
-            }
+            "default_seed" => t.default_seed = settings::DEFAULT_SEED.integer(v).map_err(|e| bad(e.to_string()))?,
             "toroidal" => {
-                t.toroidal = match v.as_str() {
-                    "auto" => Toroidal::Auto,
-                    "true" => Toroidal::True,
-                    "false" => Toroidal::False,
-                    "synthesize" => Toroidal::Synthesize,
-                    _ => {
-                        return Err(bad(format!("toroidal '{}' is not one of auto, true, false, synthesize", clip(v))))
-                    }
-                }
+                t.toroidal = serde_json::from_value(serde_json::json!(v)).map_err(|e| bad(format!("toroidal: {e}")))?
             }
             "index" => t.candidate_search = IndexChoice::parse(v).map_err(|e| bad(e.to_string()))?,
             other => {
                 let Some((mode, key)) = other.split_once('.') else {
+                    let fields: Vec<&str> = settings::TEXTURE_FIELDS.iter().map(|s| s.name).collect();
                     return Err(bad(format!(
-                        "unknown field '{}'; fields are id, name, toroidal, index, default_mode, default_seed, \
-                         attribution and MODE.KEY settings",
-                        clip(other)
+                        "unknown field '{}'; fields are {} and MODE.KEY settings",
+                        clip(other),
+                        fields.join(", ")
                     )));
                 };
                 if v.len() > 256 {
@@ -333,7 +325,7 @@ mod tests {
     #[test]
     fn fields_become_a_checked_texture_configuration() {
         let t = texture_config(&pairs(&[("id", "cobble"), ("toroidal", "false"), ("synth.kappa", "0.5")])).unwrap();
-        assert_eq!((t.id.as_str(), t.name.as_str(), t.toroidal), ("cobble", "cobble", Toroidal::False));
+        assert_eq!((t.id.as_str(), t.name.as_str(), t.toroidal), ("cobble", "cobble", crate::config::Toroidal::False));
         assert_eq!(t.mode_tables()["synth"], vec![("kappa".to_string(), "0.5".to_string())]);
         for bad in [
             vec![("name", "x")],

@@ -117,8 +117,10 @@ impl ParamSpec {
             Kind::Unit => self.unit(s).map(drop),
             Kind::Levels => s.split(',').try_for_each(|v| self.unit(v).map(drop)),
             Kind::Interval { .. } => self.interval_milli(s).map(drop),
-            Kind::Text { max_len } if s.len() as u64 <= max_len => Ok(()),
-            Kind::Text { max_len } => Err(self.error(format!("is {} characters; at most {max_len}", s.len()))),
+            Kind::Text { max_len } if s.chars().count() as u64 <= max_len => Ok(()),
+            Kind::Text { max_len } => {
+                Err(self.error(format!("is {} characters; at most {max_len}", s.chars().count())))
+            }
         }
     }
 

@@ -29,7 +29,7 @@ pub fn run(args: ServeArgs) -> CliResult {
     };
     let cfg = Config::load(args.config.config.as_deref(), &overrides)?;
     if args.print_config {
-        print!("{}", toml::to_string_pretty(&cfg.redacted())?);
+        print!("{}", cfg.to_commented_toml()?);
         return Ok(());
     }
     let filter = tracing_subscriber::EnvFilter::try_from_env("TEXTILE_LOG")

@@ -8,70 +8,18 @@ use figment::providers::{Env, Format, Serialized, Toml};
 use figment::Figment;
 use serde::{Deserialize, Serialize};
 
+pub mod settings;
 mod texture;
 
 pub use texture::{valid_id, TextureConfig, Toroidal};
 
+/// The built-in layers: every setting's declared default, then `config/textile.toml`.
+fn built_in() -> Figment {
+    Figment::from(Serialized::defaults(settings::defaults())).merge(Toml::string(DEFAULT_CONFIG))
+}
+
 /// The default configuration, compiled in.
 pub const DEFAULT_CONFIG: &str = include_str!("../../../config/textile.toml");
-
-/// Environment keys read (as `TEXTILE_<KEY>`).
-const ENV_KEYS: &[&str] = &[
-    "bind",
-    "data_dir",
-    "cache_mib",
-    "level_cache_mib",
-    "cache_control",
-    "worker_threads",
-    "request_timeout_secs",
-    "max_in_flight",
-    "max_queue_wait_ms",
-    "max_exemplar_side",
-    "public_url",
-    "archives_dir",
-    "max_connections",
-    "header_read_timeout_secs",
-    "shutdown_grace_secs",
-    "admin_token",
-    "max_upload_mib",
-    "max_concurrent_analyses",
-    "analysis_threads",
-    "analysis_timeout_secs",
-    "max_uploaded_textures",
-    "memory_budget_mib",
-];
-
-fn default_max_connections() -> usize {
-    1024
-}
-
-fn default_header_read_timeout() -> u64 {
-    10
-}
-
-fn default_shutdown_grace() -> u64 {
-    10
-}
-
-fn default_max_upload_mib() -> u64 {
-    32
-}
-
-fn default_max_concurrent_analyses() -> usize {
-    1
-}
-
-fn default_analysis_timeout_secs() -> u64 {
-    600
-}
-
-fn default_max_uploaded_textures() -> usize {
-    100
-}
-
-fn default_memory_budget_mib() -> u64 {
-    1024
-}
 
 /// The whole service configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -113,15 +61,15 @@ pub struct Config {
     #[serde(default)]
     pub trusted_proxies: Vec<String>,
     /// Open connections at most; beyond, new connections wait to be accepted.
-    #[serde(default = "default_max_connections")]
+    #[serde(default)]
     pub max_connections: usize,
     /// Seconds a client has to send a request's headers; also the longest idle time of a
     /// keep-alive connection between requests.
-    #[serde(default = "default_header_read_timeout")]
+    #[serde(default)]
     pub header_read_timeout_secs: u64,
     /// Seconds in-flight requests may take to finish after SIGINT/SIGTERM before the process
     /// exits anyway.
-    #[serde(default = "default_shutdown_grace")]
+    #[serde(default)]
     pub shutdown_grace_secs: u64,
     /// A directory of exported archives served under `/archives/` (with range requests, for
     /// PMTiles readers); empty: none.
@@ -133,10 +81,10 @@ pub struct Config {
     #[serde(default)]
     pub admin_token: String,
     /// Largest upload body, in MiB.
-    #[serde(default = "default_max_upload_mib")]
+    #[serde(default)]
     pub max_upload_mib: u64,
     /// Analyses of uploaded textures run at once at most; more wait their turn.
-    #[serde(default = "default_max_concurrent_analyses")]
+    #[serde(default)]
     pub max_concurrent_analyses: usize,
     /// Threads of the analysis pool, which runs every analysis (uploads, and those computed at
     /// start) at the lowest CPU priority, apart from the synthesis pool; 0 = one fewer than the
@@ -145,15 +93,15 @@ pub struct Config {
     pub analysis_threads: usize,
     /// Longest an analysis may take, in seconds; beyond it the upload's status turns `failed`
     /// (a configured texture's stops the start-up) with a message saying so.
-    #[serde(default = "default_analysis_timeout_secs")]
+    #[serde(default)]
     pub analysis_timeout_secs: u64,
     /// Uploaded textures kept at most.
-    #[serde(default = "default_max_uploaded_textures")]
+    #[serde(default)]
     pub max_uploaded_textures: usize,
     /// MiB of working memory that windows, glTF patches, sample batches, uploads and their
     /// analyses may hold at once (each reserves its estimated size before it starts and waits
     /// for room, at most `max_queue_wait_ms`, else 503); tiles are not counted: one per worker.
-    #[serde(default = "default_memory_budget_mib")]
+    #[serde(default)]
     pub memory_budget_mib: u64,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
@@ -193,7 +141,7 @@ pub struct ConfigError(pub String);
 impl Config {
     /// Load the layered configuration and validate it.
     pub fn load(file: Option<&Path>, overrides: &Overrides) -> Result<Config, ConfigError> {
-        let mut fig = Figment::from(Toml::string(DEFAULT_CONFIG));
+        let mut fig = built_in();
         let mut base_dir = std::env::current_dir().unwrap_or_default();
         if let Some(path) = file {
             if !path.is_file() {
@@ -205,7 +153,7 @@ impl Config {
                 base_dir = dir.to_path_buf();
             }
         }
-        fig = fig.merge(Env::prefixed("TEXTILE_").only(ENV_KEYS)).merge(Serialized::defaults(overrides));
+        fig = fig.merge(Env::prefixed("TEXTILE_").only(&settings::env_keys())).merge(Serialized::defaults(overrides));
         let mut cfg: Config = fig.extract().map_err(|e| {
             let msgs: Vec<String> = e
                 .into_iter()
@@ -231,9 +179,8 @@ impl Config {
             }
         }
         if cfg.include_default_textures {
-            let builtin: Config = Figment::from(Toml::string(DEFAULT_CONFIG))
-                .extract()
-                .map_err(|e| ConfigError(format!("the built-in configuration: {e}")))?;
+            let builtin: Config =
+                built_in().extract().map_err(|e| ConfigError(format!("the built-in configuration: {e}")))?;
             let mine: Vec<String> = cfg.textures.iter().map(|t| t.id.clone()).collect();
             let mut all: Vec<TextureConfig> = builtin.textures.into_iter().filter(|t| !mine.contains(&t.id)).collect();
             all.append(&mut cfg.textures);
@@ -248,27 +195,8 @@ impl Config {
         if self.bind.parse::<std::net::SocketAddr>().is_err() {
             return bad("bind", format!("'{}' is not an address like 127.0.0.1:8080", self.bind));
         }
-        if !(1..=65536).contains(&self.cache_mib) {
-            return bad("cache_mib", format!("{} is outside 1..=65536", self.cache_mib));
-        }
-        if self.level_cache_mib > 65536 {
-            return bad("level_cache_mib", format!("{} is outside 0..=65536 (0 = off)", self.level_cache_mib));
-        }
-        if self.worker_threads > 1024 {
-            return bad("worker_threads", format!("{} is outside 0..=1024 (0 = one per core)", self.worker_threads));
-        }
-        if !(1..=3600).contains(&self.request_timeout_secs) {
-            return bad("request_timeout_secs", format!("{} is outside 1..=3600", self.request_timeout_secs));
-        }
-        if !(1..=100_000).contains(&self.max_in_flight) {
-            return bad("max_in_flight", format!("{} is outside 1..=100000", self.max_in_flight));
-        }
-        if !(1..=600_000).contains(&self.max_queue_wait_ms) {
-            return bad("max_queue_wait_ms", format!("{} is outside 1..=600000", self.max_queue_wait_ms));
-        }
-        if !(16..=8192).contains(&self.max_exemplar_side) {
-            return bad("max_exemplar_side", format!("{} is outside 16..=8192", self.max_exemplar_side));
-        }
+        let values = serde_json::to_value(self).map_err(|e| ConfigError(e.to_string()))?;
+        settings::check_ranges(&values).or_else(|(key, msg)| bad(key, msg))?;
         if axum::http::HeaderValue::from_str(&self.cache_control).is_err() {
             return bad("cache_control", "must be a valid header value".into());
         }
@@ -285,41 +213,11 @@ impl Config {
         if let Some(p) = self.trusted_proxies.iter().find(|p| p.parse::<std::net::IpAddr>().is_err()) {
             return bad("trusted_proxies", format!("'{p}' is not an IP address"));
         }
-        if !(1..=1_000_000).contains(&self.max_connections) {
-            return bad("max_connections", format!("{} is outside 1..=1000000", self.max_connections));
-        }
-        if !(1..=3600).contains(&self.header_read_timeout_secs) {
-            return bad("header_read_timeout_secs", format!("{} is outside 1..=3600", self.header_read_timeout_secs));
-        }
-        if self.shutdown_grace_secs > 3600 {
-            return bad("shutdown_grace_secs", format!("{} is outside 0..=3600", self.shutdown_grace_secs));
-        }
         if !self.admin_token.is_empty() && self.admin_token.len() < 16 {
             return bad("admin_token", "must be at least 16 characters (or empty: admin API off)".into());
         }
         if axum::http::HeaderValue::from_str(&format!("Bearer {}", self.admin_token)).is_err() {
             return bad("admin_token", "must be printable ASCII".into());
-        }
-        if !(1..=4096).contains(&self.max_upload_mib) {
-            return bad("max_upload_mib", format!("{} is outside 1..=4096", self.max_upload_mib));
-        }
-        if !(1..=64).contains(&self.max_concurrent_analyses) {
-            return bad("max_concurrent_analyses", format!("{} is outside 1..=64", self.max_concurrent_analyses));
-        }
-        if self.analysis_threads > 1024 {
-            return bad(
-                "analysis_threads",
-                format!("{} is outside 0..=1024 (0 = one fewer than the cores)", self.analysis_threads),
-            );
-        }
-        if !(1..=86_400).contains(&self.analysis_timeout_secs) {
-            return bad("analysis_timeout_secs", format!("{} is outside 1..=86400", self.analysis_timeout_secs));
-        }
-        if self.max_uploaded_textures > 100_000 {
-            return bad("max_uploaded_textures", format!("{} is outside 0..=100000", self.max_uploaded_textures));
-        }
-        if !(64..=1 << 20).contains(&self.memory_budget_mib) {
-            return bad("memory_budget_mib", format!("{} is outside 64..=1048576", self.memory_budget_mib));
         }
         if self.textures.is_empty() {
             return bad("textures", "at least one texture is needed".into());
@@ -335,6 +233,28 @@ impl Config {
             }
         }
         Ok(())
+    }
+
+    /// The configuration as `--print-config` prints it: TOML with each service setting preceded
+    /// by what it does, its range and default and its environment variable; the admin token
+    /// hidden.
+    pub fn to_commented_toml(&self) -> Result<String, ConfigError> {
+        let text = toml::to_string_pretty(&self.redacted()).map_err(|e| ConfigError(e.to_string()))?;
+        let mut out = String::new();
+        let mut top = true;
+        for line in text.lines() {
+            if line.starts_with('[') {
+                top = false;
+            }
+            let key = line.split(" = ").next().unwrap_or("");
+            if let Some(s) = settings::get(key).filter(|_| top) {
+                out.push_str(&settings::comment(s));
+                out.push('\n');
+            }
+            out.push_str(line);
+            out.push('\n');
+        }
+        Ok(out)
     }
 
     /// The configuration as `--print-config` shows it: the admin token hidden.

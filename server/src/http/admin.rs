@@ -5,7 +5,7 @@
 //! need `Authorization: Bearer TOKEN` (the configured `admin_token`); without a configured token
 //! the routes do not exist (404). The catalogue is changed under one lock and replaced whole.
 //! `POST /textures` and `DELETE /textures/{id}` (the names the API contract gives them) are the
-//! same handlers (documented by copy in [`crate::http::openapi`]). Storage and field rules are [`crate::uploads`]'s.
+//! same handlers (documented by copy in the OpenAPI document). Storage and field rules are [`crate::uploads`]'s.
 
 use std::sync::Arc;
 
@@ -136,13 +136,7 @@ fn status_body(tex: &crate::textures::Texture) -> serde_json::Value {
 
 /// Add a texture from an uploaded exemplar.
 #[utoipa::path(post, path = "/admin/textures", tag = "admin",
-    params(("id" = Option<String>, Query, description = "texture id (1-64 of a-z 0-9 _ -); required, here or as a form field"),
-           ("name" = Option<String>, Query, description = "display name"),
-           ("toroidal" = Option<String>, Query, description = "auto, true or false"),
-           ("default_mode" = Option<String>, Query, description = "mode of requests that name none"),
-           ("default_seed" = Option<u64>, Query, description = "seed of requests that name none"),
-           ("attribution" = Option<String>, Query, description = "attribution shown in TileJSON")),
-    request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). At most max_upload_mib MiB; each side at most max_exemplar_side.",
+    request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields (id, required; name, toroidal, index, default_mode, default_seed, attribution) in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). At most max_upload_mib MiB; each side at most max_exemplar_side.",
         content(("image/png"), ("image/jpeg"), ("image/webp"), ("multipart/form-data"))),
     responses((status = 202, description = "accepted: decoded and stored; analysing (Location: the texture's status)"),
               (status = 400, description = "a field is invalid, the image is corrupt or of another format, or it is flat (code flat_image)"),

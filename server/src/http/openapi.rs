@@ -156,14 +156,20 @@ impl Modify for ErrorResponses {
     }
 }
 
-/// Documents `POST /textures` and `DELETE /textures/{id}`, the API contract's names of the admin
-/// routes, as copies of `POST /admin/textures` and `DELETE /admin/textures/{id}` (with operation
-/// ids of their own).
+/// Adds the upload's fields (query parameters of `POST /admin/textures`) from the settings table,
+/// then documents `POST /textures` and `DELETE /textures/{id}`, the API contract's names of the
+/// admin routes, as copies of `POST /admin/textures` and `DELETE /admin/textures/{id}` (with
+/// operation ids of their own).
 struct AdminAliases;
 
 impl Modify for AdminAliases {
     fn modify(&self, doc: &mut utoipa::openapi::OpenApi) {
         let paths = &mut doc.paths.paths;
+        // The upload's fields, as the settings table declares them.
+        if let Some(op) = paths.get_mut("/admin/textures").and_then(|i| i.post.as_mut()) {
+            let fields = crate::config::settings::TEXTURE_FIELDS.iter().map(|s| parameter(s, &[]));
+            op.parameters.get_or_insert_with(Vec::new).extend(fields);
+        }
         let post = paths.get("/admin/textures").and_then(|i| i.post.clone());
         let delete = paths.get("/admin/textures/{id}").and_then(|i| i.delete.clone());
         if let Some(mut op) = post {
