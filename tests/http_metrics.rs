@@ -117,3 +117,37 @@ fn loadtest_runs_every_pattern_and_reports() {
     assert!(!far.status.success());
     assert!(String::from_utf8_lossy(&far.stderr).contains("only targets this machine"));
 }
+
+/// The loadtest's run control and accounting: `--duration` alone ends the run at that time
+/// however many requests that takes, `--requests` alone at that count; requests still in
+/// flight at the deadline are counted as timed out, so every request started is in the report;
+/// an undefined server ratio is null ("n/a"), not a number.
+#[test]
+fn loadtest_bounds_end_runs_alone_and_every_request_is_counted() {
+    let s = Server::builder().start();
+    let run = |args: &[&str]| {
+        let out = Command::new(binary()).args(["loadtest", "--url", &s.base, "--json"]).args(args).output().unwrap();
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("JSON report")
+    };
+    // Hot tiles at 16 connections: far more than the old default of 1000 requests in 2 s would
+    // have ended the run early; now the duration alone ends it.
+    let timed = run(&["--texture", "grass", "--pattern", "hot", "--concurrency", "16", "--duration", "2"]);
+    let secs = timed["seconds"].as_f64().unwrap();
+    assert!((1.5..3.5).contains(&secs), "--duration 2 ran {secs} s: {timed}");
+    let counted = run(&["--texture", "grass", "--pattern", "hot", "--concurrency", "4", "--requests", "50"]);
+    assert_eq!(counted["requests"], 50, "{counted}");
+    // A hot tile, served from the cache: no synthesis in this run, so no computation ratio.
+    assert!(counted["server_computation_ratio"].is_null(), "{counted}");
+    // Cold synth tiles at 8 connections for 1 s: requests are in flight at the deadline. They
+    // are counted as timed out, and the statuses add up to every request started.
+    let busy = run(&["--texture", "brick", "--pattern", "random", "--concurrency", "8", "--duration", "1"]);
+    let timed_out = busy["timed_out"].as_u64().unwrap();
+    assert!(timed_out >= 1, "{busy}");
+    let sum: u64 = busy["status"].as_object().unwrap().values().map(|v| v.as_u64().unwrap()).sum();
+    assert_eq!(sum, busy["requests"].as_u64().unwrap(), "{busy}");
+    assert_eq!(busy["status"]["timed_out"].as_u64(), Some(timed_out));
+    // Bad bounds are clear errors.
+    let bad = Command::new(binary()).args(["loadtest", "--url", &s.base, "--duration", "0"]).output().unwrap();
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("--duration"));
+}

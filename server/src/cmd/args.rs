@@ -269,12 +269,14 @@ pub struct LoadtestArgs {
     /// Concurrent connections (1-1024).
     #[arg(long, default_value_t = 8)]
     pub concurrency: usize,
-    /// Stop after this many requests (1-10000000).
-    #[arg(long, default_value_t = 1000)]
-    pub requests: u64,
-    /// Stop after this many seconds (at most 3600).
-    #[arg(long, default_value_t = 30.0)]
-    pub duration: f64,
+    /// Stop after this many requests (1-10000000). Alone, it ends the run (within an hour);
+    /// with --duration, whichever comes first; with neither, the run lasts 30 s.
+    #[arg(long)]
+    pub requests: Option<u64>,
+    /// Stop after this many seconds (up to 3600). Alone, it ends the run however many requests
+    /// that takes; requests still in flight then are reported as timed out.
+    #[arg(long)]
+    pub duration: Option<f64>,
     /// Query string added to every tile URL, e.g. "mode=mosaic&seed=3".
     #[arg(long, default_value = "")]
     pub query: String,

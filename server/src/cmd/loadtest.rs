@@ -1,8 +1,10 @@
 //! `textile loadtest`: drive a running textile server on this machine with scripted request
 //! patterns — `pan` (a 1920×1080 viewport dragged across the plane), `zoom` (in and out around a
 //! drifting centre), `random` (uniform tiles and zooms), `hot` (one tile) and `replay FILE` — at a
-//! fixed concurrency, bounded by a request count and a duration; then print throughput,
-//! latency percentiles, status counts, bytes and the server's cache hit ratio (from /metrics).
+//! fixed concurrency, ended by a request count, a duration (requests still in flight then are
+//! counted as timed out), or whichever comes first; then print throughput, latency percentiles,
+//! status counts, bytes and the server's figures for this run only (the difference of /metrics
+//! before and after; "n/a" when a ratio is undefined).
 //! Loopback targets only.
 
 use std::collections::BTreeMap;
@@ -103,6 +105,18 @@ fn scrape(text: &str, name: &str) -> f64 {
     text.lines().find_map(|l| l.strip_prefix(name).and_then(|r| r.trim().parse().ok())).unwrap_or(0.0)
 }
 
+/// A run's length when neither `--requests` nor `--duration` is given, in seconds.
+const DEFAULT_SECONDS: f64 = 30.0;
+/// The longest run, in seconds (what bounds a run given only `--requests`).
+const MAX_SECONDS: f64 = 3600.0;
+/// The status recorded for a request still in flight at the deadline.
+const TIMED_OUT: u16 = u16::MAX;
+
+/// A ratio of the report as text: three decimals, or "n/a" when undefined.
+fn na(v: &serde_json::Value) -> String {
+    v.as_f64().map_or("n/a".to_string(), |r| format!("{r:.3}"))
+}
+
 /// Run the load test.
 pub fn run(a: LoadtestArgs) -> CliResult {
     let base = reqwest::Url::parse(&a.url).map_err(|e| format!("--url {}: {e}", a.url))?;
@@ -114,9 +128,18 @@ pub fn run(a: LoadtestArgs) -> CliResult {
     if !(1..=1024).contains(&a.concurrency) {
         return Err("--concurrency must be 1..=1024".into());
     }
-    if !((1..=10_000_000).contains(&a.requests) && a.duration > 0.0 && a.duration <= 3600.0) {
-        return Err("--requests must be 1..=10000000 and --duration 0..=3600 seconds".into());
+    if a.requests.is_some_and(|n| !(1..=10_000_000).contains(&n)) {
+        return Err("--requests must be 1..=10000000".into());
     }
+    if a.duration.is_some_and(|d| !(d > 0.0 && d <= 3600.0)) {
+        return Err("--duration must be more than 0 and at most 3600 seconds".into());
+    }
+    // Each bound ends the run alone; with neither, 30 s.
+    let (max_requests, duration) = match (a.requests, a.duration) {
+        (None, None) => (u64::MAX, DEFAULT_SECONDS),
+        (Some(n), None) => (n, MAX_SECONDS),
+        (n, Some(d)) => (n.unwrap_or(u64::MAX), d),
+    };
     let lines = match (&a.pattern[..], &a.file) {
         ("replay", Some(f)) => {
             let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}", f.display()))?;
@@ -154,11 +177,11 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let paths = Arc::new(Mutex::new(pattern(&a.pattern, &a.texture, native, minzoom, &a.query, lines, a.seed)));
         let issued = Arc::new(std::sync::atomic::AtomicU64::new(0));
         let started = Instant::now();
-        let deadline = started + Duration::from_secs_f64(a.duration);
+        let deadline = started + Duration::from_secs_f64(duration);
         let mut tasks = Vec::new();
         for _ in 0..a.concurrency {
             let (client, paths, issued, root) = (client.clone(), paths.clone(), issued.clone(), root.clone());
-            let (max, polite) = (a.requests, a.honor_retry_after);
+            let (max, polite) = (max_requests, a.honor_retry_after);
             tasks.push(tokio::spawn(async move {
                 let mut out = Vec::new();
                 while Instant::now() < deadline && issued.fetch_add(1, std::sync::atomic::Ordering::Relaxed) < max {
@@ -182,7 +205,11 @@ pub fn run(a: LoadtestArgs) -> CliResult {
                             }
                         }
                         Ok(Err(_)) => out.push((t.elapsed(), 0, 0)),
-                        Err(_) => break,
+                        // Still in flight at the deadline: counted, as timed out.
+                        Err(_) => {
+                            out.push((t.elapsed(), TIMED_OUT, 0));
+                            break;
+                        }
                     }
                 }
                 out
@@ -196,9 +223,13 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let metrics_after = client.get(format!("{root}/metrics")).send().await?.text().await?;
         let d = |n: &str| scrape(&metrics_after, n) - scrape(&metrics_before, n);
         let (hits, misses) = (d("textile_cache_hits_total"), d("textile_cache_misses_total"));
+        // Latencies of the requests that ended (a timed-out one's is unknown: it is counted apart).
         let sorted = |ok_only: bool| {
-            let mut v: Vec<f64> =
-                all.iter().filter(|r| !ok_only || r.1 == 200).map(|r| r.0.as_secs_f64() * 1e3).collect();
+            let mut v: Vec<f64> = all
+                .iter()
+                .filter(|r| r.1 != TIMED_OUT && (!ok_only || r.1 == 200))
+                .map(|r| r.0.as_secs_f64() * 1e3)
+                .collect();
             v.sort_by(f64::total_cmp);
             v
         };
@@ -207,7 +238,12 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let q = |p: f64| pct(&lat, p);
         let mut statuses = BTreeMap::new();
         for r in &all {
-            *statuses.entry(if r.1 == 0 { "error".to_string() } else { r.1.to_string() }).or_insert(0u64) += 1;
+            let key = match r.1 {
+                0 => "error".to_string(),
+                TIMED_OUT => "timed_out".to_string(),
+                s => s.to_string(),
+            };
+            *statuses.entry(key).or_insert(0u64) += 1;
         }
         let bytes: u64 = all.iter().map(|r| r.2 as u64).sum();
         // Pixels synthesized at all levels ÷ pixels delivered, over the syntheses of this run.
@@ -215,14 +251,16 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_pixels_{kind}_total{{mode=\"{m}\"}}"))).sum::<f64>()
         };
         let (synthesized, delivered) = (px("synthesized"), px("delivered"));
-        let ratio = if delivered > 0.0 { synthesized / delivered } else { 0.0 };
+        // Undefined (no synthesis, no lookup in this run): null, printed "n/a".
+        let ratio = (delivered > 0.0).then(|| synthesized / delivered);
         let report = json!({
             "pattern": a.pattern, "texture": a.texture, "concurrency": a.concurrency,
             "requests": all.len(), "seconds": elapsed, "requests_per_second": all.len() as f64 / elapsed,
             "latency_ms": { "p50": q(0.5), "p90": q(0.9), "p99": q(0.99), "max": q(1.0) },
             "latency_ms_200": { "p50": pct(&ok, 0.5), "p90": pct(&ok, 0.9), "p99": pct(&ok, 0.99), "max": pct(&ok, 1.0) },
             "status": statuses, "bytes": bytes,
-            "server_cache_hit_ratio": if hits + misses > 0.0 { hits / (hits + misses) } else { 0.0 },
+            "timed_out": statuses.get("timed_out").copied().unwrap_or(0),
+            "server_cache_hit_ratio": (hits + misses > 0.0).then(|| hits / (hits + misses)),
             "server_syntheses": textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_syntheses_total{{mode=\"{m}\"}}"))).sum::<f64>() as u64,
             "server_computation_ratio": ratio,
         });
@@ -252,10 +290,10 @@ pub fn run(a: LoadtestArgs) -> CliResult {
                 writeln!(out, "status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
             let _ = writeln!(
                 out,
-                "server: cache hit ratio {:.3} ({hits} hits, {misses} misses), {} syntheses, computation ratio {:.3}",
-                report["server_cache_hit_ratio"].as_f64().unwrap_or(0.0),
+                "server: cache hit ratio {} ({hits} hits, {misses} misses), {} syntheses, computation ratio {}",
+                na(&report["server_cache_hit_ratio"]),
                 report["server_syntheses"],
-                report["server_computation_ratio"].as_f64().unwrap_or(0.0)
+                na(&report["server_computation_ratio"])
             );
         }
         Ok::<(), Box<dyn std::error::Error>>(())
