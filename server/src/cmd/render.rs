@@ -98,6 +98,13 @@ pub fn run(a: RenderArgs) -> CliResult {
         pairs.push(("controls".into(), base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(compact)));
     }
     let params = tex.defaults.request(&tex.source(), ParamReader::texture(pairs)?)?;
+    // A texture made from --exemplar has no data directory: what its mode prepares is made once
+    // here, in memory, not again by every window the mode renders (a camera view renders many).
+    if let (Some(_), Some(step)) = (&a.exemplar, params.info().preparation) {
+        let input = textile_core::prepare::Input::exemplar(&tex.exemplar);
+        let (state, _) = step.run(&input, None, false, &|| false, &textile_core::NoProgress, &Cancel::new())?;
+        tex.prepared.set(params.name(), state);
+    }
     if a.sheet {
         return sheet(&tex, &params, &output);
     }

@@ -86,8 +86,9 @@ pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap, peer: 
 /// bytes it holds (caches included); `{"status": "preparing"}` until it is ready.
 fn prepared(t: &crate::textures::Texture) -> Value {
     let mut out = serde_json::Map::new();
+    let states = t.prepared.all();
     for (mode, step) in textile_core::modes::preparations() {
-        let v = match t.prepared.all().into_iter().find(|(m, _)| *m == mode) {
+        let v = match states.iter().find(|(m, _)| *m == mode) {
             Some((_, state)) => {
                 let mut d = state.describe();
                 d.insert("status".into(), json!("ready"));
