@@ -87,3 +87,33 @@ fn exported_archive_in_headless_chromium() {
         .expect("run node");
     assert!(status.success(), "archive page test failed (see the node test output above)");
 }
+
+/// textile's 3D documents in the clients users run (`tests/browser/clients3d.test.mjs`): three.js
+/// `GLTFLoader` on bordered, mipmapped glTF tiles (no seams up close, less aliasing far away,
+/// both measured against one-texture references), and X_ITE on X3D tile and patch documents
+/// (they show the tile, seen from above). Pictures go to `target/tmp/clients3d/`.
+#[test]
+fn three_d_clients_in_headless_chromium() {
+    let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/browser");
+    if !PathBuf::from(&chromium).exists() {
+        return common::skip("three_d_clients_in_headless_chromium", &format!("no Chromium at {chromium}"));
+    }
+    for package in ["playwright-core", "three", "x_ite"] {
+        if let Err(why) = common::npm_ready(&dir, package) {
+            return common::skip("three_d_clients_in_headless_chromium", &why);
+        }
+    }
+    let server = Server::builder().queueing().start();
+    let artefacts = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("clients3d");
+    let status = Command::new("node")
+        .args(["--test", "--test-concurrency=1", "clients3d.test.mjs"])
+        .current_dir(&dir)
+        .env("TEXTILE_URL", &server.base)
+        .env("TEXTILE_ARTEFACTS", &artefacts)
+        .env("CHROMIUM", &chromium)
+        .status()
+        .expect("run node");
+    assert!(status.success(), "3D client tests failed (see the node test output above)");
+    eprintln!("3D client pictures: {}", artefacts.display());
+}

@@ -47,7 +47,7 @@ async fn forwarded_headers_count_only_from_trusted_proxies() {
     let catalog = body(&trusting, "/catalog", XF).await;
     assert!(catalog.contains("https://tiles.example.org/tiles/gravel/tilejson.json"), "{catalog}");
     let x3d = body(&trusting, "/x3d/gravel/7/0/0.x3d", XF).await;
-    assert!(x3d.contains("https://tiles.example.org/tiles/gravel/7/0/0.png"), "{x3d}");
+    assert!(x3d.contains("https://tiles.example.org/gltf/gravel/7/0/0.png"), "{x3d}");
     let gltf = body(&trusting, "/gltf/gravel/7/0/0.gltf", XF).await;
     assert!(gltf.contains("https://tiles.example.org/tiles/gravel/7/0/0.png"), "{gltf}");
 
@@ -61,7 +61,7 @@ async fn a_configured_public_url_wins() {
     let s = Server::builder().env("TEXTILE_PUBLIC_URL", "https://cdn.example.com/textile/").start();
     assert!(tiles_url(&s, XF).await.starts_with("https://cdn.example.com/textile/tiles/gravel/{z}/{x}/{y}.png?"));
     let x3d = body(&s, "/x3d/gravel/7/0/0.x3d", &[]).await;
-    assert!(x3d.contains("https://cdn.example.com/textile/tiles/gravel/7/0/0.png"), "{x3d}");
+    assert!(x3d.contains("https://cdn.example.com/textile/gltf/gravel/7/0/0.png"), "{x3d}");
     // A bad one is refused at start, naming the key.
     let out = std::process::Command::new(common::binary())
         .args(["serve", "--bind", "127.0.0.1:0"])

@@ -164,6 +164,7 @@ async fn health_ready_viewer_and_openapi() {
         "/gltf/{id}/{z}/{x}/{y}.{ext}",
         "/gltf/{id}/patch.glb",
         "/x3d/{id}/{z}/{x}/{y}.x3d",
+        "/x3d/{id}/patch.x3d",
     ] {
         assert!(paths.contains_key(p), "openapi lacks {p}");
     }

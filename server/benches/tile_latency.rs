@@ -2,7 +2,9 @@
 //! binary on a free loopback port, then with one connection, one request at a time:
 //! * cold: N distinct, never-requested native tiles (synthesis + PNG + HTTP);
 //! * cached: the same N tiles again (cache hits);
-//! * cold mosaic: N distinct `mode=mosaic` tiles.
+//! * cold mosaic: N distinct `mode=mosaic` tiles;
+//! * cold and cached GLB: N distinct glTF tiles elsewhere (the 288² bordered image: synthesis,
+//!   PNG, GLB, HTTP), then the same again (the padding's cost beside the PNG tile).
 //!
 //! In process it also times one 256² synthesis and the PNG/JPEG/WebP encoding of a tile.
 //! Prints median / p90 / p99 / max per figure.
@@ -89,10 +91,21 @@ fn main() {
             .map(|i| format!("{base}/tiles/gravel/7/{}/{}.png", (i * 7919) % 100_003 - 50_000, (i * 104_729) % 99_991))
             .collect();
         let mosaic: Vec<String> = urls.iter().map(|u| format!("{u}?mode=mosaic")).collect();
+        let glb: Vec<String> = (0..n as i64)
+            .map(|i| {
+                format!(
+                    "{base}/gltf/gravel/7/{}/{}.glb",
+                    (i * 7919) % 100_003 - 50_000,
+                    200_000 + (i * 104_729) % 99_991
+                )
+            })
+            .collect();
         for (name, pass, list) in [
             ("cold synth tile over HTTP", 0, &urls),
             ("cached tile over HTTP", 1, &urls),
             ("cold mosaic tile over HTTP", 0, &mosaic),
+            ("cold GLB tile over HTTP", 0, &glb),
+            ("cached GLB tile over HTTP", 1, &glb),
         ] {
             let mut v = Vec::with_capacity(n);
             for u in list {

@@ -4,11 +4,17 @@
 //! World frame (documented in the README): Y up, X east = texel x, Z south = texel y, 1 unit =
 //! 1 texel at the native zoom. A tile at zoom z covers `s = 256·2^(N−z)` units; its node is
 //! translated to `(s·x, 0, s·y)` and its mesh spans `[0, s]²` locally, so vertex positions stay
-//! small (f32-exact) however far the tile is. Texture coordinates put the image's top-left at the
-//! quad's north-west corner; samplers clamp to edge so neighbouring tiles meet without bleeding.
+//! small (f32-exact) however far the tile is.
+//!
+//! Each quad's image is its tile with a border of [`BORDER`] texels of the neighbouring texture
+//! on every side (a window of the one texture, so the border is exactly what the neighbours
+//! show); texture coordinates map the quad onto the inner 256², and samplers filter with
+//! mipmaps (`LINEAR_MIPMAP_LINEAR`). Bilinear filtering and mip levels then blend across a tile
+//! edge as they would inside one big texture.
 
 use base64::Engine;
 use serde_json::{json, Value};
+use textile_core::TILE_SIZE;
 
 /// One textured ground quad.
 pub struct Quad {
@@ -20,9 +26,35 @@ pub struct Quad {
     pub size: f64,
 }
 
+/// Border texels around a tile's 256² in every 3D asset image (288² images). 16 is the widest
+/// border the mip levels a client builds need before the tile should be replaced by a coarser
+/// zoom: at mip level `l` the border is `16 / 2^l` texels, at least one up to level 4 (1/16
+/// minification, four zoom levels out), where a bilinear tap reaches half a texel past the inner
+/// square; and it is even at every level up to 4, so those levels' texels fall on the same world
+/// grid as one big texture's. It costs 27 % more texels than the bare tile.
+pub const BORDER: u32 = 16;
+
+/// Version of the documents' layout (border, texture coordinates, samplers, viewpoints): part of
+/// every 3D asset's cache key, so a change of layout changes their ETags.
+pub const LAYOUT: u32 = 2;
+
+/// Side of a tile's image in the 3D assets, border included.
+pub fn image_side() -> u32 {
+    TILE_SIZE as u32 + 2 * BORDER
+}
+
+/// The texture coordinate of the inner square's near edge (the far edge is `1 - inset()`).
+fn inset() -> f64 {
+    BORDER as f64 / image_side() as f64
+}
+
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const CHUNK_JSON: u32 = 0x4E4F_534A;
 const CHUNK_BIN: u32 = 0x004E_4942;
+// Sampler constants (WebGL enums, as glTF names them).
+const LINEAR: u32 = 9729;
+const LINEAR_MIPMAP_LINEAR: u32 = 9987;
+const CLAMP_TO_EDGE: u32 = 33071;
 
 fn pad4(v: &mut Vec<u8>, byte: u8) {
     while !v.len().is_multiple_of(4) {
@@ -36,7 +68,8 @@ fn geometry(size: f32) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
     let mut b = Vec::new();
     let pos = [[0.0, 0.0, 0.0], [size, 0.0, 0.0], [size, 0.0, size], [0.0, 0.0, size]];
     let nrm = [[0.0f32, 1.0, 0.0]; 4];
-    let uv = [[0.0f32, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    let (near, far) = (inset() as f32, 1.0 - inset() as f32);
+    let uv = [[near, near], [far, near], [far, far], [near, far]];
     let idx: [u16; 6] = [0, 2, 1, 0, 3, 2];
     let mut views = Vec::new();
     let mut push = |b: &mut Vec<u8>, bytes: Vec<u8>, target: u32| {
@@ -77,7 +110,7 @@ fn document(quads: &[Quad], generator: &str, views: Vec<Value>, accessors: Vec<V
             "pbrMetallicRoughness": { "baseColorTexture": { "index": i }, "metallicFactor": 0.0, "roughnessFactor": 1.0 },
         })).collect::<Vec<_>>(),
         "textures": (0..n).map(|i| json!({ "sampler": 0, "source": i })).collect::<Vec<_>>(),
-        "samplers": [{ "magFilter": 9729, "minFilter": 9729, "wrapS": 33071, "wrapT": 33071 }],
+        "samplers": [{ "magFilter": LINEAR, "minFilter": LINEAR_MIPMAP_LINEAR, "wrapS": CLAMP_TO_EDGE, "wrapT": CLAMP_TO_EDGE }],
         "images": images,
         "accessors": accessors,
         "bufferViews": views,
@@ -128,37 +161,62 @@ fn xml_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;").replace('\'', "&apos;")
 }
 
-/// An X3D scene: the quad with an `ImageTexture` pointing at the tile URL.
-pub fn x3d(q: &Quad, image_url: &str, generator: &str) -> String {
-    let s = q.size;
+/// An X3D scene of quads (equal sizes) whose `ImageTexture`s point at `image_urls`, with a
+/// `Viewpoint` looking straight down at them from a height equal to their extent, which frames
+/// them in a square view. There is no `Material`: X3D then shows the texture unlit, as it is.
+pub fn x3d(quads: &[Quad], image_urls: &[String], generator: &str) -> String {
+    let s = quads.first().map(|q| q.size).unwrap_or(1.0);
+    let (mut x0, mut z0, mut x1, mut z1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for q in quads {
+        (x0, z0) = (x0.min(q.origin.0), z0.min(q.origin.1));
+        (x1, z1) = (x1.max(q.origin.0 + s), z1.max(q.origin.1 + s));
+    }
+    let extent = (x1 - x0).max(z1 - z0);
+    // Looking down: the default view (along −Z, up +Y) turned −90° about X looks along −Y with
+    // north (−Z) up, so the screen shows the texture as its images do.
+    let (a, b) = (inset(), 1.0 - inset());
+    let mut shapes = String::new();
+    for (q, url) in quads.iter().zip(image_urls) {
+        shapes += &format!(
+            r#"    <Transform DEF="{def}" translation="{x} 0 {z}">
+      <Shape>
+        <Appearance>
+          <ImageTexture url='"{url}"' repeatS="false" repeatT="false">
+            <TextureProperties generateMipMaps="true" minificationFilter="AVG_PIXEL_AVG_MIPMAP" magnificationFilter="AVG_PIXEL" boundaryModeS="CLAMP_TO_EDGE" boundaryModeT="CLAMP_TO_EDGE"/>
+          </ImageTexture>
+        </Appearance>
+        <IndexedFaceSet solid="false" coordIndex="0 2 1 -1 0 3 2 -1" texCoordIndex="0 2 1 -1 0 3 2 -1">
+          <Coordinate point="0 0 0, {s} 0 0, {s} 0 {s}, 0 0 {s}"/>
+          <TextureCoordinate point="{a} {b}, {b} {b}, {b} {a}, {a} {a}"/>
+        </IndexedFaceSet>
+      </Shape>
+    </Transform>
+"#,
+            def = xml_escape(&q.name),
+            x = q.origin.0,
+            z = q.origin.1,
+            url = xml_escape(url),
+        );
+    }
+    let names = quads.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ");
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <X3D profile="Interchange" version="3.3" xmlns:xsd="http://www.w3.org/2001/XMLSchema-instance">
   <head>
+    <component name="Texturing" level="3"/>
     <meta name="generator" content="{gen}"/>
-    <meta name="description" content="{name}: a ground quad (Y up, X east, Z south, 1 unit = 1 native texel)"/>
+    <meta name="description" content="{names}: ground quads (Y up, X east, Z south, 1 unit = 1 native texel)"/>
   </head>
   <Scene>
-    <Transform DEF="{def}" translation="{x} 0 {z}">
-      <Shape>
-        <Appearance>
-          <Material diffuseColor="1 1 1"/>
-          <ImageTexture url='"{url}"' repeatS="false" repeatT="false"/>
-        </Appearance>
-        <IndexedFaceSet solid="false" coordIndex="0 2 1 -1 0 3 2 -1" texCoordIndex="0 2 1 -1 0 3 2 -1">
-          <Coordinate point="0 0 0, {s} 0 0, {s} 0 {s}, 0 0 {s}"/>
-          <TextureCoordinate point="0 1, 1 1, 1 0, 0 0"/>
-        </IndexedFaceSet>
-      </Shape>
-    </Transform>
-  </Scene>
+    <NavigationInfo type='"EXAMINE" "ANY"' headlight="true"/>
+    <Viewpoint description="top down" position="{cx} {h} {cz}" orientation="1 0 0 -1.5707963267948966" fieldOfView="0.9272952180016122" centerOfRotation="{cx} 0 {cz}"/>
+{shapes}  </Scene>
 </X3D>
 "#,
         gen = xml_escape(generator),
-        name = xml_escape(&q.name),
-        def = xml_escape(&q.name.replace(['/', ' '], "_")),
-        x = q.origin.0,
-        z = q.origin.1,
-        url = xml_escape(image_url),
+        names = xml_escape(&names),
+        cx = (x0 + x1) / 2.0,
+        cz = (z0 + z1) / 2.0,
+        h = extent,
     )
 }

@@ -99,6 +99,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/samples/{id}", post(samples::samples))
         .route("/gltf/{id}/patch.glb", get(models::gltf_patch))
         .route("/gltf/{id}/{z}/{x}/{y}", get(models::gltf_tile))
+        .route("/x3d/{id}/patch.x3d", get(models::x3d_patch))
         .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile));
     // Exported archives, served as static files with range requests (what PMTiles readers use).
     let routes = match state.config.archives_dir.as_str() {

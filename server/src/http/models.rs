@@ -1,6 +1,8 @@
-//! 3D asset endpoints: a tile as glTF (`.glb` with the tile image embedded, `.gltf` referencing
-//! the tile URL), an N×N patch of tiles as one GLB scene, and an X3D scene. Same parameters,
-//! validation, ETags and caching as tiles; the images come through the tile cache.
+//! 3D asset endpoints: a tile as glTF (`.glb` with its image embedded, `.gltf` referencing it),
+//! an N×N patch of tiles as one GLB scene, and X3D scenes of a tile or a patch. Same parameters,
+//! validation, ETags and caching as tiles. Each quad's image is its tile with a border of the
+//! neighbouring texture ([`BORDER`] texels, a window of the one texture), produced through the
+//! tile cache like any window.
 
 use std::sync::Arc;
 
@@ -14,14 +16,14 @@ use std::collections::BTreeMap;
 
 use textile_core::{ModeParams, ParamReader, TILE_SIZE};
 
-use crate::assets::{glb, gltf_json, x3d, Quad};
+use crate::assets::{glb, gltf_json, image_side, x3d, Quad, BORDER, LAYOUT};
 use crate::encode::Format;
 use crate::error::ApiError;
 use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{base_url, path_error, texture, Peer};
 use crate::metrics::GLTF_LABEL;
 use crate::pipeline::{cache_key, cached, engine_version, etag_for, produce, ImageJob, Target};
-use crate::request::{params, parse_tile, query_pairs, TileSpec, COORD_MAX};
+use crate::request::{params, parse_tile, query_pairs, TileSpec, WindowSpec, COORD_MAX};
 use crate::state::AppState;
 use crate::textures::Texture;
 
@@ -38,7 +40,9 @@ fn generator() -> String {
 fn quad(tex: &Texture, t: &TileSpec) -> Quad {
     // Native texels per tile side (a fraction of a tile when magnified).
     let size = TILE_SIZE as f64 * 2f64.powi(tex.native_zoom() as i32 - t.z as i32);
-    Quad { name: format!("tile {}/{}/{}", t.z, t.x, t.y), origin: (size * t.x as f64, size * t.y as f64), size }
+    // `tile_z_x_y`: names clients keep as they are (three.js would fold "tile 7/1/11" and
+    // "tile 7/11/1" into one).
+    Quad { name: format!("tile_{}_{}_{}", t.z, t.x, t.y), origin: (size * t.x as f64, size * t.y as f64), size }
 }
 
 /// The tile URL (absolute) with the request's parameters.
@@ -52,16 +56,22 @@ fn tile_url(base: &str, tex: &Texture, t: &TileSpec, q: &Query) -> String {
     format!("{base}/tiles/{}/{}/{}/{}.png{sep}{qs}", tex.config.id, t.z, t.x, t.y)
 }
 
-/// The relative URI of a tile image served beside its .gltf document.
-fn sibling_image(r: &TileRequest) -> String {
+/// The relative URI of a tile's image served beside its .gltf document: `{y}.png`, or
+/// `{y}.{token}.png` with the parameters as a base64url token (glTF wants URIs without a query).
+fn sibling_image(r: &TileRequest, spec: &TileSpec) -> String {
     if r.query.is_empty() {
-        return format!("{}.png", r.spec.y);
+        return format!("{}.png", spec.y);
     }
     let mut qs = form_urlencoded::Serializer::new(String::new());
     for (k, v) in &r.query {
         qs.append_pair(k, v);
     }
-    format!("{}.{}.png", r.spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(qs.finish()))
+    format!("{}.{}.png", spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(qs.finish()))
+}
+
+/// The absolute URL of a tile's image (border included) for X3D documents.
+fn image_url(base: &str, r: &TileRequest, spec: &TileSpec) -> String {
+    format!("{base}/gltf/{}/{}/{}/{}", r.tex.config.id, spec.z, spec.x, sibling_image(r, spec))
 }
 
 fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), ApiError> {
@@ -79,19 +89,28 @@ struct TileRequest {
 }
 
 impl TileRequest {
-    /// The PNG tile this asset shows.
+    /// The image of the tile this asset shows.
     fn image(&self) -> ImageJob {
         self.image_at(self.spec)
     }
 
-    /// The PNG tile at `spec` with this request's texture and parameters.
+    /// The image of the tile at `spec` with this request's texture and parameters: the PNG
+    /// window of the tile and [`BORDER`] texels around it, at the tile's zoom.
     fn image_at(&self, spec: TileSpec) -> ImageJob {
-        let spec = TileSpec { format: Format::Png, scale: 1, ..spec };
-        ImageJob { tex: self.tex.clone(), params: self.params.clone(), target: Target::Tile(spec) }
+        let (b, side) = (BORDER as i64, image_side() as i64);
+        let window = WindowSpec {
+            z: spec.z,
+            x: TILE_SIZE * spec.x - b,
+            y: TILE_SIZE * spec.y - b,
+            w: side,
+            h: side,
+            format: Format::Png,
+        };
+        ImageJob { tex: self.tex.clone(), params: self.params.clone(), target: Target::Window(window) }
     }
 }
 
-/// The bytes of a PNG tile, through the pipeline.
+/// The bytes of a tile's image, through the pipeline.
 async fn tile_png(st: &Arc<AppState>, etag: &str, job: ImageJob) -> Result<Vec<u8>, ApiError> {
     Ok(produce(st, etag, job).await.0?.to_vec())
 }
@@ -127,7 +146,7 @@ fn tile_request(
 }
 
 fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
-    cache_key(&r.tex, &r.params, format_args!("{kind}|{}|{}|{}|{extra}", r.spec.z, r.spec.x, r.spec.y))
+    cache_key(&r.tex, &r.params, format_args!("{kind}{LAYOUT}|{}|{}|{}|{extra}", r.spec.z, r.spec.x, r.spec.y))
 }
 
 /// A tile as a glTF 2.0 ground quad: `.glb` embeds the PNG tile, `.gltf` references the tile
@@ -170,7 +189,7 @@ pub async fn gltf_tile(
         // glTF wants relative URIs without a query: the image is served beside this document as
         // `{y}.png` or `{y}.{token}.png` (the parameters, base64url) with the tile's bytes. The
         // tile endpoint's absolute URL is in the image's extras for clients that prefer it.
-        let mut doc = gltf_json(&[quad(&r.tex, &r.spec)], &[sibling_image(&r)], &generator());
+        let mut doc = gltf_json(&[quad(&r.tex, &r.spec)], &[sibling_image(&r, &r.spec)], &generator());
         doc["images"][0]["extras"] = serde_json::json!({ "tile_url": tile_url(&base, &r.tex, &r.spec, &r.query) });
         let body = serde_json::to_vec(&doc).map_err(|e| ApiError::internal(e.to_string()))?;
         return Ok(image(body.into(), "model/gltf+json", &etag, cc, false));
@@ -190,19 +209,13 @@ pub async fn gltf_tile(
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
-/// An N×N patch of tiles (top-left tile `x, y`) as one GLB scene, one node per tile.
-#[utoipa::path(get, path = "/gltf/{id}/patch.glb", tag = "3d",
-    params(("id" = String, Path, description = "texture id"), ("z" = u32, Query, description = "zoom"),
-           ("x" = i64, Query, description = "left tile column"), ("y" = i64, Query, description = "top tile row"),
-           ("tiles" = u32, Query, description = "patch side in tiles, 1..=8")),
-    responses((status = 200, description = "model/gltf-binary"), (status = 400, description = "bad parameters"),
-              (status = 404, description = "unknown texture")))]
-pub async fn gltf_patch(
-    State(st): State<Arc<AppState>>,
+/// A patch's request: the tile request of its top-left tile and its side in tiles, from the
+/// query's `z`, `x`, `y` and `tiles`.
+fn patch_request(
+    st: &AppState,
     path: Result<Path<String>, PathRejection>,
-    RawQuery(raw): RawQuery,
-    headers: HeaderMap,
-) -> Result<Response, ApiError> {
+    raw: Option<String>,
+) -> Result<(TileRequest, i64), ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
     let tex = texture(&reg, &id)?;
@@ -227,7 +240,28 @@ pub async fn gltf_patch(
     }
     let params = params(&tex, reader)?;
     let query = pairs.into_iter().filter(|(k, _)| !["z", "x", "y", "tiles"].contains(&k.as_str())).collect();
-    let r = TileRequest { tex: tex.clone(), spec: origin, query, params };
+    Ok((TileRequest { tex, spec: origin, query, params }, n))
+}
+
+/// The tiles of an N×N patch, row by row.
+fn patch_tiles(origin: TileSpec, n: i64) -> impl Iterator<Item = TileSpec> {
+    (0..n).flat_map(move |j| (0..n).map(move |i| TileSpec { x: origin.x + i, y: origin.y + j, ..origin }))
+}
+
+/// An N×N patch of tiles (top-left tile `x, y`) as one GLB scene, one node per tile.
+#[utoipa::path(get, path = "/gltf/{id}/patch.glb", tag = "3d",
+    params(("id" = String, Path, description = "texture id"), ("z" = u32, Query, description = "zoom"),
+           ("x" = i64, Query, description = "left tile column"), ("y" = i64, Query, description = "top tile row"),
+           ("tiles" = u32, Query, description = "patch side in tiles, 1..=8")),
+    responses((status = 200, description = "model/gltf-binary"), (status = 400, description = "bad parameters"),
+              (status = 404, description = "unknown texture")))]
+pub async fn gltf_patch(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<String>, PathRejection>,
+    RawQuery(raw): RawQuery,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let (r, n) = patch_request(&st, path, raw)?;
     let etag = etag_for(&key(&r, "patch", &n.to_string()));
     let cc = &st.config.cache_control;
     if if_none_match(&headers, &etag) {
@@ -236,23 +270,30 @@ pub async fn gltf_patch(
     if let Some(b) = st.cache.peek(&etag) {
         return Ok(image(b, "model/gltf-binary", &etag, cc, true));
     }
-    // The tiles' PNGs and the document are held together: reserve room for them.
-    let _memory = st.reserve((4 << 20) + (n * n) as u64 * (256 << 10)).await?;
+    // The tiles' images and the document are held together: reserve room for them.
+    let _memory = st.reserve((4 << 20) + (n * n) as u64 * (320 << 10)).await?;
     let mut quads = Vec::new();
     let mut images = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let spec = TileSpec { x: origin.x + i, y: origin.y + j, ..origin };
-            let job = r.image_at(spec);
-            images.push((tile_png(&st, &job.etag(), job).await?, "image/png"));
-            quads.push(quad(&tex, &spec));
-        }
+    for spec in patch_tiles(r.spec, n) {
+        let job = r.image_at(spec);
+        images.push((tile_png(&st, &job.etag(), job).await?, "image/png"));
+        quads.push(quad(&r.tex, &spec));
     }
     let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&quads, &images, &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
-/// A tile as an X3D scene whose `ImageTexture` points at the tile URL (the VRML use case).
+/// X3D bytes for `quads` of request `r`, with its ETag handling.
+fn x3d_answer(st: &AppState, headers: &HeaderMap, etag: &str, doc: impl FnOnce() -> String) -> Response {
+    let cc = &st.config.cache_control;
+    if if_none_match(headers, etag) {
+        return not_modified(etag, cc);
+    }
+    image(doc().into_bytes().into(), "model/x3d+xml", etag, cc, false)
+}
+
+/// A tile as an X3D scene (the VRML use case): its ground quad, whose `ImageTexture` points at
+/// the tile's image (border included), and a `Viewpoint` looking down at it.
 #[utoipa::path(get, path = "/x3d/{id}/{z}/{x}/{y}.x3d", tag = "3d",
     params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
            ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row")),
@@ -268,10 +309,32 @@ pub async fn x3d_tile(
     let (r, _) = tile_request(&st, path, raw, &["x3d"])?;
     let base = base_url(&st, &headers, peer);
     let etag = etag_for(&key(&r, "x3d", &base));
-    let cc = &st.config.cache_control;
-    if if_none_match(&headers, &etag) {
-        return Ok(not_modified(&etag, cc));
-    }
-    let doc = x3d(&quad(&r.tex, &r.spec), &tile_url(&base, &r.tex, &r.spec, &r.query), &generator());
-    Ok(image(doc.into_bytes().into(), "model/x3d+xml", &etag, cc, false))
+    Ok(x3d_answer(&st, &headers, &etag, || {
+        x3d(&[quad(&r.tex, &r.spec)], &[image_url(&base, &r, &r.spec)], &generator())
+    }))
+}
+
+/// An N×N patch of tiles (top-left tile `x, y`) as one X3D scene, one `Transform` per tile.
+#[utoipa::path(get, path = "/x3d/{id}/patch.x3d", tag = "3d",
+    params(("id" = String, Path, description = "texture id"), ("z" = u32, Query, description = "zoom"),
+           ("x" = i64, Query, description = "left tile column"), ("y" = i64, Query, description = "top tile row"),
+           ("tiles" = u32, Query, description = "patch side in tiles, 1..=8")),
+    responses((status = 200, description = "model/x3d+xml"), (status = 400, description = "bad parameters"),
+              (status = 404, description = "unknown texture")))]
+pub async fn x3d_patch(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<String>, PathRejection>,
+    RawQuery(raw): RawQuery,
+    headers: HeaderMap,
+    peer: Peer,
+) -> Result<Response, ApiError> {
+    let (r, n) = patch_request(&st, path, raw)?;
+    let base = base_url(&st, &headers, peer);
+    let etag = etag_for(&key(&r, "x3d-patch", &format!("{n}|{base}")));
+    Ok(x3d_answer(&st, &headers, &etag, || {
+        let tiles: Vec<TileSpec> = patch_tiles(r.spec, n).collect();
+        let quads: Vec<Quad> = tiles.iter().map(|t| quad(&r.tex, t)).collect();
+        let urls: Vec<String> = tiles.iter().map(|t| image_url(&base, &r, t)).collect();
+        x3d(&quads, &urls, &generator())
+    }))
 }

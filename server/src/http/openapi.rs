@@ -33,7 +33,8 @@ use utoipa::{Modify, OpenApi};
         crate::http::static_files::world,
         crate::http::models::gltf_tile,
         crate::http::models::gltf_patch,
-        crate::http::models::x3d_tile
+        crate::http::models::x3d_tile,
+        crate::http::models::x3d_patch
     )
 )]
 pub struct ApiDoc;
@@ -47,6 +48,7 @@ const WITH_MODE_PARAMETERS: &[&str] = &[
     "/gltf/{id}/{z}/{x}/{y}.{ext}",
     "/gltf/{id}/patch.glb",
     "/x3d/{id}/{z}/{x}/{y}.x3d",
+    "/x3d/{id}/patch.x3d",
 ];
 
 /// Adds the common and every mode's request parameters to [`WITH_MODE_PARAMETERS`].

@@ -1,0 +1,155 @@
+// textile's 3D documents in the clients users run, in headless Chromium (WebGL on SwiftShader):
+// three.js GLTFLoader on bordered, mipmapped glTF tiles, and X_ITE on X3D documents. Run by
+// tests/browser.rs against the real binary (TEXTILE_URL); pictures go to TEXTILE_ARTEFACTS.
+//
+// The libraries come from this folder's node_modules (pinned by package-lock.json) and are
+// served on the server's own origin under /__3d/ by Playwright's request routing, so every
+// request the page makes is same-origin; nothing of textile is mocked.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
+import { join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const BASE = process.env.TEXTILE_URL;
+const ARTEFACTS = process.env.TEXTILE_ARTEFACTS;
+const HERE = dirname(fileURLToPath(import.meta.url));
+const MODULES = join(HERE, 'node_modules');
+let browser;
+
+const TYPES = { js: 'text/javascript', mjs: 'text/javascript', html: 'text/html', css: 'text/css' };
+
+const THREE_PAGE = `<!doctype html><html><head><meta charset="utf-8">
+<script type="importmap">{"imports": {"three": "/__3d/three/build/three.module.js",
+  "three/addons/": "/__3d/three/examples/jsm/"}}</script></head>
+<body><script type="module">
+  import * as scenes from '/__3d/clients3d/three-scenes.js';
+  window.scenes = scenes;
+  document.body.dataset.ready = '1';
+</script></body></html>`;
+
+const X3D_PAGE = `<!doctype html><html><head><meta charset="utf-8">
+<script src="/__3d/x_ite/dist/x_ite.min.js"></script>
+<script type="module">import * as pixels from '/__3d/clients3d/pixels.js'; window.pixels = pixels;</script>
+<style>body { margin: 0 } x3d-canvas { display: block; width: 512px; height: 512px }</style></head>
+<body><x3d-canvas splashScreen="false" contextMenu="false" notifications="false"></x3d-canvas></body></html>`;
+
+before(async () => {
+  assert.ok(BASE, 'TEXTILE_URL must name the server under test');
+  browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+    args: ['--headless', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+      '--ignore-gpu-blocklist', '--disable-background-networking', '--disable-component-update',
+      '--disable-sync', '--no-first-run'],
+  });
+});
+
+after(async () => { await browser?.close(); });
+
+/** A page on the server's origin whose /__3d/ paths are this folder's files. */
+async function open(html) {
+  const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
+  const errors = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.route(`${BASE}/__3d/**`, (route) => {
+    const path = new URL(route.request().url()).pathname.slice('/__3d/'.length);
+    if (path === 'page.html') return route.fulfill({ body: html, contentType: 'text/html' });
+    const file = path.startsWith('clients3d/') ? join(HERE, path) : join(MODULES, path);
+    const ext = path.split('.').pop();
+    return route.fulfill({ body: readFileSync(file), contentType: TYPES[ext] ?? 'application/octet-stream' });
+  });
+  await page.goto(`${BASE}/__3d/page.html`);
+  return { page, errors };
+}
+
+function save(name, dataUrl) {
+  if (!ARTEFACTS) return;
+  mkdirSync(ARTEFACTS, { recursive: true });
+  writeFileSync(join(ARTEFACTS, name), Buffer.from(dataUrl.split(',')[1], 'base64'));
+}
+
+function fmt(s) {
+  return `edges ${s.edges.mean.toFixed(2)} levels (${(100 * s.edges.over8).toFixed(2)} % > 8, ${s.edges.pixels} px), ` +
+    `elsewhere ${s.elsewhere.mean.toFixed(2)} (${(100 * s.elsewhere.over8).toFixed(2)} % > 8, ${s.elsewhere.pixels} px)`;
+}
+
+// Up close, from a camera 12 texels above tile (0, 0) near its north-west corner, looking
+// north-west across the two tile edges that meet there.
+const CLOSE = { eye: [6, 12, 30], at: [-40, 0, -50], fov: 60 };
+// Far: a 7×7 ring at a grazing angle; the distant tiles are minified 10× and more.
+const FAR = { eye: [0, 40, 890], at: [0, 0, -400], fov: 60 };
+
+test('three.js: bordered tiles filter like one texture up close', async () => {
+  const { page, errors } = await open(THREE_PAGE);
+  await page.waitForFunction(() => window.scenes);
+  const r = await page.evaluate((args) => window.scenes.closeView(args),
+    { base: BASE, id: 'gravel', z: 7, query: '?seed=4', view: CLOSE, w: 640, h: 400, reach: 2 });
+  for (const [k, v] of Object.entries(r.pictures)) save(`three-close-${k}.png`, v);
+  console.log(`close view, bordered mipmapped tiles vs one texture: ${fmt(r.tiles)}`);
+  console.log(`close view, bare tiles (before) vs one texture:      ${fmt(r.bare)}`);
+  assert.ok(r.tiles.edges.pixels > 2000 && r.tiles.elsewhere.pixels > 50000, 'the view shows edges and tiles');
+  // The bound: along edges no worse than elsewhere plus a quarter level on average, and no more
+  // pixels off by over 8 levels than elsewhere plus 0.1 % (rounding in the two mip chains).
+  assert.ok(r.tiles.edges.mean <= r.tiles.elsewhere.mean + 0.25, fmt(r.tiles));
+  assert.ok(r.tiles.edges.over8 <= r.tiles.elsewhere.over8 + 0.001, fmt(r.tiles));
+  // The comparison sees seams where they exist: the bare tiles' edges stand out.
+  assert.ok(r.bare.edges.over8 > r.bare.elsewhere.over8 + 0.01, `bare tiles: ${fmt(r.bare)}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('three.js: mipmapped tiles far away are closer to a supersampled reference', async () => {
+  const { page, errors } = await open(THREE_PAGE);
+  await page.waitForFunction(() => window.scenes);
+  const r = await page.evaluate((args) => window.scenes.farView(args),
+    { base: BASE, id: 'gravel', z: 7, query: '?seed=4', view: FAR, w: 480, h: 300, n: 7 });
+  for (const [k, v] of Object.entries(r.pictures)) save(`three-far-${k}.png`, v);
+  const m = (s) => `${s.elsewhere.mean.toFixed(2)} levels mean, ${(100 * s.elsewhere.over8).toFixed(1)} % > 8`;
+  console.log(`far view vs 4x-supersampled reference: mipmapped tiles ${m(r.tiles)}; bare tiles (before) ${m(r.bare)}`);
+  assert.ok(r.tiles.elsewhere.pixels > 50000);
+  assert.ok(r.tiles.elsewhere.mean < r.bare.elsewhere.mean, `${m(r.tiles)} vs ${m(r.bare)}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+/** Load an X3D document into the page's X_ITE canvas and wait until its texture has arrived
+ * (the canvas is not black and two looks in a row agree); the last look stays in the page as
+ * `window.shot` (see clients3d/pixels.js). Returns its size, mean level and PNG data URL. */
+async function x3dShot(page, path) {
+  await page.evaluate(async (url) => {
+    const canvas = document.querySelector('x3d-canvas');
+    await canvas.browser.loadURL(new X3D.MFString(url));
+  }, BASE + path);
+  let last;
+  for (let i = 0; i < 80; i++) {
+    await page.waitForTimeout(250);
+    const png = await page.locator('x3d-canvas').screenshot();
+    const next = await page.evaluate((b64) => window.pixels.look(b64), png.toString('base64'));
+    if (last && next.mean > 10 && next.mean === last.mean) return next;
+    last = next;
+  }
+  return last;
+}
+
+test('X_ITE: a tile document shows the tile, seen from above', async () => {
+  const { page, errors } = await open(X3D_PAGE);
+  await page.waitForFunction(() => window.X3D && window.pixels && document.querySelector('x3d-canvas')?.browser);
+  const shot = await x3dShot(page, '/x3d/gravel/7/1/2.x3d?seed=3');
+  save('x3d-tile.png', shot.url);
+  assert.ok(shot.mean > 10, `the canvas is black (mean level ${shot.mean})`);
+  const tile = `${BASE}/tiles/gravel/7/1/2.png?seed=3`;
+  const r = await page.evaluate((url) => window.pixels.correlate(url, 1, 1), tile);
+  console.log(`X_ITE top-down render vs the tile image: correlation ${r.toFixed(3)}, mean level ${shot.mean.toFixed(1)}`);
+  assert.ok(r > 0.9, `correlation ${r}`);
+  // A 3×3 patch document: the centre third of the view is the centre tile (compared at a
+  // quarter of its size: the render is minified 1.5×, through mipmaps).
+  const patch = await x3dShot(page, '/x3d/gravel/patch.x3d?z=7&x=0&y=1&tiles=3&seed=3');
+  save('x3d-patch.png', patch.url);
+  const rp = await page.evaluate((url) => window.pixels.correlate(url, 3, 4), tile);
+  console.log(`X_ITE patch: centre tile correlation ${rp.toFixed(3)}`);
+  assert.ok(rp > 0.8, `patch centre correlation ${rp}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
