@@ -90,8 +90,10 @@ fn exported_archive_in_headless_chromium() {
 
 /// textile's 3D documents in the clients users run (`tests/browser/clients3d.test.mjs`): three.js
 /// `GLTFLoader` on bordered, mipmapped glTF tiles (no seams up close, less aliasing far away,
-/// both measured against one-texture references), and X_ITE on X3D tile and patch documents
-/// (they show the tile, seen from above). Pictures go to `target/tmp/clients3d/`.
+/// both measured against one-texture references); X_ITE on X3D tile and patch documents (they
+/// show the tile, seen from above); 3DTilesRendererJS streaming the 3D Tiles tileset on
+/// `/3d.html` (levels follow the camera); CesiumJS loading it anchored on the globe. Pictures go
+/// to `target/tmp/clients3d/`.
 #[test]
 fn three_d_clients_in_headless_chromium() {
     let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
@@ -99,7 +101,7 @@ fn three_d_clients_in_headless_chromium() {
     if !PathBuf::from(&chromium).exists() {
         return common::skip("three_d_clients_in_headless_chromium", &format!("no Chromium at {chromium}"));
     }
-    for package in ["playwright-core", "three", "x_ite"] {
+    for package in ["playwright-core", "three", "x_ite", "cesium"] {
         if let Err(why) = common::npm_ready(&dir, package) {
             return common::skip("three_d_clients_in_headless_chromium", &why);
         }

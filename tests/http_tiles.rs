@@ -165,6 +165,10 @@ async fn health_ready_viewer_and_openapi() {
         "/gltf/{id}/patch.glb",
         "/x3d/{id}/{z}/{x}/{y}.x3d",
         "/x3d/{id}/patch.x3d",
+        "/3dtiles/{id}/tileset.json",
+        "/3dtiles/{id}/subtrees/{level}/{x}/{y}.subtree",
+        "/3dtiles/{id}/tiles/{level}/{x}/{y}.glb",
+        "/3d.html",
     ] {
         assert!(paths.contains_key(p), "openapi lacks {p}");
     }

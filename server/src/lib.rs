@@ -27,6 +27,7 @@ pub mod robustness;
 pub mod sampling;
 pub mod state;
 pub mod textures;
+pub mod tileset;
 pub mod uploads;
 
 /// Parse the command line and run the chosen command; the process exit code.

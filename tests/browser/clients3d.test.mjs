@@ -1,6 +1,8 @@
 // textile's 3D documents in the clients users run, in headless Chromium (WebGL on SwiftShader):
-// three.js GLTFLoader on bordered, mipmapped glTF tiles, and X_ITE on X3D documents. Run by
-// tests/browser.rs against the real binary (TEXTILE_URL); pictures go to TEXTILE_ARTEFACTS.
+// three.js GLTFLoader on bordered, mipmapped glTF tiles; X_ITE on X3D documents; the 3D viewer
+// page (/3d.html: 3DTilesRendererJS on the 3D Tiles tileset); CesiumJS on the tileset anchored
+// on the globe. Run by tests/browser.rs against the real binary (TEXTILE_URL, a server that
+// queues rather than sheds); pictures go to TEXTILE_ARTEFACTS.
 //
 // The libraries come from this folder's node_modules (pinned by package-lock.json) and are
 // served on the server's own origin under /__3d/ by Playwright's request routing, so every
@@ -34,6 +36,13 @@ const X3D_PAGE = `<!doctype html><html><head><meta charset="utf-8">
 <script type="module">import * as pixels from '/__3d/clients3d/pixels.js'; window.pixels = pixels;</script>
 <style>body { margin: 0 } x3d-canvas { display: block; width: 512px; height: 512px }</style></head>
 <body><x3d-canvas splashScreen="false" contextMenu="false" notifications="false"></x3d-canvas></body></html>`;
+
+const CESIUM_PAGE = `<!doctype html><html><head><meta charset="utf-8">
+<script>window.CESIUM_BASE_URL = '/__3d/cesium/Build/Cesium/';</script>
+<script src="/__3d/cesium/Build/Cesium/Cesium.js"></script>
+<link rel="stylesheet" href="/__3d/cesium/Build/Cesium/Widgets/widgets.css">
+<style>html, body, #globe { margin: 0; width: 100%; height: 100%; }</style></head>
+<body><div id="globe"></div></body></html>`;
 
 before(async () => {
   assert.ok(BASE, 'TEXTILE_URL must name the server under test');
@@ -150,6 +159,108 @@ test('X_ITE: a tile document shows the tile, seen from above', async () => {
   const rp = await page.evaluate((url) => window.pixels.correlate(url, 3, 4), tile);
   console.log(`X_ITE patch: centre tile correlation ${rp.toFixed(3)}`);
   assert.ok(rp > 0.8, `patch centre correlation ${rp}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+/** Wait until the 3D page's tiles are all loaded for the current view (two looks in a row). */
+async function settled3d(page, timeout = 60000) {
+  await page.waitForFunction(() => window.textile3d?.settled(), null, { timeout, polling: 200 });
+  await page.waitForTimeout(300);
+  await page.waitForFunction(() => window.textile3d.settled(), null, { timeout, polling: 200 });
+}
+
+test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the camera', async () => {
+  const page = await browser.newPage({ viewport: { width: 1000, height: 640 } });
+  const errors = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  const failed = [];
+  page.on('response', (r) => { if (r.url().includes('/3dtiles/') && r.status() !== 200) failed.push(`${r.status()} ${r.url()}`); });
+  const t0 = Date.now();
+  // Low over the ground, near the middle of the root tile (gravel: 32768 texels wide).
+  await page.goto(`${BASE}/3d.html#t=gravel&m=synth&seed=4&cam=16400,60,16460,16384,0,16384`);
+  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 30000 });
+  await settled3d(page);
+  console.log(`3D page: first full view in ${Date.now() - t0} ms`);
+  save('3d-page-low.png', `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
+  // Rise: coarser levels replace finer ones on screen.
+  const visible = async () => page.evaluate(() => window.textile3d.visibleLevels());
+  const finest = (v) => Math.max(...Object.keys(v).map(Number));
+  const views = [await visible()];
+  for (const h of [600, 5000, 40000]) {
+    await page.evaluate((h) => window.textile3d.look([16384, h, 16384 + h], [16384, 0, 16384]), h);
+    await settled3d(page);
+    views.push(await visible());
+  }
+  save('3d-page-high.png', `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
+  const requested = await page.evaluate(() => window.textile3d.requested.length);
+  console.log(`3D page: ${requested} content tiles requested; tiles on screen by level as the camera rises ` +
+    `(60, 600, 5000, 40000): ${views.map((v) => JSON.stringify(v)).join(' → ')}`);
+  const shown = new Set(views.flatMap((v) => Object.keys(v)));
+  assert.ok(shown.size >= 3, `tiles of ${shown.size} levels shown: ${[...shown]}`);
+  for (let i = 1; i < views.length; i++) {
+    assert.ok(finest(views[i]) <= finest(views[i - 1]), `rising never shows finer tiles: ${JSON.stringify(views)}`);
+  }
+  assert.ok(finest(views.at(-1)) < finest(views[0]), 'the high view shows coarser tiles than the low one');
+  assert.deepEqual(failed, []);
+  assert.deepEqual(errors, []);
+  // The permalink holds the view.
+  assert.match(page.url(), /cam=16384,40000,56384,16384,0,16384/);
+  await page.close();
+});
+
+test('CesiumJS loads the tileset anchored on the globe and requests its content', async () => {
+  const { page, errors } = await open(CESIUM_PAGE);
+  const failed = [];
+  const content = new Set();
+  page.on('response', (r) => {
+    const m = r.url().match(/\/3dtiles\/gravel\/tiles\/(\d+)\//);
+    if (m) content.add(Number(m[1]));
+    if (r.url().includes('/3dtiles/') && r.status() !== 200) failed.push(`${r.status()} ${r.url()}`);
+  });
+  await page.waitForFunction(() => window.Cesium);
+  // Paris, 35 m above the ellipsoid: 1 texel = 1 m, east-north-up.
+  const r = await page.evaluate(async (base) => {
+    const viewer = new Cesium.Viewer('globe', {
+      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false, animation: false,
+      homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
+      infoBox: false, selectionIndicator: false, terrainProvider: new Cesium.EllipsoidTerrainProvider(),
+    });
+    const failures = [];
+    const tileset = await Cesium.Cesium3DTileset.fromUrl(`${base}/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=4`);
+    tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
+    viewer.scene.primitives.add(tileset);
+    const centre = Cesium.Cartesian3.fromDegrees(2.35, 48.85, 35);
+    // 900 m from a point 300 m east and south of the anchor, looking down at about 45°.
+    viewer.camera.lookAt(Cesium.Matrix4.multiplyByPoint(tileset.root.computedTransform,
+      new Cesium.Cartesian3(300, -300, 0), new Cesium.Cartesian3()), new Cesium.HeadingPitchRange(0.6, -0.8, 900));
+    await new Promise((resolve) => {
+      const t = setTimeout(resolve, 60000);
+      tileset.allTilesLoaded.addEventListener(() => { clearTimeout(t); resolve(); });
+    });
+    viewer.render();
+    const where = Cesium.Cartographic.fromCartesian(tileset.boundingSphere.center);
+    return {
+      failures,
+      loaded: tileset.tilesLoaded,
+      anchor: Cesium.Cartesian3.distance(Cesium.Matrix4.getTranslation(tileset.root.computedTransform, new Cesium.Cartesian3()), centre),
+      lon: Cesium.Math.toDegrees(where.longitude), lat: Cesium.Math.toDegrees(where.latitude),
+    };
+  }, BASE);
+  const png = (await page.screenshot()).toString('base64');
+  save('cesium.png', `data:image/png;base64,${png}`);
+  const levels = [...content].sort((a, b) => a - b);
+  console.log(`CesiumJS: tileset loaded ${r.loaded}, content levels requested [${levels}], bounding sphere at ` +
+    `${r.lon.toFixed(4)}°, ${r.lat.toFixed(4)}°; root transform ${r.anchor.toFixed(3)} m from the anchor`);
+  assert.ok(r.loaded, 'every tile of the view loaded');
+  assert.ok(r.anchor < 0.01, 'the root transform sits at lon, lat, height');
+  // The anchor is texel (0, 0), the root square's north-west corner; the square spans 32768 m
+  // east and south of it, so its centre is about 16 km south-east.
+  assert.ok(r.lon > 2.5 && r.lon < 2.65 && r.lat < 48.75 && r.lat > 48.65, `${r.lon}, ${r.lat}`);
+  assert.ok(levels.length >= 2, `content requested at levels [${levels}]`);
+  assert.deepEqual(r.failures, []);
+  assert.deepEqual(failed, []);
   assert.deepEqual(errors, []);
   await page.close();
 });

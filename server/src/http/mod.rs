@@ -15,6 +15,7 @@ pub mod models;
 pub mod openapi;
 pub mod samples;
 pub mod static_files;
+pub mod tiles3d;
 
 use std::sync::Arc;
 
@@ -82,6 +83,7 @@ pub fn router(state: Arc<AppState>) -> Router {
     let routes = Router::new()
         .route("/", get(static_files::index))
         .route("/world.html", get(static_files::world))
+        .route("/3d.html", get(static_files::three_d))
         .route("/static/{*path}", get(static_files::static_file))
         .route("/health", get(meta::health))
         .route("/ready", get(meta::ready))
@@ -100,6 +102,9 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/gltf/{id}/patch.glb", get(models::gltf_patch))
         .route("/gltf/{id}/{z}/{x}/{y}", get(models::gltf_tile))
         .route("/x3d/{id}/patch.x3d", get(models::x3d_patch))
+        .route("/3dtiles/{id}/tileset.json", get(tiles3d::tileset_json))
+        .route("/3dtiles/{id}/subtrees/{level}/{x}/{y}", get(tiles3d::subtree_file))
+        .route("/3dtiles/{id}/tiles/{level}/{x}/{y}", get(tiles3d::content_tile))
         .route("/x3d/{id}/{z}/{x}/{y}", get(models::x3d_tile));
     // Exported archives, served as static files with range requests (what PMTiles readers use).
     let routes = match state.config.archives_dir.as_str() {

@@ -33,7 +33,8 @@ type Query = BTreeMap<String, String>;
 /// Largest patch side in tiles.
 pub const MAX_PATCH: i64 = 8;
 
-fn generator() -> String {
+/// The `generator` of every 3D document.
+pub(super) fn generator() -> String {
     format!("textile {} ({})", env!("CARGO_PKG_VERSION"), engine_version())
 }
 
@@ -74,14 +75,15 @@ fn image_url(base: &str, r: &TileRequest, spec: &TileSpec) -> String {
     format!("{base}/gltf/{}/{}/{}/{}", r.tex.config.id, spec.z, spec.x, sibling_image(r, spec))
 }
 
-fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), ApiError> {
+pub(super) fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), ApiError> {
     match s.rsplit_once('.') {
         Some((stem, ext)) if allowed.contains(&ext) => Ok((stem, ext)),
         _ => Err(ApiError::bad_request("invalid_format", format!("'{s}' must end in .{}", allowed.join(" or .")))),
     }
 }
 
-struct TileRequest {
+/// A request for one tile's 3D asset: texture, tile, query and the mode's parameters.
+pub(super) struct TileRequest {
     tex: Arc<Texture>,
     spec: TileSpec,
     query: Query,
@@ -89,6 +91,13 @@ struct TileRequest {
 }
 
 impl TileRequest {
+    /// Tile `spec` of `tex` with the parameters of query `raw`.
+    pub(super) fn new(tex: Arc<Texture>, spec: TileSpec, raw: Option<&str>) -> Result<TileRequest, ApiError> {
+        let pairs = query_pairs(raw);
+        let params = params(&tex, ParamReader::request(pairs.clone())?)?;
+        Ok(TileRequest { tex, spec, query: pairs.into_iter().collect(), params })
+    }
+
     /// The image of the tile this asset shows.
     fn image(&self) -> ImageJob {
         self.image_at(self.spec)
@@ -140,9 +149,7 @@ fn tile_request(
         _ => (y, raw),
     };
     let spec = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
-    let pairs = query_pairs(raw.as_deref());
-    let params = params(&tex, ParamReader::request(pairs.clone())?)?;
-    Ok((TileRequest { tex, spec, query: pairs.into_iter().collect(), params }, ext.to_string()))
+    Ok((TileRequest::new(tex, spec, raw.as_deref())?, ext.to_string()))
 }
 
 fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
@@ -194,18 +201,23 @@ pub async fn gltf_tile(
         let body = serde_json::to_vec(&doc).map_err(|e| ApiError::internal(e.to_string()))?;
         return Ok(image(body.into(), "model/gltf+json", &etag, cc, false));
     }
-    let etag = etag_for(&key(&r, "glb", ""));
-    if if_none_match(&headers, &etag) {
+    glb_tile(&st, &r, &headers).await
+}
+
+/// A tile's GLB answer (conditional requests, tile cache), for `/gltf` and 3D Tiles content.
+pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &HeaderMap) -> Result<Response, ApiError> {
+    let cc = &st.config.cache_control;
+    let etag = etag_for(&key(r, "glb", ""));
+    if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
     if let Some(b) = st.cache.peek(&etag) {
         return Ok(image(b, "model/gltf-binary", &etag, cc, true));
     }
     let job = r.image();
-    let png = tile_png(&st, &job.etag(), job).await?;
+    let png = tile_png(st, &job.etag(), job).await?;
     let q = quad(&r.tex, &r.spec);
-    let (bytes, hit) =
-        cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&[q], &[(png, "image/png")], &generator()))).await;
+    let (bytes, hit) = cached(st, &etag, GLTF_LABEL, move |_| Ok(glb(&[q], &[(png, "image/png")], &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 

@@ -31,10 +31,14 @@ use utoipa::{Modify, OpenApi};
         crate::http::meta::metrics,
         crate::http::static_files::index,
         crate::http::static_files::world,
+        crate::http::static_files::three_d,
         crate::http::models::gltf_tile,
         crate::http::models::gltf_patch,
         crate::http::models::x3d_tile,
-        crate::http::models::x3d_patch
+        crate::http::models::x3d_patch,
+        crate::http::tiles3d::tileset_json,
+        crate::http::tiles3d::subtree_file,
+        crate::http::tiles3d::content_tile
     )
 )]
 pub struct ApiDoc;
@@ -49,6 +53,8 @@ const WITH_MODE_PARAMETERS: &[&str] = &[
     "/gltf/{id}/patch.glb",
     "/x3d/{id}/{z}/{x}/{y}.x3d",
     "/x3d/{id}/patch.x3d",
+    "/3dtiles/{id}/tileset.json",
+    "/3dtiles/{id}/tiles/{level}/{x}/{y}.glb",
 ];
 
 /// Adds the common and every mode's request parameters to [`WITH_MODE_PARAMETERS`].

@@ -1,4 +1,5 @@
-//! The web viewer's files, compiled into the binary (`web/`): pages at `/` and `/world.html`,
+//! The web viewer's files, compiled into the binary (`web/`): pages at `/`, `/world.html` and
+//! `/3d.html`,
 //! the archive page `/static/pmtiles.html`, scripts, styles and the vendored libraries (with their licences) under `/static/`.
 
 use axum::extract::Path;
@@ -24,6 +25,73 @@ const FILES: &[(&str, &str, &[u8])] = &[
     ("vendor/LICENSE-leaflet", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/LICENSE-leaflet")),
     ("vendor/LICENSE-ol.md", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/LICENSE-ol.md")),
     ("vendor/VERSIONS", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/VERSIONS")),
+    ("3d.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/3d.js")),
+    (
+        "vendor/three/three.module.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/three/three.module.js"),
+    ),
+    (
+        "vendor/three/three.core.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/three/three.core.js"),
+    ),
+    (
+        "vendor/three/addons/loaders/GLTFLoader.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/three/addons/loaders/GLTFLoader.js"),
+    ),
+    (
+        "vendor/three/addons/utils/BufferGeometryUtils.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/three/addons/utils/BufferGeometryUtils.js"),
+    ),
+    (
+        "vendor/three/addons/utils/SkeletonUtils.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/three/addons/utils/SkeletonUtils.js"),
+    ),
+    (
+        "vendor/three/addons/controls/MapControls.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/three/addons/controls/MapControls.js"),
+    ),
+    (
+        "vendor/three/addons/controls/OrbitControls.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/three/addons/controls/OrbitControls.js"),
+    ),
+    (
+        "vendor/3d-tiles-renderer/index.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/3d-tiles-renderer/index.js"),
+    ),
+    (
+        "vendor/3d-tiles-renderer/index.core-plugins.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/3d-tiles-renderer/index.core-plugins.js"),
+    ),
+    (
+        "vendor/3d-tiles-renderer/plugins-RoDI5SD7.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/3d-tiles-renderer/plugins-RoDI5SD7.js"),
+    ),
+    (
+        "vendor/3d-tiles-renderer/renderer-CUfHAmYW.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/3d-tiles-renderer/renderer-CUfHAmYW.js"),
+    ),
+    (
+        "vendor/3d-tiles-renderer/renderer-_7gAivIK.js",
+        "text/javascript; charset=utf-8",
+        include_bytes!("../../../web/vendor/3d-tiles-renderer/renderer-_7gAivIK.js"),
+    ),
+    ("vendor/LICENSE-three", "text/plain; charset=utf-8", include_bytes!("../../../web/vendor/LICENSE-three")),
+    (
+        "vendor/LICENSE-3d-tiles-renderer",
+        "text/plain; charset=utf-8",
+        include_bytes!("../../../web/vendor/LICENSE-3d-tiles-renderer"),
+    ),
 ];
 
 fn file(bytes: &'static [u8], content_type: &'static str) -> Response {
@@ -52,4 +120,10 @@ pub async fn index() -> Response {
 #[utoipa::path(get, path = "/world.html", tag = "viewer", responses((status = 200, description = "HTML")))]
 pub async fn world() -> Response {
     file(include_bytes!("../../../web/world.html"), "text/html; charset=utf-8")
+}
+
+/// The 3D viewer: the texture's 3D Tiles tileset in three.js with 3DTilesRendererJS.
+#[utoipa::path(get, path = "/3d.html", tag = "viewer", responses((status = 200, description = "HTML")))]
+pub async fn three_d() -> Response {
+    file(include_bytes!("../../../web/3d.html"), "text/html; charset=utf-8")
 }

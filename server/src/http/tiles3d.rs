@@ -1,0 +1,169 @@
+//! OGC 3D Tiles 1.1 endpoints: a texture's tileset (implicit quadtree over its zooms, same
+//! query parameters as tiles, optional Earth anchoring with `lon`, `lat`, `height`), its subtree
+//! files, and its content tiles (the glTF tiles of `/gltf`, addressed by implicit coordinates).
+//! The documents themselves are built by [`crate::tileset`].
+
+use std::sync::Arc;
+
+use axum::extract::rejection::PathRejection;
+use axum::extract::{Path, RawQuery, State};
+use axum::http::HeaderMap;
+use axum::response::Response;
+
+use crate::encode::Format;
+use crate::error::ApiError;
+use crate::http::content::{if_none_match, image, not_modified};
+use crate::http::extract::{path_error, texture};
+use crate::http::models::{generator, glb_tile, split_ext, TileRequest};
+use crate::pipeline::{cache_key, etag_for};
+use crate::request::{params, query_pairs, TileSpec};
+use crate::state::AppState;
+use crate::textures::Texture;
+use crate::tileset::{enu_to_ecef, subtree, tileset, xyz_row, Tree, SUBTREE_LEVELS};
+use textile_core::ParamReader;
+
+/// The tileset's anchoring parameters. Content requests accept and ignore them: CesiumJS carries
+/// the tileset URL's query into every URL it resolves against it.
+const ANCHORING: [&str; 3] = ["lon", "lat", "height"];
+
+/// `raw` without the anchoring parameters.
+fn without_anchoring(raw: Option<&str>) -> String {
+    let mut qs = form_urlencoded::Serializer::new(String::new());
+    for (k, v) in query_pairs(raw).iter().filter(|(k, _)| !ANCHORING.contains(&k.as_str())) {
+        qs.append_pair(k, v);
+    }
+    qs.finish()
+}
+
+/// The tileset's tree for a texture: zooms `0..=max_zoom`.
+fn tree(tex: &Texture) -> Tree {
+    Tree { native: tex.native_zoom(), levels: tex.max_zoom() + 1 }
+}
+
+fn number(name: &str, v: &str, lo: f64, hi: f64) -> Result<f64, ApiError> {
+    v.parse::<f64>().ok().filter(|x| (lo..=hi).contains(x)).ok_or_else(|| {
+        ApiError::bad_request("invalid_parameter", format!("parameter '{name}': '{v}' is not a number in [{lo}, {hi}]"))
+    })
+}
+
+/// Implicit tile coordinates from the path: level, x, y (the last one with its extension).
+fn implicit(tree: &Tree, level: &str, x: &str, y: &str) -> Result<(u32, i64, i64), ApiError> {
+    let bad = || {
+        ApiError::bad_request(
+            "invalid_coordinate",
+            format!("'{level}/{x}/{y}' is not a tile of the tileset (levels 0..{})", tree.levels),
+        )
+    };
+    let level: u32 = level.parse().map_err(|_| bad())?;
+    let (x, y): (i64, i64) = (x.parse().map_err(|_| bad())?, y.parse().map_err(|_| bad())?);
+    if !tree.contains(level, x, y) {
+        return Err(bad());
+    }
+    Ok((level, x, y))
+}
+
+/// The tileset JSON: implicit quadtree tiling of the texture's zooms with glTF content.
+#[utoipa::path(get, path = "/3dtiles/{id}/tileset.json", tag = "3d",
+    params(("id" = String, Path, description = "texture id"),
+           ("lon" = Option<f64>, Query, description = "anchor the root on WGS 84: longitude in degrees (with lat)"),
+           ("lat" = Option<f64>, Query, description = "latitude in degrees (with lon)"),
+           ("height" = Option<f64>, Query, description = "metres above the ellipsoid (default 0)")),
+    responses((status = 200, description = "application/json: a 3D Tiles 1.1 tileset"), (status = 304, description = "not modified"),
+              (status = 400, description = "bad parameters"), (status = 404, description = "unknown texture")))]
+pub async fn tileset_json(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<String>, PathRejection>,
+    RawQuery(raw): RawQuery,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let reg = st.ready()?;
+    let Path(id) = path.map_err(path_error)?;
+    let tex = texture(&reg, &id)?;
+    let mut reader = ParamReader::request(query_pairs(raw.as_deref()))?;
+    let (lon, lat, height) = (reader.take("lon"), reader.take("lat"), reader.take("height"));
+    let transform = match (lon, lat) {
+        (Some(lon), Some(lat)) => {
+            let h = height.as_deref().map(|h| number("height", h, -11_000.0, 100_000.0)).transpose()?;
+            let (lon, lat) = (number("lon", &lon, -180.0, 180.0)?, number("lat", &lat, -90.0, 90.0)?);
+            Some(enu_to_ecef(lon, lat, h.unwrap_or(0.0)))
+        }
+        (None, None) if height.is_none() => None,
+        _ => {
+            return Err(ApiError::bad_request(
+                "missing_parameter",
+                "anchoring the tileset needs both 'lon' and 'lat' ('height' is optional)",
+            ))
+        }
+    };
+    // Everything else is the tiles' query: validated here, carried into the content URIs.
+    let pairs = query_pairs(Some(&without_anchoring(raw.as_deref())));
+    let p = params(&tex, ParamReader::request(pairs.clone())?)?;
+    // Sorted: one URI (and cache entry) per set of parameters, however they were ordered.
+    let mut qs = form_urlencoded::Serializer::new(String::new());
+    for (k, v) in pairs.iter().map(|(k, v)| (k, v)).collect::<std::collections::BTreeMap<_, _>>() {
+        qs.append_pair(k, v);
+    }
+    let query = qs.finish();
+    let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset|{query}|{transform:?}")));
+    let cc = &st.config.cache_control;
+    if if_none_match(&headers, &etag) {
+        return Ok(not_modified(&etag, cc));
+    }
+    let doc = tileset(&tree(&tex), &query, transform, &generator());
+    let body = serde_json::to_vec(&doc).map_err(|e| ApiError::internal(e.to_string()))?;
+    Ok(image(body.into(), "application/json", &etag, cc, false))
+}
+
+/// A subtree file of the tileset (binary `.subtree`).
+#[utoipa::path(get, path = "/3dtiles/{id}/subtrees/{level}/{x}/{y}.subtree", tag = "3d",
+    params(("id" = String, Path, description = "texture id"), ("level" = u32, Path, description = "implicit level (a multiple of the subtree levels)"),
+           ("x" = i64, Path, description = "implicit x (east)"), ("y" = i64, Path, description = "implicit y (north)")),
+    responses((status = 200, description = "application/octet-stream: a 3D Tiles 1.1 subtree"),
+              (status = 400, description = "not a subtree of the tileset"), (status = 404, description = "unknown texture")))]
+pub async fn subtree_file(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<(String, String, String, String)>, PathRejection>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let reg = st.ready()?;
+    let Path((id, level, x, y)) = path.map_err(path_error)?;
+    let tex = texture(&reg, &id)?;
+    let (y, _) = split_ext(&y, &["subtree"])?;
+    let tree = tree(&tex);
+    let (level, _, _) = implicit(&tree, &level, &x, y)?;
+    if !level.is_multiple_of(SUBTREE_LEVELS) {
+        return Err(ApiError::bad_request(
+            "invalid_coordinate",
+            format!("subtrees start at levels that are multiples of {SUBTREE_LEVELS}, not {level}"),
+        ));
+    }
+    let etag = etag_for(&format!("subtree|{}|{}|{level}", tree.native, tree.levels));
+    let cc = &st.config.cache_control;
+    if if_none_match(&headers, &etag) {
+        return Ok(not_modified(&etag, cc));
+    }
+    Ok(image(subtree(&tree, level).into(), "application/octet-stream", &etag, cc, false))
+}
+
+/// A content tile of the tileset: the GLB of XYZ tile `level / x / 2^level − 1 − y` (the
+/// tileset's anchoring parameters, if a client carries them along, are ignored).
+#[utoipa::path(get, path = "/3dtiles/{id}/tiles/{level}/{x}/{y}.glb", tag = "3d",
+    params(("id" = String, Path, description = "texture id"), ("level" = u32, Path, description = "implicit level = zoom"),
+           ("x" = i64, Path, description = "implicit x (east) = column"), ("y" = i64, Path, description = "implicit y (north) = 2^level − 1 − row")),
+    responses((status = 200, description = "model/gltf-binary"), (status = 304, description = "not modified"),
+              (status = 400, description = "not a tile of the tileset, or bad parameters"), (status = 404, description = "unknown texture")))]
+pub async fn content_tile(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<(String, String, String, String)>, PathRejection>,
+    RawQuery(raw): RawQuery,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let reg = st.ready()?;
+    let Path((id, level, x, y)) = path.map_err(path_error)?;
+    let tex = texture(&reg, &id)?;
+    let (y, _) = split_ext(&y, &["glb"])?;
+    let (level, x, y) = implicit(&tree(&tex), &level, &x, y)?;
+    let spec = TileSpec { z: level, x, y: xyz_row(level, y), scale: 1, format: Format::Png };
+    let r = TileRequest::new(tex, spec, Some(&without_anchoring(raw.as_deref())))?;
+    glb_tile(&st, &r, &headers).await
+}

@@ -1,0 +1,206 @@
+//! OGC 3D Tiles 1.1 through the real server, checked against the specification's rules rather
+//! than against our own code: the tileset's required properties and implicit-tiling rules, every
+//! subtree's binary header and availability layout (sizes of the bitstreams, counts, which
+//! levels and child subtrees exist), content URIs that resolve to the glTF tile of the flipped
+//! row and lie inside their implicit tile's bounding box, the root transform, ETags, bad input.
+
+mod common;
+
+use common::{assert_error, Server};
+use serde_json::Value;
+
+fn u32le(b: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(b[at..at + 4].try_into().unwrap())
+}
+
+fn u64le(b: &[u8], at: usize) -> u64 {
+    u64::from_le_bytes(b[at..at + 8].try_into().unwrap())
+}
+
+/// The 3D Tiles 1.1 tileset rules an implicit, glTF-content tileset must meet (tileset.schema,
+/// tile.schema, implicitTiling, boundingVolume); returns (subtreeLevels, availableLevels).
+fn check_tileset(t: &Value) -> (u32, u32) {
+    assert_eq!(t["asset"]["version"], "1.1", "asset.version");
+    let ge = t["geometricError"].as_f64().expect("tileset.geometricError is required");
+    let root = &t["root"];
+    let root_ge = root["geometricError"].as_f64().expect("tile.geometricError is required");
+    assert!(ge >= root_ge && root_ge > 0.0, "geometric errors: {ge} ≥ {root_ge} > 0");
+    let bx = root["boundingVolume"]["box"].as_array().expect("a box bounding volume");
+    assert_eq!(bx.len(), 12, "box: centre and three half-axes");
+    assert!(bx.iter().all(Value::is_f64), "box numbers");
+    assert_eq!(root["refine"], "REPLACE");
+    assert!(root.get("children").is_none(), "a tile with implicitTiling must not have children");
+    let it = &root["implicitTiling"];
+    assert_eq!(it["subdivisionScheme"], "QUADTREE");
+    let s = it["subtreeLevels"].as_u64().expect("subtreeLevels") as u32;
+    let a = it["availableLevels"].as_u64().expect("availableLevels") as u32;
+    assert!(s >= 1 && a >= 1);
+    for uri in [it["subtrees"]["uri"].as_str().unwrap(), root["content"]["uri"].as_str().unwrap()] {
+        for p in ["{level}", "{x}", "{y}"] {
+            assert!(uri.contains(p), "template {uri} lacks {p}");
+        }
+        assert!(!uri.starts_with('/') && !uri.contains("://"), "relative to the tileset: {uri}");
+    }
+    if let Some(m) = root.get("transform") {
+        assert_eq!(m.as_array().unwrap().len(), 16);
+    }
+    (s, a)
+}
+
+/// An availability object: constant, or a bitstream of at least `bits` bits in the binary.
+/// Returns the availability of each of the `bits` entries.
+fn availability(a: &Value, json: &Value, bin: &[u8], bits: usize) -> Vec<bool> {
+    if let Some(c) = a.get("constant") {
+        let c = c.as_u64().unwrap();
+        assert!(c <= 1, "constant is 0 or 1");
+        return vec![c == 1; bits];
+    }
+    let view = &json["bufferViews"][a["bitstream"].as_u64().expect("constant or bitstream") as usize];
+    let buffer = &json["buffers"][view["buffer"].as_u64().unwrap() as usize];
+    assert!(buffer.get("uri").is_none(), "our bitstreams are in the internal buffer");
+    let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+    assert!(o + l <= buffer["byteLength"].as_u64().unwrap() as usize && o + l <= bin.len());
+    assert!(l >= bits.div_ceil(8), "bitstream of {l} bytes for {bits} bits");
+    let v: Vec<bool> = (0..bits).map(|i| bin[o + i / 8] >> (i % 8) & 1 == 1).collect();
+    if let Some(n) = a.get("availableCount") {
+        assert_eq!(n.as_u64().unwrap() as usize, v.iter().filter(|b| **b).count(), "availableCount");
+    }
+    v
+}
+
+/// A subtree file: header, padding, and its three availabilities (tiles, content, children).
+fn check_subtree(b: &[u8], levels: u32) -> (Vec<bool>, Vec<bool>, Vec<bool>) {
+    assert_eq!(&b[0..4], b"subt", "magic");
+    assert_eq!(u32le(b, 4), 1, "version");
+    let (jl, bl) = (u64le(b, 8) as usize, u64le(b, 16) as usize);
+    assert_eq!(24 + jl + bl, b.len(), "lengths");
+    assert_eq!(jl % 8, 0, "JSON padded to 8 bytes");
+    assert_eq!(bl % 8, 0, "binary padded to 8 bytes");
+    let json: Value = serde_json::from_slice(&b[24..24 + jl]).expect("subtree JSON");
+    let bin = &b[24 + jl..];
+    if bl > 0 {
+        assert!(json["buffers"][0]["byteLength"].as_u64().unwrap() as usize <= bl);
+    }
+    let tiles = ((1usize << (2 * levels)) - 1) / 3;
+    let t = availability(&json["tileAvailability"], &json, bin, tiles);
+    let contents = json["contentAvailability"].as_array().expect("contentAvailability: one per content");
+    assert_eq!(contents.len(), 1);
+    let c = availability(&contents[0], &json, bin, tiles);
+    let k = availability(&json["childSubtreeAvailability"], &json, bin, 1 << (2 * levels));
+    (t, c, k)
+}
+
+#[tokio::test]
+async fn tileset_and_subtrees_follow_the_specification() {
+    let s = Server::builder().start();
+    let r = s.get("/3dtiles/gravel/tileset.json?seed=4").await;
+    assert_eq!(r.status(), 200);
+    assert_eq!(r.headers()["content-type"], "application/json");
+    let etag = r.headers()["etag"].to_str().unwrap().to_string();
+    let t: Value = r.json().await.unwrap();
+    let (sl, levels) = check_tileset(&t);
+    let meta = s.json("/textures/gravel").await;
+    assert_eq!(levels as u64, meta["maxzoom"].as_u64().unwrap() + 1, "one level per zoom 0..=maxzoom");
+    // Every subtree root level: the availability says exactly which levels exist.
+    for root in (0..levels).step_by(sl as usize) {
+        let n = 1i64 << root;
+        for (x, y) in [(0, 0), (n - 1, n / 2)] {
+            let (status, b) = s.get_bytes(&format!("/3dtiles/gravel/subtrees/{root}/{x}/{y}.subtree")).await;
+            assert_eq!(status, 200, "subtree {root}/{x}/{y}");
+            let (tiles, content, children) = check_subtree(&b, sl);
+            let mut i = 0;
+            for l in 0..sl {
+                for _ in 0..1usize << (2 * l) {
+                    assert_eq!(tiles[i], root + l < levels, "tile bit {i} of subtree {root}");
+                    assert_eq!(content[i], tiles[i], "every available tile has content");
+                    i += 1;
+                }
+            }
+            assert!(children.iter().all(|c| *c == (root + sl < levels)), "child subtrees of {root}");
+        }
+    }
+    let cond = s.client.get(s.url("/3dtiles/gravel/tileset.json?seed=4")).header("If-None-Match", &etag).send().await;
+    assert_eq!(cond.unwrap().status(), 304);
+}
+
+#[tokio::test]
+async fn content_tiles_are_the_gltf_tiles_inside_their_boxes() {
+    let s = Server::builder().start();
+    let t = s.json("/3dtiles/gravel/tileset.json?seed=4&mode=mosaic").await;
+    let template = t["root"]["content"]["uri"].as_str().unwrap();
+    assert!(template.ends_with(".glb?mode=mosaic&seed=4"), "{template}");
+    let b: Vec<f64> =
+        t["root"]["boundingVolume"]["box"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    // The root box is axis-aligned here: its x and y extent.
+    let (x0, y0, side) = (b[0] - b[3], b[1] - b[7], 2.0 * b[3]);
+    assert_eq!(b[3], b[7]);
+    for (level, x, y) in [(0u32, 0i64, 0i64), (3, 2, 5), (7, 100, 3), (9, 511, 0)] {
+        let uri = template
+            .replace("{level}", &level.to_string())
+            .replace("{x}", &x.to_string())
+            .replace("{y}", &y.to_string());
+        let (status, glb) = s.get_bytes(&format!("/3dtiles/gravel/{uri}")).await;
+        assert_eq!(status, 200, "{uri}");
+        // The same bytes as the XYZ tile of the flipped row.
+        let row = (1i64 << level) - 1 - y;
+        let xyz = s.get_bytes(&format!("/gltf/gravel/{level}/{x}/{row}.glb?seed=4&mode=mosaic")).await.1;
+        assert!(glb == xyz, "{uri} is /gltf/gravel/{level}/{x}/{row}.glb");
+        // CesiumJS carries the tileset's query (anchoring included) into content URLs.
+        let carried = s.get_bytes(&format!("/3dtiles/gravel/{uri}&lon=2.35&lat=48.85&height=35")).await.1;
+        assert!(carried == xyz, "{uri} with the anchoring parameters");
+        // Its quad, Y-up turned Z-up ((x, y, z) → (x, −z, y)), covers the implicit tile.
+        let jl = u32le(&glb, 12) as usize;
+        let json: Value = serde_json::from_slice(&glb[20..20 + jl]).unwrap();
+        let tr = &json["nodes"][0]["translation"];
+        let size = json["accessors"][0]["max"][0].as_f64().unwrap();
+        let (qx0, qx1) = (tr[0].as_f64().unwrap(), tr[0].as_f64().unwrap() + size);
+        let (qy1, qy0) = (-tr[2].as_f64().unwrap(), -tr[2].as_f64().unwrap() - size);
+        let w = side / (1u64 << level) as f64;
+        let (bx0, by0) = (x0 + w * x as f64, y0 + w * y as f64);
+        assert_eq!((qx0, qx1, qy0, qy1), (bx0, bx0 + w, by0, by0 + w), "tile {level}/{x}/{y}");
+    }
+}
+
+#[tokio::test]
+async fn the_root_transform_anchors_on_the_ellipsoid() {
+    let s = Server::builder().start();
+    let t = s.json("/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=1").await;
+    check_tileset(&t);
+    let m: Vec<f64> = t["root"]["transform"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let col = |i: usize| [m[4 * i], m[4 * i + 1], m[4 * i + 2]];
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    // East, north, up: orthonormal, up along the position for a sphere-like Earth.
+    for i in 0..3 {
+        assert!((dot(col(i), col(i)) - 1.0).abs() < 1e-9);
+    }
+    assert!(dot(col(0), col(1)).abs() < 1e-9 && dot(col(1), col(2)).abs() < 1e-9);
+    let r = dot(col(3), col(3)).sqrt();
+    assert!((6_356_000.0..6_379_000.0).contains(&r), "ECEF radius {r}");
+    assert!(dot(col(2), col(3)) / r > 0.99, "up points away from the centre");
+    assert_eq!(m[15], 1.0);
+    assert!(t["root"]["content"]["uri"].as_str().unwrap().ends_with(".glb?seed=1"), "anchoring stays out of tiles");
+    assert!(s.json("/3dtiles/gravel/tileset.json").await["root"].get("transform").is_none());
+}
+
+#[tokio::test]
+async fn bad_3dtiles_requests_are_json_4xx() {
+    let s = Server::builder().start();
+    for (path, status, code) in [
+        ("/3dtiles/gravel/tileset.json?lon=3", 400, "missing_parameter"),
+        ("/3dtiles/gravel/tileset.json?height=3", 400, "missing_parameter"),
+        ("/3dtiles/gravel/tileset.json?lon=3&lat=91", 400, "invalid_parameter"),
+        ("/3dtiles/gravel/tileset.json?lon=x&lat=1", 400, "invalid_parameter"),
+        ("/3dtiles/gravel/tileset.json?bogus=1", 400, "unknown_parameter"),
+        ("/3dtiles/nosuch/tileset.json", 404, "unknown_texture"),
+        ("/3dtiles/gravel/tiles/11/0/0.glb", 400, "invalid_coordinate"),
+        ("/3dtiles/gravel/tiles/2/4/0.glb", 400, "invalid_coordinate"),
+        ("/3dtiles/gravel/tiles/2/0/-1.glb", 400, "invalid_coordinate"),
+        ("/3dtiles/gravel/tiles/2/0/0.png", 400, "invalid_format"),
+        ("/3dtiles/gravel/tiles/2/0/0.glb?seed=x", 400, "invalid_parameter"),
+        ("/3dtiles/gravel/subtrees/1/0/0.subtree", 400, "invalid_coordinate"),
+        ("/3dtiles/gravel/subtrees/4/16/0.subtree", 400, "invalid_coordinate"),
+        ("/3dtiles/gravel/subtrees/99999999999/0/0.subtree", 400, "invalid_coordinate"),
+    ] {
+        assert_error(&s, path, status, code).await;
+    }
+}

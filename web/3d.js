@@ -1,0 +1,246 @@
+// textile 3D viewer: the texture's OGC 3D Tiles tileset (/3dtiles/{id}/tileset.json) streamed by
+// 3DTilesRendererJS into a three.js scene, with a map-style camera (pan, orbit, dolly) and the
+// texture, mode, seed and mode-parameter pickers built from /catalog and the texture's parameter
+// specs, as the 2D viewer's are. The view and the choices live in the URL hash (the permalink).
+import * as THREE from 'three';
+import { MapControls } from 'three/addons/controls/MapControls.js';
+import { TilesRenderer } from '3d-tiles-renderer';
+import { ImplicitTilingPlugin } from '3d-tiles-renderer/core/plugins';
+
+const $ = (id) => document.getElementById(id);
+const num = (v) => String(Number(Number(v).toFixed(3)));
+
+// t: texture, m: mode, seed, p: mode parameters as given, cam: eye and target.
+const state = { t: null, m: null, seed: '0', p: {}, cam: null };
+let catalog = null, meta = null, tiles = null, debounce = null, retry = null;
+// Every content tile the renderer asked for, by level (the test and the readout use them).
+const requested = [];
+
+function readHash() {
+  const h = new URLSearchParams(location.hash.slice(1));
+  state.t = h.get('t');
+  state.m = h.get('m');
+  state.seed = h.get('seed') ?? '0';
+  state.p = {};
+  for (const [k, v] of h) if (k.startsWith('p.')) state.p[k.slice(2)] = v;
+  const cam = (h.get('cam') || '').split(',').map(Number);
+  state.cam = cam.length === 6 && cam.every(Number.isFinite) ? cam : null;
+}
+
+function writeHash() {
+  const h = new URLSearchParams();
+  h.set('t', state.t);
+  h.set('m', state.m);
+  h.set('seed', state.seed);
+  for (const [k, v] of Object.entries(state.p)) h.set(`p.${k}`, v);
+  const e = camera.position, g = controls.target;
+  h.set('cam', [e.x, e.y, e.z, g.x, g.y, g.z].map(num).join(','));
+  history.replaceState(null, '', `#${h.toString().replace(/%2C/g, ',')}`);
+  $('permalink').href = location.href;
+}
+
+/** The tileset URL of the current choices: the tiles' query parameters. */
+function tilesetUrl() {
+  const q = new URLSearchParams();
+  if (state.m !== meta.default_mode) q.set('mode', state.m);
+  if (state.seed !== '0') q.set('seed', state.seed);
+  for (const [k, v] of Object.entries(state.p)) q.set(k, v);
+  const qs = q.toString();
+  return `/3dtiles/${encodeURIComponent(state.t)}/tileset.json${qs ? `?${qs}` : ''}`;
+}
+
+// The scene: Y up; the tileset (Z up) turned so that its east-north-up frame shows with north
+// away from the default camera, which makes the ground frame of the glTF tiles (X east, Z south).
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+$('view').append(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xbfd1e5);
+// A rough, non-metallic ground under ambient light of intensity π shows its texture as it is.
+scene.add(new THREE.AmbientLight(0xffffff, Math.PI));
+const camera = new THREE.PerspectiveCamera(50, 1, 0.5, 4e6);
+const controls = new MapControls(camera, renderer.domElement);
+controls.screenSpacePanning = false;
+controls.maxPolarAngle = Math.PI / 2 - 0.02;
+controls.minDistance = 2;
+controls.addEventListener('end', () => { clearTimeout(debounce); debounce = setTimeout(writeHash, 200); });
+
+function resize() {
+  const el = $('view');
+  renderer.setSize(el.clientWidth, el.clientHeight);
+  camera.aspect = el.clientWidth / Math.max(1, el.clientHeight);
+  camera.updateProjectionMatrix();
+}
+window.addEventListener('resize', resize);
+
+function loadTiles() {
+  if (tiles) {
+    scene.remove(tiles.group);
+    tiles.dispose();
+  }
+  const url = tilesetUrl();
+  $('tilesetlink').href = url;
+  tiles = new TilesRenderer(url);
+  tiles.registerPlugin(new ImplicitTilingPlugin());
+  // A few requests at a time: a burst of hundreds would only queue (or be shed) at the server.
+  tiles.downloadQueue.maxJobs = 4;
+  tiles.group.rotation.x = -Math.PI / 2;
+  tiles.setCamera(camera);
+  tiles.setResolutionFromRenderer(camera, renderer);
+  tiles.addEventListener('load-error', (e) => {
+    // A busy server sheds with 503: ask again a little later, as the 2D viewer does.
+    if (/\b503\b/.test(String(e.error))) {
+      clearTimeout(retry);
+      retry = setTimeout(() => tiles?.resetFailedTiles(), 1000 + 1000 * Math.random());
+    } else {
+      console.error(`tile load failed: ${e.url}: ${e.error}`);
+    }
+  });
+  tiles.addEventListener('load-tileset', () => { document.body.dataset.ready = '1'; });
+  scene.add(tiles.group);
+  writeHash();
+}
+
+/** Place the camera: from the hash, or above the middle of the root tile, looking down at 45°. */
+function placeCamera() {
+  const side = 256 * 2 ** meta.native_zoom;
+  const [ex, ey, ez, tx, ty, tz] = state.cam ?? [side / 2, 700, side / 2 + 700, side / 2, 0, side / 2];
+  camera.position.set(ex, ey, ez);
+  controls.target.set(tx, ty, tz);
+  controls.update();
+}
+
+function changed() {
+  clearTimeout(debounce);
+  debounce = setTimeout(loadTiles, 250);
+}
+
+/** A control for one request parameter of the mode: numbers and integers as sliders, choices
+ * as a select; other kinds (per-level lists, intervals, controls) are the 2D viewer's. */
+function control(name, spec) {
+  const row = document.createElement('div');
+  row.className = 'slider';
+  row.title = spec.description;
+  const label = document.createElement('label');
+  label.textContent = name;
+  label.htmlFor = `p-${name}`;
+  let input;
+  if (spec.type === 'choice') {
+    input = document.createElement('select');
+    for (const v of spec.values) input.append(new Option(v, v));
+  } else if (spec.type === 'number' || spec.type === 'integer') {
+    input = document.createElement('input');
+    Object.assign(input, { type: 'range', min: spec.min, max: spec.max, step: spec.type === 'integer' ? 1 : (spec.max - spec.min) / 100 });
+  } else {
+    return null;
+  }
+  input.id = `p-${name}`;
+  input.value = state.p[name] ?? spec.default;
+  const out = document.createElement('output');
+  out.textContent = input.value;
+  input.addEventListener('input', () => {
+    out.textContent = input.value;
+    state.p[name] = spec.type === 'choice' ? input.value : num(input.value);
+    changed();
+  });
+  row.append(label, input, out);
+  return row;
+}
+
+function buildParams() {
+  $('modename').textContent = state.m;
+  const box = $('controls');
+  box.textContent = '';
+  const specs = Object.entries(meta.parameters).filter(([, s]) => s.modes && s.modes.includes(state.m) && s.scope === 'request');
+  for (const name of Object.keys(state.p)) if (!specs.some(([n]) => n === name)) delete state.p[name];
+  for (const [name, spec] of specs) {
+    const c = control(name, spec);
+    if (c) box.append(c);
+  }
+}
+
+async function selectTexture(id, keepView) {
+  const r = await fetch(`/textures/${encodeURIComponent(id)}`);
+  if (!r.ok) throw new Error(`texture ${id}: HTTP ${r.status}`);
+  meta = await r.json();
+  state.t = id;
+  const modes = $('mode');
+  modes.textContent = '';
+  for (const m of meta.modes) modes.append(new Option(m, m));
+  if (!meta.modes.includes(state.m)) state.m = meta.default_mode;
+  modes.value = state.m;
+  buildParams();
+  if (!keepView) state.cam = null;
+  placeCamera();
+  loadTiles();
+}
+
+function frame() {
+  requestAnimationFrame(frame);
+  controls.update();
+  camera.updateMatrixWorld();
+  if (tiles) {
+    tiles.update();
+    const s = tiles.stats;
+    $('tilestats').textContent = `${s.visible ?? '–'} visible, ${s.downloading ?? 0} loading`;
+  }
+  $('readout').textContent = `height ${num(camera.position.y)}`;
+  renderer.render(scene, camera);
+}
+
+async function main() {
+  readHash();
+  resize();
+  catalog = await (await fetch('/catalog')).json();
+  const sel = $('texture');
+  for (const t of catalog.textures) sel.append(new Option(t.name, t.id));
+  if (!catalog.textures.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
+  sel.value = state.t;
+  $('seed').value = state.seed;
+  sel.addEventListener('change', () => { state.p = {}; selectTexture(sel.value, false); });
+  $('mode').addEventListener('change', () => { state.m = $('mode').value; buildParams(); changed(); });
+  $('seed').addEventListener('change', () => { state.seed = String(Math.max(0, Math.floor(Number($('seed').value) || 0))); changed(); });
+  $('newseed').addEventListener('click', () => {
+    state.seed = String(Math.floor(Math.random() * 2 ** 31));
+    $('seed').value = state.seed;
+    changed();
+  });
+  await selectTexture(state.t, true);
+  frame();
+}
+
+// Content requests by level, for the readout and the browser test.
+new PerformanceObserver((list) => {
+  for (const e of list.getEntries()) {
+    const m = e.name.match(/\/3dtiles\/[^/]+\/tiles\/(\d+)\/(\d+)\/(\d+)\.glb/);
+    if (m) requested.push({ level: Number(m[1]), x: Number(m[2]), y: Number(m[3]) });
+  }
+}).observe({ type: 'resource', buffered: true });
+
+window.textile3d = {
+  camera, controls, requested, state,
+  get tiles() { return tiles; },
+  /** Move the camera (eye and target) and let the tiles follow. */
+  look(eye, target) {
+    camera.position.set(...eye);
+    controls.target.set(...target);
+    controls.update();
+    writeHash();
+  },
+  /** The levels of the tiles on screen, with how many of each. */
+  visibleLevels() {
+    const n = {};
+    for (const t of tiles?.visibleTiles ?? []) {
+      const m = (t.content?.uri ?? '').match(/tiles\/(\d+)\//);
+      if (m) n[m[1]] = (n[m[1]] ?? 0) + 1;
+    }
+    return n;
+  },
+  /** Whether every tile the view needs is loaded and nothing is in flight. */
+  settled() {
+    const s = tiles?.stats;
+    return !!s && tiles.root && s.downloading === 0 && s.parsing === 0 && tiles.loadProgress === 1;
+  },
+};
+
+main().catch((e) => console.error(String(e)));
