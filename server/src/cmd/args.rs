@@ -260,12 +260,23 @@ pub struct LoadtestArgs {
     #[arg(long, default_value = "gravel")]
     pub texture: String,
     /// Request pattern: pan (viewport dragged across the plane), zoom (in and out), random
-    /// (uniform tiles), hot (one tile), replay (the URLs of --file, cycled).
+    /// (uniform tiles), hot (one tile), replay (the requests of --file, cycled or --once).
     #[arg(long, default_value = "pan", value_parser = ["pan", "zoom", "random", "hot", "replay"])]
     pub pattern: String,
-    /// URL list for `--pattern replay`: one URL or /path per line.
+    /// Requests for `--pattern replay`: one URL, /path, or nginx/Apache combined (or common)
+    /// access-log line per line; access-log lines other than GET and HEAD are left out.
     #[arg(long, value_name = "FILE")]
     pub file: Option<PathBuf>,
+    /// Replay the file once, in order, then end (by default it is cycled).
+    #[arg(long)]
+    pub once: bool,
+    /// Replay an access log at its own pace, X times real time (2 = twice as fast), once: each
+    /// request is due at its timestamp (an open model; latency from the due time).
+    #[arg(long, value_name = "X")]
+    pub speed: Option<f64>,
+    /// Replay only access-log lines of these statuses, e.g. 200,304.
+    #[arg(long, value_name = "CODES", value_delimiter = ',')]
+    pub replay_status: Vec<u16>,
     /// Concurrent connections (1-1024).
     #[arg(long, default_value_t = 8)]
     pub concurrency: usize,
@@ -284,9 +295,46 @@ pub struct LoadtestArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Behave like a polite client: after a 503, a connection waits the advised Retry-After
-    /// before its next request (by default it asks again at once, the harder test).
+    /// before its next request (by default it asks again at once, the harder test). Closed
+    /// loop only.
     #[arg(long)]
     pub honor_retry_after: bool,
+    /// Open model: offer this many requests per second (constant arrivals, as wrk2 -R or k6's
+    /// constant-arrival-rate), whatever the answers; --concurrency bounds the connections.
+    /// Latency is then measured from each request's intended send time (corrected for
+    /// coordinated omission), with the uncorrected figure beside it. Without it: a closed loop.
+    #[arg(long, value_name = "R")]
+    pub rate: Option<f64>,
+    /// Open model with a rate ramped linearly from FROM to TO requests per second over the run
+    /// (needs --duration), e.g. 50:400.
+    #[arg(long, value_name = "FROM:TO")]
+    pub rate_ramp: Option<String>,
+    /// Run the load this many seconds first, leaving it out of every figure (caches and
+    /// connections warm).
+    #[arg(long, value_name = "SECONDS")]
+    pub warmup: Option<f64>,
+    /// Verify under load: fetch each distinct URL's reference bytes once before the run (one at
+    /// a time), then check every 200 under load against it; a difference is an error naming the
+    /// URL, and the command fails. Needs the run's URLs up front: --pattern replay, or --requests
+    /// N (the run then plays the first N of the pattern).
+    #[arg(long)]
+    pub verify: bool,
+    /// Verify against the references of FILE (`URL sha256` lines, as --record writes) instead of
+    /// fetching them (URLs not in it are fetched). Implies --verify.
+    #[arg(long, value_name = "FILE")]
+    pub expect: Option<PathBuf>,
+    /// Write the references fetched before the run to FILE (`URL sha256` lines), e.g. from one
+    /// replica, to --expect them of another. Implies --verify.
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
+    /// Draw the run's timeline to FILE.svg: p50 and p99 latency and requests and errors per
+    /// second, in one chart.
+    #[arg(long, value_name = "FILE.svg")]
+    pub plot: Option<PathBuf>,
+    /// Write the latency histogram to FILE in HdrHistogram's percentile-distribution text format
+    /// (milliseconds; what HdrHistogram's plotters read).
+    #[arg(long, value_name = "FILE")]
+    pub histogram: Option<PathBuf>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
