@@ -10,8 +10,13 @@ use std::process::Command;
 
 use common::Server;
 
+/// One browser suite at a time: each runs Chromium with software WebGL and a server, and two at
+/// once on a 2-core machine only make both slow enough to time out.
+static ONE_BROWSER: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 #[test]
 fn viewer_in_headless_chromium() {
+    let _one = ONE_BROWSER.lock().unwrap_or_else(|e| e.into_inner());
     let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/browser");
     if !PathBuf::from(&chromium).exists() {
@@ -51,6 +56,7 @@ fn viewer_in_headless_chromium() {
 
 #[test]
 fn exported_archive_in_headless_chromium() {
+    let _one = ONE_BROWSER.lock().unwrap_or_else(|e| e.into_inner());
     let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/browser");
     if !PathBuf::from(&chromium).exists() {
@@ -96,6 +102,7 @@ fn exported_archive_in_headless_chromium() {
 /// to `target/tmp/clients3d/`.
 #[test]
 fn three_d_clients_in_headless_chromium() {
+    let _one = ONE_BROWSER.lock().unwrap_or_else(|e| e.into_inner());
     let chromium = std::env::var("CHROMIUM").unwrap_or_else(|_| "/usr/bin/chromium".into());
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/browser");
     if !PathBuf::from(&chromium).exists() {

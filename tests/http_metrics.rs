@@ -141,12 +141,29 @@ fn loadtest_bounds_end_runs_alone_and_every_request_is_counted() {
     assert!(counted["server_computation_ratio"].is_null(), "{counted}");
     // Cold synth tiles at 8 connections for 1 s: requests are in flight at the deadline. They
     // are counted as timed out, and the statuses add up to every request started.
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let tiles_counted = || {
+        let text =
+            rt.block_on(async { reqwest::get(format!("{}/metrics", s.base)).await.unwrap().text().await.unwrap() });
+        text.lines()
+            .filter(|l| l.starts_with("textile_http_requests_total{route=\"/tiles/{id}/{z}/{x}/{y}\""))
+            .map(|l| l.rsplit(' ').next().unwrap().parse::<f64>().unwrap())
+            .sum::<f64>() as u64
+    };
+    let before = tiles_counted();
     let busy = run(&["--texture", "brick", "--pattern", "random", "--concurrency", "8", "--duration", "1"]);
     let timed_out = busy["timed_out"].as_u64().unwrap();
     assert!(timed_out >= 1, "{busy}");
     let sum: u64 = busy["status"].as_object().unwrap().values().map(|v| v.as_u64().unwrap()).sum();
     assert_eq!(sum, busy["requests"].as_u64().unwrap(), "{busy}");
     assert_eq!(busy["status"]["timed_out"].as_u64(), Some(timed_out));
+    // Against the server's own count: every request the loader saw answered, the server counted;
+    // beyond those, at most the timed-out ones (the server counts an answer it finishes, and a
+    // request whose client went away at the deadline may or may not be finished).
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    let counted = tiles_counted() - before;
+    let requests = busy["requests"].as_u64().unwrap();
+    assert!((requests - timed_out..=requests).contains(&counted), "server counted {counted}: {busy}");
     // Bad bounds are clear errors.
     let bad = Command::new(binary()).args(["loadtest", "--url", &s.base, "--duration", "0"]).output().unwrap();
     assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("--duration"));
