@@ -27,6 +27,15 @@ pub const MAX_V: usize = 80;
 /// Longest `v` a caller may give TileJSON (carried into its tiles template).
 pub const MAX_CALLER_V: usize = 64;
 
+/// A query string (percent-encoded, without the `?`) of key–value pairs, in their order.
+pub fn query_string<'a>(pairs: impl IntoIterator<Item = (&'a String, &'a String)>) -> String {
+    let mut qs = form_urlencoded::Serializer::new(String::new());
+    for (k, v) in pairs {
+        qs.append_pair(k, v);
+    }
+    qs.finish()
+}
+
 /// The key–value pairs of a raw query string, percent-decoded, in order.
 pub fn query_pairs(raw: Option<&str>) -> Vec<(String, String)> {
     form_urlencoded::parse(raw.unwrap_or("").as_bytes()).into_owned().collect()

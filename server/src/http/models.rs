@@ -23,7 +23,7 @@ use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{base_url, path_error, texture, Peer};
 use crate::metrics::GLTF_LABEL;
 use crate::pipeline::{cache_key, cached, engine_version, etag_for, produce, ImageJob, Target};
-use crate::request::{params, parse_tile, query_pairs, TileSpec, WindowSpec, COORD_MAX};
+use crate::request::{params, parse_tile, query_pairs, query_string, TileSpec, WindowSpec, COORD_MAX};
 use crate::state::AppState;
 use crate::textures::Texture;
 
@@ -48,11 +48,7 @@ fn quad(tex: &Texture, t: &TileSpec) -> Quad {
 
 /// The tile URL (absolute) with the request's parameters.
 fn tile_url(base: &str, tex: &Texture, t: &TileSpec, q: &Query) -> String {
-    let mut qs = form_urlencoded::Serializer::new(String::new());
-    for (k, v) in q {
-        qs.append_pair(k, v);
-    }
-    let qs = qs.finish();
+    let qs = query_string(q);
     let sep = if qs.is_empty() { "" } else { "?" };
     format!("{base}/tiles/{}/{}/{}/{}.png{sep}{qs}", tex.config.id, t.z, t.x, t.y)
 }
@@ -63,11 +59,7 @@ fn sibling_image(r: &TileRequest, spec: &TileSpec) -> String {
     if r.query.is_empty() {
         return format!("{}.png", spec.y);
     }
-    let mut qs = form_urlencoded::Serializer::new(String::new());
-    for (k, v) in &r.query {
-        qs.append_pair(k, v);
-    }
-    format!("{}.{}.png", spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(qs.finish()))
+    format!("{}.{}.png", spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(query_string(&r.query)))
 }
 
 /// The absolute URL of a tile's image (border included) for X3D documents.
@@ -91,9 +83,12 @@ pub(super) struct TileRequest {
 }
 
 impl TileRequest {
-    /// Tile `spec` of `tex` with the parameters of query `raw`.
-    pub(super) fn new(tex: Arc<Texture>, spec: TileSpec, raw: Option<&str>) -> Result<TileRequest, ApiError> {
-        let pairs = query_pairs(raw);
+    /// Tile `spec` of `tex` with the parameters of the query's `pairs`.
+    pub(super) fn new(
+        tex: Arc<Texture>,
+        spec: TileSpec,
+        pairs: Vec<(String, String)>,
+    ) -> Result<TileRequest, ApiError> {
         let params = params(&tex, ParamReader::request(pairs.clone())?)?;
         Ok(TileRequest { tex, spec, query: pairs.into_iter().collect(), params })
     }
@@ -149,7 +144,7 @@ fn tile_request(
         _ => (y, raw),
     };
     let spec = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
-    Ok((TileRequest::new(tex, spec, raw.as_deref())?, ext.to_string()))
+    Ok((TileRequest::new(tex, spec, query_pairs(raw.as_deref()))?, ext.to_string()))
 }
 
 fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
@@ -295,7 +290,7 @@ pub async fn gltf_patch(
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
-/// X3D bytes for `quads` of request `r`, with its ETag handling.
+/// An X3D answer with ETag `etag`: `304` when the client has it, else the document `doc` makes.
 fn x3d_answer(st: &AppState, headers: &HeaderMap, etag: &str, doc: impl FnOnce() -> String) -> Response {
     let cc = &st.config.cache_control;
     if if_none_match(headers, etag) {

@@ -16,7 +16,7 @@ use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{path_error, texture};
 use crate::http::models::{generator, glb_tile, split_ext, TileRequest};
 use crate::pipeline::{cache_key, etag_for};
-use crate::request::{params, query_pairs, TileSpec};
+use crate::request::{params, query_pairs, query_string, TileSpec};
 use crate::state::AppState;
 use crate::textures::Texture;
 use crate::tileset::{enu_to_ecef, subtree, tileset, xyz_row, Tree, SUBTREE_LEVELS};
@@ -26,13 +26,9 @@ use textile_core::ParamReader;
 /// the tileset URL's query into every URL it resolves against it.
 const ANCHORING: [&str; 3] = ["lon", "lat", "height"];
 
-/// `raw` without the anchoring parameters.
-fn without_anchoring(raw: Option<&str>) -> String {
-    let mut qs = form_urlencoded::Serializer::new(String::new());
-    for (k, v) in query_pairs(raw).iter().filter(|(k, _)| !ANCHORING.contains(&k.as_str())) {
-        qs.append_pair(k, v);
-    }
-    qs.finish()
+/// The pairs of query `raw` without the anchoring parameters.
+fn without_anchoring(raw: Option<&str>) -> Vec<(String, String)> {
+    query_pairs(raw).into_iter().filter(|(k, _)| !ANCHORING.contains(&k.as_str())).collect()
 }
 
 /// The tileset's tree for a texture: zooms `0..=max_zoom`.
@@ -96,14 +92,10 @@ pub async fn tileset_json(
         }
     };
     // Everything else is the tiles' query: validated here, carried into the content URIs.
-    let pairs = query_pairs(Some(&without_anchoring(raw.as_deref())));
+    let pairs = without_anchoring(raw.as_deref());
     let p = params(&tex, ParamReader::request(pairs.clone())?)?;
     // Sorted: one URI (and cache entry) per set of parameters, however they were ordered.
-    let mut qs = form_urlencoded::Serializer::new(String::new());
-    for (k, v) in pairs.iter().map(|(k, v)| (k, v)).collect::<std::collections::BTreeMap<_, _>>() {
-        qs.append_pair(k, v);
-    }
-    let query = qs.finish();
+    let query = query_string(&pairs.into_iter().collect::<std::collections::BTreeMap<_, _>>());
     let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset|{query}|{transform:?}")));
     let cc = &st.config.cache_control;
     if if_none_match(&headers, &etag) {
@@ -164,6 +156,6 @@ pub async fn content_tile(
     let (y, _) = split_ext(&y, &["glb"])?;
     let (level, x, y) = implicit(&tree(&tex), &level, &x, y)?;
     let spec = TileSpec { z: level, x, y: xyz_row(level, y), scale: 1, format: Format::Png };
-    let r = TileRequest::new(tex, spec, Some(&without_anchoring(raw.as_deref())))?;
+    let r = TileRequest::new(tex, spec, without_anchoring(raw.as_deref()))?;
     glb_tile(&st, &r, &headers).await
 }

@@ -230,7 +230,8 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let (hits, misses) = (d("textile_cache_hits_total"), d("textile_cache_misses_total"));
         let open = !matches!(model, Model::Closed { .. });
         // The figure the report leads with: from the intended send time in the open model.
-        let lat = report::percentiles(&report::latencies(all, false, open));
+        let leading = report::latencies(all, false, open);
+        let lat = report::percentiles(&leading);
         let ok = report::percentiles(&report::latencies(all, true, open));
         let statuses = report::statuses(all);
         let bytes: u64 = all.iter().map(|r| r.bytes as u64).sum();
@@ -279,7 +280,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             plot::write(f, &title, report["timeline"].as_array().map(Vec::as_slice).unwrap_or(&[]))?;
         }
         if let Some(f) = &a.histogram {
-            let text = report::distribution_text(&report::latencies(all, false, open));
+            let text = report::distribution_text(&leading);
             textile_core::files::write_atomic(f, text.as_bytes()).map_err(|e| format!("{}: {e}", f.display()))?;
         }
         // Write the report; a reader that went away (a closed pipe) is not an error worth a panic.

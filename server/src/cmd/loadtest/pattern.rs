@@ -90,6 +90,15 @@ pub fn pattern(
     }
 }
 
+/// The path (and query) of a URL or `/path`; `None` for anything else.
+pub fn path_of(s: &str) -> Option<String> {
+    match reqwest::Url::parse(s) {
+        Ok(u) => Some(format!("{}{}", u.path(), u.query().map(|q| format!("?{q}")).unwrap_or_default())),
+        Err(_) if s.starts_with('/') && !s.contains(char::is_whitespace) => Some(s.to_string()),
+        Err(_) => None,
+    }
+}
+
 /// One line of a replay file: the path (and query) to request, and when the log saw it
 /// (seconds since the Unix epoch; access-log lines only).
 #[derive(Debug, Clone, PartialEq)]
@@ -165,16 +174,9 @@ pub fn replay_lines(f: &Path, statuses: &[u16]) -> Result<Vec<Entry>, String> {
             }
             continue;
         }
-        let path = match reqwest::Url::parse(l) {
-            Ok(u) => format!("{}{}", u.path(), u.query().map(|q| format!("?{q}")).unwrap_or_default()),
-            Err(_) if l.starts_with('/') && !l.contains(char::is_whitespace) => l.to_string(),
-            Err(_) => {
-                return Err(format!(
-                    "{}:{n}: '{l}' is neither a URL, a /path, nor a combined or common access-log line",
-                    f.display()
-                ))
-            }
-        };
+        let path = path_of(l).ok_or_else(|| {
+            format!("{}:{n}: '{l}' is neither a URL, a /path, nor a combined or common access-log line", f.display())
+        })?;
         v.push(Entry { path, at: None });
     }
     if v.is_empty() {

@@ -9,21 +9,14 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
+use super::pattern::path_of;
+
 /// Reference digests by request path.
 pub type References = HashMap<String, String>;
 
 /// The SHA-256 of `bytes`, lowercase hex.
 pub fn digest(bytes: &[u8]) -> String {
     Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
-}
-
-/// The path (and query) of a URL or `/path` line.
-fn path_of(s: &str) -> Option<String> {
-    match reqwest::Url::parse(s) {
-        Ok(u) => Some(format!("{}{}", u.path(), u.query().map(|q| format!("?{q}")).unwrap_or_default())),
-        Err(_) if s.starts_with('/') => Some(s.to_string()),
-        Err(_) => None,
-    }
 }
 
 /// Read an `--expect` file: `URL-or-path sha256` per line; blank lines and `#` comments skipped.
