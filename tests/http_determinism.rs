@@ -71,23 +71,18 @@ async fn same_bytes_across_processes_thread_counts_and_orders() {
 #[tokio::test]
 async fn zoomed_out_tiles_are_reduced_views_of_their_children() {
     let s = Server::builder().start();
-    // z = native - 1: exactly the 2×2 box average of the four native children (up to rounding).
-    for (id, x, y) in [("gravel", 0, 0), ("brick", -3, 2)] {
-        let parent = s.image(&format!("/tiles/{id}/6/{x}/{y}.png")).await;
-        let children = block(&s, id, 7, 2 * x, 2 * y, "").await;
+    // A zoomed-out tile shows a coarser synthesis level's coordinates with the exact box
+    // mean of the exemplar block under each (so it costs what a native tile does): close to its
+    // children box-filtered, not exact — what the finer levels' correction moved differs. Bound
+    // 8 of 255 per channel, as core/tests/zoom_consistency.rs keeps for synth (measured there
+    // on 16 tiles: gravel 3.5, 5.6, 7.2 one to three steps out; brick at most 4.2).
+    for (id, z, x, y) in [("gravel", 6, 0, 0), ("brick", 6, -3, 2), ("gravel", 5, 0, 0), ("gravel", 4, 1, -1)] {
+        let parent = s.image(&format!("/tiles/{id}/{z}/{x}/{y}.png")).await;
+        let children = block(&s, id, z + 1, 2 * x, 2 * y, "").await;
         let mad = mean_abs_diff(&parent, &box_half(&children));
-        eprintln!("{id}: z6 vs z7 mean abs difference {mad}");
-        // Bound: the parent is the exact 2×2 box average of the children; only rounding of
-        // the average may differ (measured: 0.0).
-        assert!(mad < 0.5, "{id}: mean abs difference {mad}");
+        eprintln!("{id}: z{z} vs z{} mean abs difference {mad}", z + 1);
+        assert!(mad < 8.0, "{id} z{z}: mean abs difference {mad}");
     }
-    // Two zoom steps out the parent uses the blurred Gaussian stack of the next level: close,
-    // not exact (measured 6.25 on gravel; bound 12 of 255).
-    let parent = s.image("/tiles/gravel/5/0/0.png").await;
-    let children = block(&s, "gravel", 6, 0, 0, "").await;
-    let mad = mean_abs_diff(&parent, &box_half(&children));
-    eprintln!("gravel: z5 vs z6 mean abs difference {mad}");
-    assert!(mad < 12.0, "z5 vs z6: mean abs difference {mad}");
 }
 
 /// 2×2 box downsampling with rounding.

@@ -90,3 +90,57 @@ pub struct Rendered {
 pub fn box_mip(texels: &[[u8; 3]], n: usize, lvl: usize) -> Vec<[u8; 3]> {
     RgbWindow::from_texels(n as u32, texels).box_down(1 << lvl).texels()
 }
+
+/// Sums of an `n × n` exemplar's texels over `f × f` boxes anywhere on its torus, from an
+/// integral image of the exemplar extended by `f` texels right and down (wrapping).
+pub(crate) struct Integral {
+    /// Side of the exemplar (a power of two).
+    n: usize,
+    /// Box side (a power of two, at most `n`).
+    f: usize,
+    /// `(n + f + 1)²` prefix sums per channel: entry `(x, y)` sums the texels left of and
+    /// above it.
+    sums: Vec<[u32; 3]>,
+}
+
+impl Integral {
+    pub(crate) fn new(texels: &[[u8; 3]], n: usize, f: usize) -> Integral {
+        debug_assert!(n.is_power_of_two() && f.is_power_of_two() && f <= n);
+        let s = n + f + 1;
+        let mut sums = vec![[0u32; 3]; s * s];
+        for y in 1..s {
+            for x in 1..s {
+                let t = texels[((y - 1) & (n - 1)) * n + ((x - 1) & (n - 1))];
+                let (l, u, d) = (sums[y * s + x - 1], sums[(y - 1) * s + x], sums[(y - 1) * s + x - 1]);
+                sums[y * s + x] = std::array::from_fn(|c| t[c] as u32 + l[c] + u[c] - d[c]);
+            }
+        }
+        Integral { n, f, sums }
+    }
+
+    /// The mean (rounded to nearest) of the `f × f` texels centred on texel `(x, y)` (from
+    /// `f/2` before it to `f/2 − 1` after), on the torus.
+    pub(crate) fn mean_around(&self, x: usize, y: usize) -> [u8; 3] {
+        let (n, f, s) = (self.n, self.f, self.n + self.f + 1);
+        let (x0, y0) = ((x + n - f / 2) & (n - 1), (y + n - f / 2) & (n - 1));
+        let at = |x: usize, y: usize| self.sums[y * s + x];
+        let (a, b, c, d) = (at(x0, y0), at(x0 + f, y0), at(x0, y0 + f), at(x0 + f, y0 + f));
+        // `f` is a power of two: dividing by the area is a shift.
+        let shift = 2 * f.trailing_zeros();
+        std::array::from_fn(|k| ((d[k] + a[k] - b[k] - c[k] + (1 << shift >> 1)) >> shift) as u8)
+    }
+}
+
+/// The centred box means of an `n × n` exemplar at every scale: entry `k` (`0..=log2 n`) holds,
+/// for each texel, the mean of the `2^k × 2^k` texels centred on it on the torus (see
+/// [`Integral::mean_around`]). A zoomed-out pixel whose native texels are the exemplar's block
+/// around one coordinate shows exactly this colour.
+pub fn box_stack(texels: &[[u8; 3]], n: usize) -> Vec<Vec<[u8; 3]>> {
+    let levels = n.trailing_zeros() as usize;
+    (0..=levels)
+        .map(|k| {
+            let sums = Integral::new(texels, n, 1 << k);
+            (0..n * n).map(|i| sums.mean_around(i % n, i / n)).collect()
+        })
+        .collect()
+}

@@ -4,7 +4,9 @@
 //! * cached: the same N tiles again (cache hits);
 //! * cold mosaic: N distinct `mode=mosaic` tiles;
 //! * cold and cached GLB: N distinct glTF tiles elsewhere (the 288² bordered image: synthesis,
-//!   PNG, GLB, HTTP), then the same again (the padding's cost beside the PNG tile).
+//!   PNG, GLB, HTTP), then the same again (the padding's cost beside the PNG tile);
+//! * per zoom (issue 41): for every mode and every zoom from native (7) out to 0, max(5, N/50)
+//!   distinct cold PNG tiles, median and ratio to the mode's native median.
 //!
 //! In process it also times one 256² synthesis and the PNG/JPEG/WebP encoding of a tile.
 //! Prints median / p90 / p99 / max per figure.
@@ -17,7 +19,7 @@ use std::time::{Duration, Instant};
 
 use textile_core::modes::mosaic::MosaicParams;
 use textile_core::modes::synth::{render, SynthParams};
-use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress, Rect};
+use textile_core::{Analysis, Exemplar, ExemplarOptions, NoProgress, Rect, MODE_NAMES};
 use textile_server::encode::{encode, Effort, Format};
 
 fn summary(name: &str, mut v: Vec<Duration>) {
@@ -116,6 +118,32 @@ fn main() {
                 v.push(t.elapsed());
             }
             summary(name, v);
+        }
+        // Cold tiles per mode and zoom, far from everything requested before.
+        let per_zoom = (n / 50).max(5);
+        println!("cold PNG tiles over HTTP per zoom, median of {per_zoom} (ratio to the mode's native zoom 7):");
+        for mode in MODE_NAMES {
+            let mut row = format!("{mode:<9}");
+            let mut native = 0.0;
+            for z in (0..=7u32).rev() {
+                let mut v = Vec::with_capacity(per_zoom);
+                for i in 0..per_zoom as i64 {
+                    let (x, y) = ((i * 7919) % 100_003 - 50_000, 400_000 + 1000 * z as i64 + (i * 104_729) % 997);
+                    let t = Instant::now();
+                    let r =
+                        client.get(format!("{base}/tiles/gravel/{z}/{x}/{y}.png?mode={mode}")).send().await.unwrap();
+                    assert_eq!(r.headers()["x-cache"], "MISS");
+                    let _ = r.bytes().await.unwrap();
+                    v.push(t.elapsed().as_secs_f64() * 1e3);
+                }
+                v.sort_by(f64::total_cmp);
+                let median = v[v.len() / 2];
+                if z == 7 {
+                    native = median;
+                }
+                row += &format!("  z{z} {median:6.2} ms ({:.2}×)", median / native);
+            }
+            println!("{row}");
         }
     });
     let _ = child.kill();

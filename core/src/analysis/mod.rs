@@ -22,6 +22,7 @@ use crate::analysis::stack::{build_stack, to_u8};
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
+use crate::image::box_stack;
 use crate::lattice::Lattice;
 use crate::mask::RandomnessMask;
 
@@ -176,6 +177,9 @@ pub struct Analysis {
     pub corrected: Vec<CorrectionLevel>,
     /// Derived: 8-bit stack colours (not stored).
     pub(crate) stack8: Vec<Vec<[u8; 3]>>,
+    /// Derived: the exemplar's centred box means at every scale (not stored; see
+    /// [`crate::image::box_stack`]).
+    pub(crate) boxes: Vec<Vec<[u8; 3]>>,
     /// The exemplar's randomness mask (not stored: [`Analysis::attach`]).
     pub(crate) randomness_mask: Option<RandomnessMask>,
 }
@@ -243,7 +247,8 @@ impl Analysis {
             lattice: ex.lattice,
         };
         let randomness_mask = ex.randomness_mask.clone();
-        Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8, randomness_mask })
+        let boxes = box_stack(&ex.pixels, m);
+        Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8, boxes, randomness_mask })
     }
 
     /// The analysis id an exemplar would get with the search `index` chooses: compare with a
@@ -287,6 +292,12 @@ impl Analysis {
         &self.stack8[l as usize]
     }
 
+    /// The exemplar's box means over `2^k × 2^k` texels centred on each texel (`k = 0`: the
+    /// exemplar itself; `k = levels`: the mean colour everywhere).
+    pub fn box_colours(&self, k: u32) -> &[[u8; 3]] {
+        &self.boxes[k as usize]
+    }
+
     /// Mean colour of the exemplar (8-bit).
     pub fn mean_colour(&self) -> [u8; 3] {
         self.stack8[0][0]
@@ -300,7 +311,8 @@ impl Analysis {
         corrected: Vec<CorrectionLevel>,
     ) -> Analysis {
         let stack8 = derive_stack8(&stack);
-        Analysis { header, exemplar, stack, corrected, stack8, randomness_mask: None }
+        let boxes = box_stack(&exemplar, header.side as usize);
+        Analysis { header, exemplar, stack, corrected, stack8, boxes, randomness_mask: None }
     }
 
     /// Attach what an analysis read from a file keeps with the exemplar instead (its

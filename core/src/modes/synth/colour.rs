@@ -1,7 +1,10 @@
 //! From coordinates to colours (design note §1.4, §1.8): native windows copy exemplar texels;
-//! zoomed-out windows average 2×2 blocks of the next finer level's stack colours (a faithful
-//! reduced view: one zoom step out is exactly the 2×2 box average of the native pixels); beyond
-//! the pyramid the view is the exemplar's mean colour.
+//! a window `k` steps out is synthesis level `L − k` one pixel per pixel — the texture's mipmap,
+//! as Lefebvre & Hoppe note, at the cost of a native window — each pixel the exact box mean of
+//! the `2^k × 2^k` exemplar block its coordinate's descendants cover when the finer levels keep
+//! coherence (where their correction moves texels, close to the box filter of the native
+//! pixels, not equal; `core/tests/zoom_consistency.rs` bounds it); beyond the pyramid the view
+//! is the exemplar's mean colour.
 
 use crate::analysis::Analysis;
 use crate::image::{Rendered, RgbWindow};
@@ -32,24 +35,15 @@ pub fn render_with(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out:
             pixels.extend_from_slice(&an.exemplar[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
         }
     } else if zoom_out <= levels {
-        let l = levels - zoom_out + 1;
-        let sw = synthesize_with(pyr, an, params, l, rect.children())?;
+        // Level `L − k`, one pixel per pixel: coherent upsampling would give each of them the
+        // `2^k × 2^k` exemplar block centred on its coordinate at the finest level, so it shows
+        // that block's mean (exact wherever finer levels keep coherence; close where their
+        // jitter or correction moved texels).
+        let sw = synthesize_with(pyr, an, params, levels - zoom_out, rect)?;
         synthesized = sw.synthesized;
-        let cw = sw.window;
-        let stack = &an.stack[l as usize];
-        let cwid = 2 * w;
-        let at = |i: usize, j: usize| {
-            let v = cw.coords[j * cwid + i];
-            stack[(v >> 16) as usize * m + (v & 0xFFFF) as usize]
-        };
-        for j in 0..h {
-            for i in 0..w {
-                let q = [at(2 * i, 2 * j), at(2 * i + 1, 2 * j), at(2 * i, 2 * j + 1), at(2 * i + 1, 2 * j + 1)];
-                for c in 0..3 {
-                    let s: u32 = q.iter().map(|p| p[c] as u32).sum();
-                    pixels.push(((s + 512) >> 10).min(255) as u8);
-                }
-            }
+        let boxes = an.box_colours(zoom_out);
+        for &v in &sw.window.coords {
+            pixels.extend_from_slice(&boxes[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
         }
     } else {
         params.validate(an.side())?;

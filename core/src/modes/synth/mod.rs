@@ -73,7 +73,7 @@ fn unit_value(v: u32) -> f64 {
 
 impl Mode for Synth {
     const NAME: &'static str = "synth";
-    const VERSION: u32 = 4;
+    const VERSION: u32 = 5;
     const SUMMARY: &'static str = "parallel controllable texture synthesis (Lefebvre & Hoppe 2005)";
     const NEEDS: Needs = Needs::Analysis;
     const COST: Cost = Cost::Heavy;

@@ -119,16 +119,13 @@ pub(super) fn colour_shift(
     })
 }
 
-/// The background of a view: another mode's pixels (or the mean colour). Zoomed out, the
-/// mosaic's sampled pixels (each labelled once, at its centre, and averaged over its footprint
-/// around that label's source), not its exact box filter of the native ones: the background
-/// shows only between umbrellas, and the exact filter cost a fifth of a zoom-out-1 tile.
+/// The background of a view: another mode's pixels (or the mean colour), at the view's zoom.
 pub(super) fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> Result<RgbWindow> {
     let ex = src.exemplar;
     Ok(match p.background {
         Background::Mosaic => {
             let mp = MosaicParams { seed: p.seed, period: p.period, ..MosaicParams::default() };
-            mosaic::render_sampled(ex, &mp, view.zoom_out, view.rect)?
+            mosaic::render(ex, &mp, view.zoom_out, view.rect)?
         }
         Background::Synth => {
             let sp = SynthParams { seed: p.seed, period: p.period, ..SynthParams::default() };
