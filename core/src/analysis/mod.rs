@@ -11,6 +11,8 @@ mod preparation;
 pub use preparation::INDEX;
 pub mod stack;
 
+use std::sync::OnceLock;
+
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::candidates::{candidate_sets, CandidateRules, SearchPlan, BANDS};
@@ -177,9 +179,9 @@ pub struct Analysis {
     pub corrected: Vec<CorrectionLevel>,
     /// Derived: 8-bit stack colours (not stored).
     pub(crate) stack8: Vec<Vec<[u8; 3]>>,
-    /// Derived: the exemplar's centred box means at every scale (not stored; see
-    /// [`crate::image::box_stack`]).
-    pub(crate) boxes: Vec<Vec<[u8; 3]>>,
+    /// Derived on first use (zoomed-out views): the exemplar's centred box means at every
+    /// scale (not stored; see [`crate::image::box_stack`]).
+    pub(crate) boxes: OnceLock<Vec<Vec<[u8; 3]>>>,
     /// The exemplar's randomness mask (not stored: [`Analysis::attach`]).
     pub(crate) randomness_mask: Option<RandomnessMask>,
 }
@@ -247,7 +249,7 @@ impl Analysis {
             lattice: ex.lattice,
         };
         let randomness_mask = ex.randomness_mask.clone();
-        let boxes = box_stack(&ex.pixels, m);
+        let boxes = OnceLock::new();
         Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8, boxes, randomness_mask })
     }
 
@@ -295,7 +297,7 @@ impl Analysis {
     /// The exemplar's box means over `2^k × 2^k` texels centred on each texel (`k = 0`: the
     /// exemplar itself; `k = levels`: the mean colour everywhere).
     pub fn box_colours(&self, k: u32) -> &[[u8; 3]] {
-        &self.boxes[k as usize]
+        &self.boxes.get_or_init(|| box_stack(&self.exemplar, self.header.side as usize))[k as usize]
     }
 
     /// Mean colour of the exemplar (8-bit).
@@ -311,8 +313,7 @@ impl Analysis {
         corrected: Vec<CorrectionLevel>,
     ) -> Analysis {
         let stack8 = derive_stack8(&stack);
-        let boxes = box_stack(&exemplar, header.side as usize);
-        Analysis { header, exemplar, stack, corrected, stack8, boxes, randomness_mask: None }
+        Analysis { header, exemplar, stack, corrected, stack8, boxes: OnceLock::new(), randomness_mask: None }
     }
 
     /// Attach what an analysis read from a file keeps with the exemplar instead (its

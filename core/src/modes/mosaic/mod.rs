@@ -140,8 +140,9 @@ fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let n = layout.n as usize;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let step = 1i64 << k.min(40);
-    if k >= ex.side.trailing_zeros() {
-        let mean = box_mip(&ex.pixels, n, k.min(ex.side.trailing_zeros()) as usize)[0];
+    let levels = ex.side.trailing_zeros();
+    if k >= levels {
+        let mean = box_mip(&ex.pixels, n, levels as usize)[0];
         return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
     }
     let sums = Integral::new(&ex.pixels, n, step as usize);
