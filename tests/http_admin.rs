@@ -263,12 +263,12 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     assert!(data.path().join("mine.umbrella").exists(), "the kept uploads keep their extraction");
     assert_eq!(files_in(&uploads), ["mine.png", "mine.toml", "race.png", "race.toml"]);
     let ids = catalog_ids(&s).await;
-    assert_eq!(ids, ["gravel", "grass", "brick", "corkboard", "mine", "race"]);
+    assert_eq!(ids, ["gravel", "grass", "brick", "corkboard", "flagstones", "mine", "race"]);
     drop(s);
 
     // A restart serves the uploads that were kept, with the same bytes.
     let s = admin_server(data.path(), &[]);
-    assert_eq!(catalog_ids(&s).await, ["gravel", "grass", "brick", "corkboard", "mine", "race"]);
+    assert_eq!(catalog_ids(&s).await, ["gravel", "grass", "brick", "corkboard", "flagstones", "mine", "race"]);
     let (status, again) = s.get_bytes("/tiles/mine/7/1/2.png?seed=3").await;
     assert_eq!((status, again), (200, tile));
     assert!(s.log_text().contains("texture 'mine': loaded analysis"), "the analysis was kept, not recomputed");

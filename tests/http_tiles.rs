@@ -77,7 +77,7 @@ async fn catalog_and_metadata_agree() {
     let cat = s.json("/catalog").await;
     let list = cat["textures"].as_array().unwrap();
     let ids: Vec<&str> = list.iter().map(|t| t["id"].as_str().unwrap()).collect();
-    for id in ["gravel", "grass", "brick", "corkboard"] {
+    for id in ["gravel", "grass", "brick", "corkboard", "flagstones"] {
         assert!(ids.contains(&id), "{ids:?}");
     }
     for t in list {
@@ -392,7 +392,7 @@ async fn a_users_texture_beside_the_built_ins() {
         .iter()
         .map(|t| t["id"].as_str().unwrap().to_string())
         .collect();
-    assert_eq!(ids, ["gravel", "grass", "brick", "corkboard", "mine"]);
+    assert_eq!(ids, ["gravel", "grass", "brick", "corkboard", "flagstones", "mine"]);
     let meta = s.json("/textures/mine").await;
     assert_eq!(meta["name"], "mine", "name defaults to the id");
     let e = &meta["exemplar"];

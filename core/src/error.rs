@@ -112,6 +112,14 @@ pub enum CoreError {
         /// The level's budget.
         budget: u64,
     },
+    /// A material map is unusable, or not one the texture or the mode has.
+    #[error("map '{name}' {message}")]
+    Map {
+        /// The map's name as given.
+        name: String,
+        /// What is wrong with it.
+        message: String,
+    },
     /// The work was abandoned: its requester went away, or the service is stopping.
     #[error("cancelled: the requester went away or the service is stopping")]
     Cancelled,

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
 use crate::lattice::Lattice;
+use crate::maps::{MaterialMap, NormalConvention};
 use crate::mask::RandomnessMask;
 
 /// Smallest exemplar side accepted on input.
@@ -75,6 +76,9 @@ pub struct Exemplar {
     pub randomness_mask: Option<RandomnessMask>,
     /// The lattice of a near-regular exemplar ([`Exemplar::with_lattice`]).
     pub lattice: Option<Lattice>,
+    /// Its co-registered material maps ([`Exemplar::with_map`]); not part of
+    /// [`Exemplar::hash_content`]: each map's tiles are keyed by the map's own hash.
+    pub maps: Vec<MaterialMap>,
 }
 
 impl Exemplar {
@@ -129,6 +133,7 @@ impl Exemplar {
             hires: None,
             randomness_mask: None,
             lattice: None,
+            maps: Vec::new(),
         }
     }
 
@@ -203,6 +208,7 @@ impl Exemplar {
             hires: Some(hires.pixels),
             randomness_mask: None,
             lattice: None,
+            maps: Vec::new(),
         })
     }
 
@@ -232,6 +238,45 @@ impl Exemplar {
             .collect();
         self.randomness_mask = Some(RandomnessMask::new(self.side, luma, self.toroidal)?);
         Ok(self)
+    }
+
+    /// This exemplar with material map `name` ([`MaterialMap::new`]): `image` is the map
+    /// prepared like the exemplar's own image (same input size, hence the same crop and
+    /// resampling; for an exemplar reduced from a high-resolution image, that image's size). A
+    /// map of the same name is replaced.
+    pub fn with_map(mut self, name: &str, image: &Exemplar, convention: Option<NormalConvention>) -> Result<Exemplar> {
+        let (p, q) = (&self.preparation, &image.preparation);
+        if (p.input_width, p.input_height) != (q.input_width, q.input_height) {
+            return Err(CoreError::Map {
+                name: name.to_string(),
+                message: format!(
+                    "is {}x{}; it must be the size of the exemplar image, {}x{}",
+                    q.input_width, q.input_height, p.input_width, p.input_height
+                ),
+            });
+        }
+        let (texels, hires) = match &self.hires {
+            Some(_) => {
+                let big = image.side as usize;
+                (area_resample(&image.pixels, big, big / 2), Some(image.pixels.clone()))
+            }
+            None => (image.pixels.clone(), None),
+        };
+        if texels.len() != self.pixels.len() {
+            return Err(CoreError::Map {
+                name: name.to_string(),
+                message: format!("prepares to {} texels, the exemplar to {}", texels.len(), self.pixels.len()),
+            });
+        }
+        let map = MaterialMap::new(name, texels, hires, convention)?;
+        self.maps.retain(|m| m.name != name);
+        self.maps.push(map);
+        Ok(self)
+    }
+
+    /// The material map called `name`.
+    pub fn map(&self, name: &str) -> Option<&MaterialMap> {
+        self.maps.iter().find(|m| m.name == name)
     }
 
     /// This exemplar as a near-regular one (design note §1.9): a rectified exemplar that a

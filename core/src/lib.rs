@@ -50,6 +50,7 @@ pub mod geom;
 pub mod hash;
 pub mod image;
 pub mod lattice;
+pub mod maps;
 pub mod mask;
 pub mod memo;
 pub mod modes;

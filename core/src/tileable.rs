@@ -297,5 +297,6 @@ pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
         hires: None,
         randomness_mask: None,
         lattice: None,
+        maps: Vec::new(),
     })
 }

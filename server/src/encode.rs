@@ -109,6 +109,25 @@ fn png(rgb: &[u8], w: u32, h: u32, effort: Effort) -> Result<Vec<u8>, ImageError
     Ok(out.into_inner())
 }
 
+/// `map=uv` as a 16-bit RGB PNG: R = u, G = v in `1/UV_SCALE` exemplar texel, B = 0 (the
+/// encoder takes native-endian samples and writes them big-endian, as PNG stores them).
+pub fn png_uv(uv: &textile_core::maps::UvWindow) -> Result<Vec<u8>, ImageError> {
+    let mut bytes = Vec::with_capacity(6 * uv.uv.len());
+    for [u, v] in &uv.uv {
+        bytes.extend_from_slice(&u.to_ne_bytes());
+        bytes.extend_from_slice(&v.to_ne_bytes());
+        bytes.extend_from_slice(&[0, 0]);
+    }
+    let mut out = Cursor::new(Vec::new());
+    PngEncoder::new_with_quality(&mut out, CompressionType::Level(1), FilterType::Paeth).write_image(
+        &bytes,
+        uv.width,
+        uv.height,
+        ExtendedColorType::Rgb16,
+    )?;
+    Ok(out.into_inner())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

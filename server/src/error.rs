@@ -98,6 +98,7 @@ impl From<CoreError> for ApiError {
             CoreError::Param { .. } | CoreError::ParamKey { .. } => Self::bad_request("invalid_parameter", msg),
             CoreError::UnknownParam { .. } => Self::bad_request("unknown_parameter", msg),
             CoreError::Window { .. } => Self::bad_request("invalid_window", msg),
+            CoreError::Map { .. } => Self::bad_request("invalid_map", msg),
             CoreError::Sample { .. } => Self::bad_request("invalid_sample", msg),
             CoreError::Cancelled => Self::new(Kind::Unavailable, "cancelled", msg),
             CoreError::ExemplarUndecodable(_) => Self::new(Kind::Unprocessable, "undecodable_image", msg),

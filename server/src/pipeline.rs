@@ -8,8 +8,9 @@
 use std::sync::Arc;
 
 use axum::body::Bytes;
+use textile_core::maps::MapChoice;
 use textile_core::modes::{Cost, Needs};
-use textile_core::{Cancel, ModeParams, Pyramid, Rect, Rendered, RgbWindow, View, TILE_SIZE};
+use textile_core::{Cancel, ModeParams, Pyramid, Rect, Rendered, RgbWindow, Source, View, TILE_SIZE};
 
 use crate::encode::{encode, Effort, Format, ENCODER_VERSION};
 use crate::error::ApiError;
@@ -53,7 +54,7 @@ pub enum Target {
     Window(WindowSpec),
 }
 
-/// An image to produce: texture, mode with parameters, and target.
+/// An image to produce: texture, mode with parameters, target, and which map.
 #[derive(Clone)]
 pub struct ImageJob {
     /// The texture.
@@ -62,6 +63,8 @@ pub struct ImageJob {
     pub params: ModeParams,
     /// What part.
     pub target: Target,
+    /// The colour, a material map or the coordinates.
+    pub map: MapChoice,
 }
 
 impl ImageJob {
@@ -73,16 +76,40 @@ impl ImageJob {
         }
     }
 
-    /// The cache key.
+    /// The cache key: a map's tiles are keyed by that map's hash (and the colour's keys stay
+    /// as they were), so changing one map changes only its own tiles.
     pub fn key(&self) -> String {
         let f = self.format().ext();
+        let map = match &self.map {
+            MapChoice::Albedo => String::new(),
+            MapChoice::Uv => "|map=uv".into(),
+            MapChoice::Map(n) => {
+                format!("|map={n}:{}", self.tex.exemplar.map(n).map_or("missing", |m| m.hash.as_str()))
+            }
+        };
         match self.target {
             Target::Tile(t) => {
-                cache_key(&self.tex, &self.params, format_args!("tile|{}|{}|{}|{}|{f}", t.z, t.x, t.y, t.scale))
+                cache_key(&self.tex, &self.params, format_args!("tile|{}|{}|{}|{}|{f}{map}", t.z, t.x, t.y, t.scale))
             }
-            Target::Window(w) => {
-                cache_key(&self.tex, &self.params, format_args!("window|{}|{}|{}|{}|{}|{f}", w.z, w.x, w.y, w.w, w.h))
+            Target::Window(w) => cache_key(
+                &self.tex,
+                &self.params,
+                format_args!("window|{}|{}|{}|{}|{}|{f}{map}", w.z, w.x, w.y, w.w, w.h),
+            ),
+        }
+    }
+
+    /// What the mode renders from: the texture, showing the job's map.
+    fn source(&self) -> Result<Source<'_>, ApiError> {
+        let src = self.tex.source();
+        match &self.map {
+            MapChoice::Map(n) => {
+                let map = self.tex.exemplar.map(n).ok_or_else(|| {
+                    ApiError::bad_request("invalid_map", format!("texture '{}' has no map '{n}'", self.tex.config.id))
+                })?;
+                Ok(src.with_map(map))
             }
+            _ => Ok(src),
         }
     }
 
@@ -139,10 +166,11 @@ impl ImageJob {
     /// [`ImageJob::render`], abandoned between pieces once `cancel` is set.
     fn render_until(&self, cache: &Pyramid, cancel: &Cancel) -> Result<Rendered, ApiError> {
         let (view, upscale) = self.view();
+        let src = self.source()?;
         let mut r = if view.rect.area() > PIECE * PIECE {
-            render_pieces(&self.params, &self.tex, cache, view, cancel)?
+            render_pieces(&self.params, &src, cache, view, cancel)?
         } else {
-            self.params.render(&self.tex.source(), cache, view)?
+            self.params.render(&src, cache, view)?
         };
         if upscale {
             r.image = upscale2(&r.image);
@@ -167,8 +195,39 @@ impl ImageJob {
 
     /// [`ImageJob::bytes`], abandoned between the pieces of a big view once `cancel` is set.
     pub fn bytes_until(&self, cache: &Pyramid, cancel: &Cancel) -> Result<(Vec<u8>, Rendered), ApiError> {
+        if self.map == MapChoice::Uv {
+            return self.uv_bytes(cache);
+        }
         let r = self.render_until(cache, cancel)?;
         Ok((self.encode(&r.image)?, r))
+    }
+
+    /// `map=uv`: the coordinates as a 16-bit PNG (the figures count its pixels, none rendered).
+    fn uv_bytes(&self, cache: &Pyramid) -> Result<(Vec<u8>, Rendered), ApiError> {
+        let (view, upscale) = self.view();
+        if view.rect.area() > PIECE * PIECE {
+            return Err(ApiError::bad_request(
+                "invalid_window",
+                format!("map 'uv': windows of at most {PIECE}x{PIECE} pixels at a time"),
+            ));
+        }
+        let mut uv = self.params.coordinates(&self.tex.source(), cache, view)?;
+        if upscale {
+            let w = uv.width as usize;
+            uv.uv = uv
+                .uv
+                .chunks(w)
+                .flat_map(|row| {
+                    let doubled: Vec<[u16; 2]> = row.iter().flat_map(|&c| [c, c]).collect();
+                    [doubled.clone(), doubled]
+                })
+                .flatten()
+                .collect();
+            (uv.width, uv.height) = (2 * uv.width, 2 * uv.height);
+        }
+        let bytes = crate::encode::png_uv(&uv).map_err(|e| ApiError::internal(format!("encoding: {e}")))?;
+        let image = RgbWindow { width: uv.width, height: uv.height, pixels: Vec::new() };
+        Ok((bytes, Rendered { image, synthesized: 0 }))
     }
 }
 
@@ -213,7 +272,7 @@ pub const PIECE: i64 = 1024;
 /// Render `view` as pieces of at most `PIECE × PIECE` pixels, row by row, into one image.
 fn render_pieces(
     params: &ModeParams,
-    tex: &Texture,
+    src: &Source,
     cache: &Pyramid,
     view: View,
     cancel: &Cancel,
@@ -228,7 +287,7 @@ fn render_pieces(
             }
             let (pw, ph) = ((w - px).min(PIECE as usize), (h - py).min(PIECE as usize));
             let rect = Rect::new(view.rect.x0 + px as i64, view.rect.y0 + py as i64, pw as i64, ph as i64);
-            let r = params.render(&tex.source(), cache, View { rect, ..view })?;
+            let r = params.render(src, cache, View { rect, ..view })?;
             synthesized += r.synthesized;
             for j in 0..ph {
                 let dst = 3 * ((py + j) * w + px);
@@ -267,7 +326,7 @@ mod tests {
         let target = Target::Tile(TileSpec { z: 7, x: 1, y: -2, scale: 1, format: Format::Png });
         let key = |tex: &Arc<Texture>, mode: &str| {
             let params = tex.defaults.request(&tex.source(), ParamReader::request([("mode", mode)]).unwrap()).unwrap();
-            ImageJob { tex: tex.clone(), params, target }.key()
+            ImageJob { tex: tex.clone(), params, target, map: MapChoice::Albedo }.key()
         };
         let a = Arc::new(tex);
         // The same texture with another analysis file (e.g. a new analysis version).

@@ -6,6 +6,7 @@
 //! mode's own keys, and whatever is left is refused, naming the mode it belongs to.
 
 use textile_core::error::clip;
+use textile_core::maps::MapChoice;
 use textile_core::modes::Needs;
 use textile_core::{ModeParams, ParamReader};
 
@@ -59,6 +60,31 @@ pub fn params(tex: &Texture, mut r: ParamReader) -> Result<ModeParams, ApiError>
         return Err(textile_core::CoreError::NotAnalysed { mode }.into());
     }
     Ok(p)
+}
+
+/// Read `map=` (default `albedo`): the colour, one of the texture's maps, or `uv` (PNG only).
+pub fn map_choice(tex: &Texture, r: &mut ParamReader, format: Format) -> Result<MapChoice, ApiError> {
+    let Some(name) = r.take("map") else { return Ok(MapChoice::Albedo) };
+    let choice = match name.as_str() {
+        "albedo" => MapChoice::Albedo,
+        "uv" => MapChoice::Uv,
+        n if tex.exemplar.map(n).is_some() => MapChoice::Map(n.to_string()),
+        n => {
+            let have: Vec<&str> =
+                ["albedo"].into_iter().chain(tex.exemplar.maps.iter().map(|m| m.name.as_str())).chain(["uv"]).collect();
+            return Err(ApiError::bad_request(
+                "invalid_map",
+                format!("map '{}': texture '{}' has no such map; it has: {}", clip(n), tex.config.id, have.join(", ")),
+            ));
+        }
+    };
+    if choice == MapChoice::Uv && format != Format::Png {
+        return Err(ApiError::bad_request(
+            "invalid_map",
+            "map 'uv': coordinates are served as 16-bit PNG only (use .png)".to_string(),
+        ));
+    }
+    Ok(choice)
 }
 
 /// A tile address.

@@ -271,6 +271,7 @@ impl Analysis {
             hires: None,
             randomness_mask: None,
             lattice: h.lattice,
+            maps: Vec::new(),
         }
     }
 

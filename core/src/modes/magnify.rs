@@ -13,6 +13,7 @@
 use crate::error::{CoreError, Result};
 use crate::geom::Rect;
 use crate::image::RgbWindow;
+use crate::maps::{UvWindow, UV_SCALE};
 
 /// Most magnification steps: zooms up to `native + MAX_ZOOM_IN` (the server serves one step
 /// fewer, so that its `@2x` tiles at the highest zoom stay within it).
@@ -120,6 +121,30 @@ pub fn patches(coords: &[u32], m: u32, detail: Detail, k: u32, rect: Rect) -> Rg
         }
     }
     RgbWindow { width: rect.width() as u32, height: rect.height() as u32, pixels }
+}
+
+/// The exemplar point each pixel of `rect` (zoom `native + k`) shows, for `map=uv`: the
+/// pixel's centre in the patch of the texel it lies in (`coords` as for [`patches`]), in
+/// `1/UV_SCALE` texel. Where neighbouring patches disagree [`patches`] blends them; this
+/// names the one the pixel belongs to.
+pub fn patch_points(coords: &[u32], m: u32, _toroidal: bool, k: u32, rect: Rect) -> UvWindow {
+    let src = source_rect(rect, k);
+    let sw = src.width() as usize;
+    let unit = (UV_SCALE >> 1 >> k) as i64;
+    let mut uv = Vec::with_capacity(rect.area() as usize);
+    for y in rect.y0..rect.y1 {
+        let qy = y >> k;
+        let fy = 2 * y + 1 - ((2 * qy) << k);
+        for x in rect.x0..rect.x1 {
+            let qx = x >> k;
+            let fx = 2 * x + 1 - ((2 * qx) << k);
+            let v = coords[(qy - src.y0) as usize * sw + (qx - src.x0) as usize];
+            let (sx, sy) = ((v & 0xFFFF) as i64, (v >> 16) as i64);
+            let at = |s: i64, f: i64| (s * UV_SCALE as i64 + f * unit).clamp(0, (m * UV_SCALE) as i64 - 1) as u16;
+            uv.push([at(sx, fx), at(sy, fy)]);
+        }
+    }
+    UvWindow { width: rect.width() as u32, height: rect.height() as u32, uv }
 }
 
 /// Magnify `rect` bilinearly from `native`, the native-zoom pixels of

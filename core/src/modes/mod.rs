@@ -22,6 +22,7 @@ use crate::error::{CoreError, Result};
 use crate::exemplar::Exemplar;
 use crate::geom::Rect;
 use crate::image::{Rendered, RgbWindow};
+use crate::maps::{MaterialMap, UvWindow};
 use crate::prepare::{Prepared, Step};
 use params::{Common, ParamReader, ParamSpec};
 
@@ -54,6 +55,8 @@ pub struct Source<'a> {
     /// The modes' prepared states, when the caller keeps them (a mode whose state is missing
     /// prepares it for the request).
     pub prepared: Option<&'a Prepared>,
+    /// The material map to show instead of the colour ([`Source::with_map`]).
+    pub map: Option<&'a MaterialMap>,
 }
 
 impl std::fmt::Debug for Source<'_> {
@@ -62,6 +65,7 @@ impl std::fmt::Debug for Source<'_> {
             .field("side", &self.exemplar.side)
             .field("analysis", &self.analysis.map(|a| &a.header.id))
             .field("prepared", &self.prepared.map(|p| p.all().into_iter().map(|(m, _)| m).collect::<Vec<_>>()))
+            .field("map", &self.map.map(|m| &m.name))
             .finish()
     }
 }
@@ -69,17 +73,36 @@ impl std::fmt::Debug for Source<'_> {
 impl<'a> Source<'a> {
     /// A source with both exemplar and analysis.
     pub fn new(exemplar: &'a Exemplar, analysis: &'a Analysis) -> Self {
-        Source { exemplar, analysis: Some(analysis), prepared: None }
+        Source { exemplar, analysis: Some(analysis), prepared: None, map: None }
     }
 
     /// A source with the exemplar only.
     pub fn exemplar(exemplar: &'a Exemplar) -> Self {
-        Source { exemplar, analysis: None, prepared: None }
+        Source { exemplar, analysis: None, prepared: None, map: None }
     }
 
     /// This source with the modes' prepared states.
     pub fn with_prepared(self, prepared: &'a Prepared) -> Self {
         Source { prepared: Some(prepared), ..self }
+    }
+
+    /// This source showing material `map` instead of the colour: modes look it up where they
+    /// would look the colour up, so every map of a view agrees texel for texel.
+    pub fn with_map(self, map: &'a MaterialMap) -> Self {
+        Source { map: Some(map), ..self }
+    }
+
+    /// The texels a render shows at exemplar coordinates: the map's, or the exemplar's colours.
+    pub fn texels(&self) -> &'a [[u8; 3]] {
+        self.map.map_or(&self.exemplar.pixels, |m| &m.texels)
+    }
+
+    /// The high-resolution texels magnified views sample, when the texture has them.
+    pub fn hires(&self) -> Option<&'a [[u8; 3]]> {
+        match self.map {
+            Some(m) => m.hires.as_deref(),
+            None => self.exemplar.hires.as_deref(),
+        }
     }
 
     /// Exemplar side `m`.
@@ -178,6 +201,25 @@ pub trait Mode {
         None
     }
 
+    /// Whether the mode renders material maps ([`Source::map`]): modes that only look texels up
+    /// by coordinate do; a mode that cannot yet says so with `false`.
+    const RENDERS_MAPS: bool = true;
+    /// Whether the mode's pixels are exemplar texels looked up by coordinate, which
+    /// [`Mode::coordinates`] then gives (`map=uv`).
+    const HAS_UV: bool = false;
+
+    /// The exemplar coordinates each pixel of `view` shows (`map=uv`), for modes whose pixels
+    /// are exemplar texels looked up by coordinate; others answer [`CoreError::Map`] saying why.
+    fn coordinates(_p: &Self::Params, _src: &Source, _cache: &Pyramid, _view: View) -> Result<UvWindow> {
+        Err(CoreError::Map {
+            name: "uv".into(),
+            message: format!(
+                "is not available in mode={}: its pixels are not texels looked up by coordinate",
+                Self::NAME
+            ),
+        })
+    }
+
     /// Render a view that is not magnified (`view.zoom_in = 0`); `cache` is the shared
     /// pyramidal cache (modes that keep nothing ignore it).
     fn render(p: &Self::Params, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered>;
@@ -208,6 +250,10 @@ pub struct ModeInfo {
     pub specs: &'static [ParamSpec],
     /// What it prepares per texture, if anything.
     pub preparation: Option<&'static dyn Step>,
+    /// Whether it renders material maps ([`Mode::RENDERS_MAPS`]).
+    pub renders_maps: bool,
+    /// Whether it gives its coordinates ([`Mode::HAS_UV`]).
+    pub has_uv: bool,
 }
 
 impl std::fmt::Debug for ModeInfo {
@@ -230,6 +276,8 @@ impl ModeInfo {
             cost: M::COST,
             specs,
             preparation: M::preparation(),
+            renders_maps: M::RENDERS_MAPS,
+            has_uv: M::HAS_UV,
         }
     }
 
@@ -317,8 +365,35 @@ macro_rules! modes {
                 }
             }
 
-            /// Render a view, magnified or not.
+            /// The exemplar coordinates each pixel of a view shows (see [`Mode::coordinates`]).
+            pub fn coordinates(&self, src: &Source, cache: &Pyramid, view: View) -> Result<UvWindow> {
+                if view.zoom_in > 0 {
+                    magnify::check_steps(view.zoom_in)?;
+                }
+                match self {
+                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::coordinates(p, src, cache, view),)+
+                }
+            }
+
+            /// Render a view, magnified or not, of the colour or of `src`'s map (a normal map's
+            /// blended normals renormalised).
             pub fn render(&self, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
+                let Some(map) = src.map else { return self.render_texels(src, cache, view) };
+                if !self.info().renders_maps {
+                    return Err(CoreError::Map {
+                        name: map.name.clone(),
+                        message: format!("cannot be rendered in mode={} yet; modes that render maps: {}",
+                            self.name(), all_rendering_maps().join(", ")),
+                    });
+                }
+                let mut r = self.render_texels(src, cache, view)?;
+                if map.normal {
+                    crate::maps::renormalise(&mut r.image.pixels);
+                }
+                Ok(r)
+            }
+
+            fn render_texels(&self, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
                 if view.zoom_in > 0 {
                     magnify::check_steps(view.zoom_in)?;
                     return match self {
@@ -345,6 +420,11 @@ impl ModeParams {
     pub fn name(&self) -> &'static str {
         self.info().name
     }
+}
+
+/// Names of the modes that render material maps.
+fn all_rendering_maps() -> Vec<&'static str> {
+    all().into_iter().filter(|m| m.renders_maps).map(|m| m.name).collect()
 }
 
 /// Every mode's parameters, for naming the mode a stray key belongs to.

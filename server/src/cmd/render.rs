@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use base64::Engine;
 use textile_core::files::write_atomic;
+use textile_core::maps::MapChoice;
 use textile_core::modes::params::{Scope, COMMON};
 use textile_core::samples::{self, camera::GroundCamera, Footprint};
 use textile_core::{Analysis, Cancel, ExemplarOptions, ModeParams, ParamReader, Pyramid};
@@ -136,7 +137,7 @@ pub fn run(a: RenderArgs) -> CliResult {
         }
         Target::Tile(TileSpec { z, x, y, scale: 1, format })
     };
-    let (bytes, r) = ImageJob { tex, params, target }.bytes(&Pyramid::off())?;
+    let (bytes, r) = ImageJob { tex, params, target, map: MapChoice::Albedo }.bytes(&Pyramid::off())?;
     write_atomic(&output, &bytes)?;
     println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
     Ok(())

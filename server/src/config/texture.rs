@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use textile_core::analysis::IndexChoice;
 use textile_core::error::clip;
+use textile_core::maps::NormalConvention;
 use textile_core::MODE_NAMES;
 
 /// Tri-state toroidal setting of a texture.
@@ -80,6 +81,11 @@ pub struct TextureConfig {
     /// Attribution shown in TileJSON.
     #[serde(default)]
     pub attribution: String,
+    /// Co-registered material maps (`[textures.maps]`): map name → image (path or
+    /// `embedded:NAME`, the size of the exemplar image), plus `normal_convention = "opengl" |
+    /// "directx"` when there is a `normal` map.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub maps: BTreeMap<String, String>,
     /// Per-mode tables, and any other key (refused by validation, naming it).
     #[serde(flatten)]
     pub modes: BTreeMap<String, toml::Value>,
@@ -108,6 +114,7 @@ impl TextureConfig {
             default_mode: default_mode(),
             default_seed: 0,
             attribution: String::new(),
+            maps: BTreeMap::new(),
             modes: BTreeMap::new(),
             uploaded: false,
         }
@@ -144,6 +151,7 @@ impl TextureConfig {
             }
             _ => {}
         }
+        self.validate_maps(at)?;
         if !MODE_NAMES.contains(&self.default_mode.as_str()) {
             return bad(
                 format!("{at}.default_mode"),
@@ -184,6 +192,54 @@ impl TextureConfig {
         Ok(())
     }
 
+    /// Check `[textures.maps]`: valid names, an image for each, and the normal convention with
+    /// (and only with) a normal map.
+    fn validate_maps(&self, at: &str) -> Result<(), (String, String)> {
+        let at = format!("{at}.maps");
+        if !self.maps.is_empty() && self.toroidal == Toroidal::Synthesize {
+            return Err((
+                at.clone(),
+                "toroidal = \"synthesize\" remakes the exemplar, which its maps could no longer follow".into(),
+            ));
+        }
+        for (name, value) in &self.maps {
+            if name == NORMAL_CONVENTION {
+                continue;
+            }
+            if let Err(e) = textile_core::maps::check_name(name) {
+                return Err((format!("{at}.{}", clip(name)), e.to_string()));
+            }
+            if value.trim().is_empty() {
+                return Err((format!("{at}.{name}"), "must name an image (a path or embedded:NAME)".into()));
+            }
+        }
+        match (self.maps.contains_key("normal"), self.maps.get(NORMAL_CONVENTION)) {
+            (true, None) => Err((
+                format!("{at}.{NORMAL_CONVENTION}"),
+                "is required with a normal map: \"opengl\" (+Y up, glTF's) or \"directx\" (+Y down)".into(),
+            )),
+            (false, Some(_)) => Err((format!("{at}.{NORMAL_CONVENTION}"), "is given without a normal map".into())),
+            (_, Some(c)) if self.normal_convention().is_none() => {
+                Err((format!("{at}.{NORMAL_CONVENTION}"), format!("'{}' is not \"opengl\" or \"directx\"", clip(c))))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The material maps, `(name, image)`, in name order.
+    pub fn map_images(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.maps.iter().filter(|(k, _)| *k != NORMAL_CONVENTION).map(|(k, v)| (k.as_str(), v.as_str()))
+    }
+
+    /// The normal map's convention, when given and valid.
+    pub fn normal_convention(&self) -> Option<NormalConvention> {
+        match self.maps.get(NORMAL_CONVENTION)?.as_str() {
+            "opengl" => Some(NormalConvention::OpenGl),
+            "directx" => Some(NormalConvention::DirectX),
+            _ => None,
+        }
+    }
+
     /// The per-mode tables as `key = value` text pairs (lists joined with commas).
     pub fn mode_tables(&self) -> BTreeMap<String, Vec<(String, String)>> {
         self.modes
@@ -194,6 +250,9 @@ impl TextureConfig {
             .collect()
     }
 }
+
+/// The key of `[textures.maps]` that says how its normal map encodes +Y.
+pub const NORMAL_CONVENTION: &str = "normal_convention";
 
 /// A configuration value as the text a query string would carry.
 pub(crate) fn text(v: &toml::Value) -> String {

@@ -22,6 +22,7 @@ use std::sync::Arc;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde_json::json;
+use textile_core::maps::MapChoice;
 use textile_core::{ModeParams, ParamReader, Pyramid};
 
 use crate::encode::Format;
@@ -291,7 +292,12 @@ fn write(plan: &Plan, output: &Path, tmp: &Path) -> Result<u64, String> {
         let bytes: Vec<Result<Vec<u8>, String>> = part
             .par_iter()
             .map(|e| {
-                let job = ImageJob { tex: plan.tex.clone(), params: plan.params.clone(), target: Target::Tile(e.tile) };
+                let job = ImageJob {
+                    tex: plan.tex.clone(),
+                    params: plan.params.clone(),
+                    target: Target::Tile(e.tile),
+                    map: MapChoice::Albedo,
+                };
                 job.bytes(&pyramid).map(|(b, _)| b).map_err(|err| err.message)
             })
             .collect();

@@ -14,7 +14,7 @@ use crate::error::ApiError;
 use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{path_error, texture};
 use crate::pipeline::{produce, ImageJob, Target};
-use crate::request::{params, parse_tile, parse_window, query_reader, split_format};
+use crate::request::{map_choice, params, parse_tile, parse_window, query_reader, split_format};
 use crate::state::AppState;
 
 /// Answer an image job: 304 when the client holds it, else its bytes with the image headers.
@@ -36,6 +36,7 @@ async fn answer(st: &Arc<AppState>, headers: &HeaderMap, job: ImageJob) -> Resul
            ("x" = i64, Path, description = "column, -2^31..2^31-1"),
            ("y" = i64, Path, description = "row, -2^31..2^31-1; append @2x for 512 px tiles"),
            ("fmt" = String, Path, description = "png, jpg, jpeg or webp"),
+           ("map" = Option<String>, Query, description = "albedo (default), one of the texture's material maps, or uv (16-bit PNG coordinates)"),
            ("v" = Option<String>, Query, description = "cache-busting version (content unchanged)")),
     responses((status = 200, description = "the tile image"), (status = 304, description = "not modified"),
               (status = 400, description = "bad coordinates or parameters"), (status = 404, description = "unknown texture"),
@@ -50,8 +51,10 @@ pub async fn tile(
     let Path((id, z, x, y)) = path.map_err(path_error)?;
     let tex = texture(&reg, &id)?;
     let spec = parse_tile(&tex, &z, &x, &y)?;
-    let params = params(&tex, query_reader(q.as_deref())?)?;
-    answer(&st, &headers, ImageJob { tex, params, target: Target::Tile(spec) }).await
+    let mut r = query_reader(q.as_deref())?;
+    let map = map_choice(&tex, &mut r, spec.format)?;
+    let params = params(&tex, r)?;
+    answer(&st, &headers, ImageJob { tex, params, target: Target::Tile(spec), map }).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -60,6 +63,7 @@ pub async fn tile(
            ("x" = i64, Query, description = "left pixel at zoom z"), ("y" = i64, Query, description = "top pixel at zoom z"),
            ("w" = u32, Query, description = "width, 1..=4096"), ("h" = u32, Query, description = "height, 1..=4096"),
            ("z" = Option<u32>, Query, description = "zoom (default: native)"),
+           ("map" = Option<String>, Query, description = "albedo (default), one of the texture's material maps, or uv"),
            ("v" = Option<String>, Query, description = "cache-busting version")),
     responses((status = 200, description = "the window image"), (status = 400, description = "bad parameters"),
               (status = 404, description = "unknown texture")))]
@@ -75,6 +79,7 @@ pub async fn window(
     let tex = texture(&reg, id)?;
     let mut r = query_reader(q.as_deref())?;
     let spec = parse_window(&tex, &mut r, fmt)?;
+    let map = map_choice(&tex, &mut r, fmt)?;
     let params = params(&tex, r)?;
-    answer(&st, &headers, ImageJob { tex, params, target: Target::Window(spec) }).await
+    answer(&st, &headers, ImageJob { tex, params, target: Target::Window(spec), map }).await
 }

@@ -9,10 +9,12 @@ use axum::http::{header, HeaderMap, HeaderValue, Uri};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use serde_json::{json, Map, Value};
+use textile_core::error::clip;
 use textile_core::modes::params::{Scope, COMMON, MODE, SEED, WORLD};
 use textile_core::modes::{Cost, Needs};
 use textile_core::{MODE_NAMES, TILE_SIZE};
 
+use crate::encode::{Effort, Format};
 use crate::error::{ApiError, Kind};
 use crate::http::extract::{base_url, path_error, texture, Peer};
 use crate::pipeline::engine_version;
@@ -141,6 +143,7 @@ pub async fn texture_meta(
             "lattice": ex.lattice.map(|l| [l.nx, l.ny]),
         },
         "analysis": analysis,
+        "maps": maps(&t),
         "prepared": prepared(&t),
         "modes": MODE_NAMES,
         "default_mode": t.defaults.mode,
@@ -240,6 +243,41 @@ pub async fn exemplar(
     let Path(id) = path.map_err(path_error)?;
     let t = texture(&reg, &id)?;
     let mut r = t.exemplar_png.clone().into_response();
+    r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
+    r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("public, max-age=3600"));
+    Ok(r)
+}
+
+/// A prepared material map of a texture, as `map=` tiles look it up (`albedo`: the exemplar;
+/// normals in glTF's OpenGL convention, unit length): what a client of `map=uv` needs.
+#[utoipa::path(get, path = "/textures/{id}/maps/{name}.png", tag = "textures",
+    params(("id" = String, Path, description = "texture id"), ("name" = String, Path, description = "map name")),
+    responses((status = 200, description = "PNG"), (status = 400, description = "no such map"),
+              (status = 404, description = "unknown texture")))]
+pub async fn map_image(
+    State(st): State<Arc<AppState>>,
+    path: Result<Path<(String, String)>, PathRejection>,
+) -> Result<Response, ApiError> {
+    let reg = st.ready()?;
+    let Path((id, file)) = path.map_err(path_error)?;
+    let t = texture(&reg, &id)?;
+    let name = file.strip_suffix(".png").unwrap_or(&file);
+    let png = if name == "albedo" {
+        t.exemplar_png.clone()
+    } else {
+        let map = t.exemplar.map(name).ok_or_else(|| {
+            let have: Vec<&str> =
+                std::iter::once("albedo").chain(t.exemplar.maps.iter().map(|m| m.name.as_str())).collect();
+            ApiError::bad_request(
+                "invalid_map",
+                format!("map '{}': texture '{id}' has no such map; it has: {}", clip(name), have.join(", ")),
+            )
+        })?;
+        let side = t.exemplar.side;
+        crate::encode::encode(map.texels.as_flattened(), side, side, Format::Png, Effort::Tight)
+            .map_err(|e| ApiError::internal(format!("encoding: {e}")))?
+    };
+    let mut r = png.into_response();
     r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
     r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("public, max-age=3600"));
     Ok(r)
@@ -369,4 +407,27 @@ pub async fn method_not_allowed(req: axum::extract::Request, next: axum::middlew
         fixed.headers_mut().insert(header::ALLOW, v);
     }
     fixed
+}
+
+/// What `map=` offers for a texture: the colour, each material map (normals in glTF's OpenGL
+/// convention), and the coordinates with the modes that have them.
+fn maps(t: &crate::textures::Texture) -> Value {
+    use textile_core::maps::UV_SCALE;
+    let modes = textile_core::modes::all();
+    let with_maps: Vec<&str> = modes.iter().filter(|m| m.renders_maps).map(|m| m.name).collect();
+    let with_uv: Vec<&str> = modes.iter().filter(|m| m.has_uv).map(|m| m.name).collect();
+    let mut list = vec![json!({ "name": "albedo", "kind": "colour" })];
+    for m in &t.exemplar.maps {
+        let kind = if m.normal { "normal" } else { "scalar" };
+        let mut e = json!({ "name": m.name, "kind": kind, "hash": m.hash, "modes": with_maps });
+        if m.normal {
+            e["convention"] = json!("opengl (+Y up, glTF), unit length");
+        }
+        list.push(e);
+    }
+    list.push(json!({
+        "name": "uv", "kind": "coordinates", "modes": with_uv,
+        "encoding": format!("16-bit PNG: R = u, G = v in 1/{UV_SCALE} exemplar texel (texel x = R / {UV_SCALE}), B = 0"),
+    }));
+    Value::Array(list)
 }

@@ -95,6 +95,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/admin/textures", post(admin::upload).layer(upload_limit))
         .route("/admin/textures/{id}", delete(admin::delete))
         .route("/textures/{id}/exemplar.png", get(meta::exemplar))
+        .route("/textures/{id}/maps/{name}", get(meta::map_image))
         .route("/tiles/{id}/tilejson.json", get(meta::tilejson))
         .route("/tiles/{id}/{z}/{x}/{y}", get(images::tile))
         .route("/windows/{file}", get(images::window))

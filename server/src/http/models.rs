@@ -14,6 +14,7 @@ use base64::Engine;
 
 use std::collections::BTreeMap;
 
+use textile_core::maps::MapChoice;
 use textile_core::{ModeParams, ParamReader, TILE_SIZE};
 
 use crate::assets::{glb, gltf_json, image_side, x3d, Quad, BORDER, LAYOUT};
@@ -110,7 +111,12 @@ impl TileRequest {
             h: side,
             format: Format::Png,
         };
-        ImageJob { tex: self.tex.clone(), params: self.params.clone(), target: Target::Window(window) }
+        ImageJob {
+            tex: self.tex.clone(),
+            params: self.params.clone(),
+            target: Target::Window(window),
+            map: MapChoice::Albedo,
+        }
     }
 }
 

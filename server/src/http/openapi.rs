@@ -21,6 +21,7 @@ use utoipa::{Modify, OpenApi};
         crate::http::meta::catalog,
         crate::http::meta::texture_meta,
         crate::http::meta::exemplar,
+        crate::http::meta::map_image,
         crate::http::meta::tilejson,
         crate::http::images::tile,
         crate::http::images::window,

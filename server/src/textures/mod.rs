@@ -155,6 +155,7 @@ impl Texture {
             exemplar: &self.exemplar,
             analysis: self.analysis().map(|a| a.as_ref()),
             prepared: Some(&self.prepared),
+            map: None,
         }
     }
 
@@ -193,7 +194,7 @@ pub enum LoadError {
         source: std::io::Error,
     },
     /// `embedded:NAME` names no embedded exemplar.
-    #[error("texture '{id}': no embedded exemplar '{name}' (have: gravel.png, grass.png, brick.png, corkboard.png)")]
+    #[error("texture '{id}': no embedded image '{name}' (have: {})", storage::embedded_names().join(", "))]
     NoEmbedded {
         /// Texture id.
         id: String,

@@ -90,6 +90,14 @@ pub fn prepare_texture(
     if let Some(mask) = &mask {
         ex = ex.with_randomness_mask(mask).map_err(core)?;
     }
+    // Each map is prepared like the exemplar's image, so that they stay co-registered.
+    for (name, image) in t.map_images() {
+        let map = Exemplar::from_bytes(&image_bytes(cfg, t, image)?, &opts).map_err(|e| LoadError::Core {
+            id: t.id.clone(),
+            source: textile_core::CoreError::Map { name: name.into(), message: format!("({image}): {e}") },
+        })?;
+        ex = ex.with_map(name, &map, t.normal_convention()).map_err(core)?;
+    }
     let prep = &ex.preparation;
     if prep.input_width != prep.input_height || prep.crop_side != ex.side {
         log(format!(

@@ -13,7 +13,35 @@ const EMBEDDED: &[(&str, &[u8])] = &[
     ("grass.png", include_bytes!("../../../config/exemplars/grass.png")),
     ("brick.png", include_bytes!("../../../config/exemplars/brick.png")),
     ("corkboard.png", include_bytes!("../../../config/exemplars/corkboard.png")),
+    ("materials/flagstones/albedo.png", include_bytes!("../../../config/exemplars/materials/flagstones/albedo.png")),
+    ("materials/flagstones/normal.png", include_bytes!("../../../config/exemplars/materials/flagstones/normal.png")),
+    ("materials/flagstones/height.png", include_bytes!("../../../config/exemplars/materials/flagstones/height.png")),
+    (
+        "materials/flagstones/specular.png",
+        include_bytes!("../../../config/exemplars/materials/flagstones/specular.png"),
+    ),
+    (
+        "materials/forest_floor/albedo.png",
+        include_bytes!("../../../config/exemplars/materials/forest_floor/albedo.png"),
+    ),
+    (
+        "materials/forest_floor/normal.png",
+        include_bytes!("../../../config/exemplars/materials/forest_floor/normal.png"),
+    ),
+    (
+        "materials/forest_floor/height.png",
+        include_bytes!("../../../config/exemplars/materials/forest_floor/height.png"),
+    ),
+    (
+        "materials/forest_floor/specular.png",
+        include_bytes!("../../../config/exemplars/materials/forest_floor/specular.png"),
+    ),
 ];
+
+/// Names of the embedded images, for errors.
+pub fn embedded_names() -> Vec<&'static str> {
+    EMBEDDED.iter().map(|(n, _)| *n).collect()
+}
 
 /// The bytes of an embedded exemplar.
 pub fn embedded(name: &str) -> Option<&'static [u8]> {

@@ -99,7 +99,7 @@ impl Mode for Mosaic {
 
     fn render(p: &MosaicParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
         Ok(Rendered {
-            image: render(src.exemplar, p, view.zoom_out, view.rect)?,
+            image: render_texels(src.exemplar, src.texels(), p, view.zoom_out, view.rect)?,
             synthesized: render_cost(view.zoom_out, view.rect),
         })
     }
@@ -119,13 +119,19 @@ pub fn render_cost(zoom_out: u32, rect: Rect) -> u64 {
 /// [`sampled`]): as cheap at every zoom as at native, and the box filter of the native pixels
 /// but where a pixel spans a block edge.
 pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    render_texels(ex, &ex.pixels, p, zoom_out, rect)
+}
+
+/// [`render`] showing `texels` at the exemplar's coordinates: its colours, or one of its
+/// material maps.
+pub fn render_texels(ex: &Exemplar, texels: &[[u8; 3]], p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
     p.validate(ex.side)?;
     check_window(rect, MAX_PIXELS)?;
     let layout = Layout::new(ex.side as i64, p);
     if zoom_out == 0 {
-        return Ok(native(ex, &layout, rect));
+        return Ok(native(ex, texels, &layout, rect));
     }
-    Ok(sampled(ex, &layout, zoom_out, rect))
+    Ok(sampled(ex, texels, &layout, zoom_out, rect))
 }
 
 /// Rows per band of [`sampled`]'s parallel labelling.
@@ -136,16 +142,16 @@ const SAMPLED_BAND: i64 = 32;
 /// `2^k × 2^k` exemplar texels around that source (toroidally, from an integral image): the
 /// exact box filter of the native pixels wherever they all share the label, all but a block
 /// edge's pixels; the mean colour once a pixel covers the whole exemplar.
-fn sampled(ex: &Exemplar, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
+fn sampled(ex: &Exemplar, texels: &[[u8; 3]], layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let n = layout.n as usize;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let step = 1i64 << k.min(40);
     let levels = ex.side.trailing_zeros();
     if k >= levels {
-        let mean = box_mip(&ex.pixels, n, levels as usize)[0];
+        let mean = box_mip(texels, n, levels as usize)[0];
         return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
     }
-    let sums = Integral::new(&ex.pixels, n, step as usize);
+    let sums = Integral::new(texels, n, step as usize);
     // Bands of rows in parallel (each pixel's label depends on its position alone).
     let pixels: Vec<Vec<u8>> = (rect.y0..rect.y1)
         .step_by(SAMPLED_BAND as usize)

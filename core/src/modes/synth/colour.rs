@@ -7,6 +7,7 @@
 //! is the exemplar's mean colour.
 
 use crate::analysis::Analysis;
+use crate::maps::{UvWindow, MaterialMap, UV_SCALE};
 use crate::image::{Rendered, RgbWindow};
 use crate::error::Result;
 use crate::geom::Rect;
@@ -22,6 +23,18 @@ pub fn render(an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) ->
 
 /// [`render`] through a pyramidal cache (same pixels, shared work).
 pub fn render_with(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) -> Result<Rendered> {
+    render_map(pyr, an, None, params, zoom_out, rect)
+}
+
+/// [`render_with`] showing material `map` (none: the colour) at the same coordinates.
+pub fn render_map(
+    pyr: &Pyramid,
+    an: &Analysis,
+    map: Option<&MaterialMap>,
+    params: &SynthParams,
+    zoom_out: u32,
+    rect: Rect,
+) -> Result<Rendered> {
     let levels = an.levels();
     let mut synthesized = 0;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
@@ -30,9 +43,9 @@ pub fn render_with(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out:
     if zoom_out == 0 {
         let sw = synthesize_with(pyr, an, params, levels, rect)?;
         synthesized = sw.synthesized;
-        let cw = sw.window;
-        for &v in &cw.coords {
-            pixels.extend_from_slice(&an.exemplar[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
+        let texels = map.map_or(&an.exemplar[..], |m| &m.texels);
+        for &v in &sw.window.coords {
+            pixels.extend_from_slice(&texels[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
         }
     } else if zoom_out <= levels {
         // Level `L − k`, one pixel per pixel: coherent upsampling would give each of them the
@@ -41,16 +54,36 @@ pub fn render_with(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out:
         // jitter or correction moved texels).
         let sw = synthesize_with(pyr, an, params, levels - zoom_out, rect)?;
         synthesized = sw.synthesized;
-        let boxes = an.box_colours(zoom_out);
+        let boxes = map.map_or_else(|| an.box_colours(zoom_out), |m| m.box_colours(zoom_out));
         for &v in &sw.window.coords {
             pixels.extend_from_slice(&boxes[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
         }
     } else {
         params.validate(an.side())?;
-        let mean = an.mean_colour();
+        let mean = map.map_or_else(|| an.mean_colour(), MaterialMap::mean);
         for _ in 0..w * h {
             pixels.extend_from_slice(&mean);
         }
     }
     Ok(Rendered { image: RgbWindow { width: w as u32, height: h as u32, pixels }, synthesized })
+}
+
+/// The exemplar point each pixel of `rect` shows, `zoom_out` steps coarser than native (see
+/// [`crate::maps::UV_SCALE`]): a native pixel's texel centre; zoomed out, the centre of the
+/// block whose mean it shows; beyond the pyramid, the exemplar's centre.
+pub fn coordinates(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out: u32, rect: Rect) -> Result<UvWindow> {
+    let levels = an.levels();
+    let (w, h) = (rect.width() as u32, rect.height() as u32);
+    let s = UV_SCALE;
+    let uv = if zoom_out <= levels {
+        let sw = synthesize_with(pyr, an, params, levels - zoom_out, rect)?;
+        // Native: the texel's centre; zoomed out: the centred block's centre, a texel corner.
+        let half = if zoom_out == 0 { s / 2 } else { 0 };
+        sw.window.coords.iter().map(|&v| [(v & 0xFFFF) * s + half, (v >> 16) * s + half].map(|c| c as u16)).collect()
+    } else {
+        params.validate(an.side())?;
+        let c = (an.side() * s / 2) as u16;
+        vec![[c, c]; (w * h) as usize]
+    };
+    Ok(UvWindow { width: w, height: h, uv })
 }

@@ -23,11 +23,12 @@ use crate::cache::Pyramid;
 use crate::error::Result;
 use crate::geom::Rect;
 use crate::image::Rendered;
+use crate::maps::UvWindow;
 use crate::modes::magnify::{self, Detail};
 use crate::modes::params::{Common, Kind, ParamReader, ParamSpec, Scope, ONE_Q16};
 use crate::modes::{Cost, Mode, Needs, Source, View};
 
-pub use colour::{render, render_with};
+pub use colour::{render, render_map, render_with};
 pub use params::{Randomness, SynthParams, MAX_PASSES};
 pub use window::{synthesis_cost, synthesize, synthesize_with, CoordWindow, Synthesized};
 
@@ -77,6 +78,7 @@ impl Mode for Synth {
     const SUMMARY: &'static str = "parallel controllable texture synthesis (Lefebvre & Hoppe 2005)";
     const NEEDS: Needs = Needs::Analysis;
     const COST: Cost = Cost::Heavy;
+    const HAS_UV: bool = true;
     type Params = SynthParams;
 
     fn specs() -> &'static [ParamSpec] {
@@ -126,16 +128,26 @@ impl Mode for Synth {
     }
 
     fn render(p: &SynthParams, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
-        render_with(cache, src.analysis(Self::NAME)?, p, view.zoom_out, view.rect)
+        render_map(cache, src.analysis(Self::NAME)?, src.map, p, view.zoom_out, view.rect)
+    }
+
+    fn coordinates(p: &SynthParams, src: &Source, cache: &Pyramid, view: View) -> Result<UvWindow> {
+        let an = src.analysis(Self::NAME)?;
+        if view.zoom_in == 0 {
+            return colour::coordinates(cache, an, p, view.zoom_out, view.rect);
+        }
+        let (k, rect) = (view.zoom_in, view.rect);
+        let sw = synthesize_with(cache, an, p, an.levels(), magnify::source_rect(rect, k))?;
+        Ok(magnify::patch_points(&sw.window.coords, an.side(), an.header.toroidal, k, rect))
     }
 
     fn magnify(p: &SynthParams, src: &Source, cache: &Pyramid, k: u32, rect: Rect) -> Result<Rendered> {
         let an = src.analysis(Self::NAME)?;
         let sw = synthesize_with(cache, an, p, an.levels(), magnify::source_rect(rect, k))?;
         let toroidal = an.header.toroidal;
-        let detail = match &src.exemplar.hires {
+        let detail = match src.hires() {
             Some(h) => Detail { pixels: h, side: 2 * an.side(), toroidal },
-            None => Detail { pixels: &an.exemplar, side: an.side(), toroidal },
+            None => Detail { pixels: src.map.map_or(&an.exemplar[..], |m| &m.texels), side: an.side(), toroidal },
         };
         let image = magnify::patches(&sw.window.coords, an.side(), detail, k, rect);
         Ok(Rendered { image, synthesized: sw.synthesized })

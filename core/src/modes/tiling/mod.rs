@@ -10,6 +10,7 @@ use serde_json::{json, Map, Value};
 use crate::cache::Pyramid;
 use crate::error::Result;
 use crate::image::{box_mip, Rendered, RgbWindow};
+use crate::maps::{UvWindow, UV_SCALE};
 use crate::modes::params::{check_period, Common, ParamReader, ParamSpec};
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
@@ -34,6 +35,7 @@ impl Mode for Tiling {
     const SUMMARY: &'static str = "the exemplar repeated as it is: the reference that synthesis improves on";
     const NEEDS: Needs = Needs::Exemplar;
     const COST: Cost = Cost::Light;
+    const HAS_UV: bool = true;
     type Params = TilingParams;
 
     fn specs() -> &'static [ParamSpec] {
@@ -64,10 +66,10 @@ impl Mode for Tiling {
     fn render(_: &TilingParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
-        let ex = src.exemplar;
-        let n = ex.side as usize;
+        let texels = src.texels();
+        let n = src.side() as usize;
         let lvl = view.zoom_out.min(src.levels()) as usize;
-        let mip = if lvl == 0 { ex.pixels.clone() } else { box_mip(&ex.pixels, n, lvl) };
+        let mip = if lvl == 0 { texels.to_vec() } else { box_mip(texels, n, lvl) };
         let side = (n >> lvl) as i64;
         let (w, h) = (rect.width() as usize, rect.height() as usize);
         let mut pixels = Vec::with_capacity(3 * w * h);
@@ -79,5 +81,28 @@ impl Mode for Tiling {
         }
         let image = RgbWindow { width: w as u32, height: h as u32, pixels };
         Ok(Rendered { image, synthesized: rect.area() as u64 })
+    }
+
+    /// Native and magnified: the pixel centre's place in the exemplar; zoomed out, the centre
+    /// of the block it averages (the exemplar's centre once it covers the whole exemplar).
+    fn coordinates(_: &TilingParams, src: &Source, _: &Pyramid, view: View) -> Result<UvWindow> {
+        let rect = view.rect;
+        check_window(rect, MAX_PIXELS)?;
+        let period = (src.side() * UV_SCALE) as i64;
+        let lvl = view.zoom_out.min(src.levels());
+        // A pixel's centre along an axis, in 1/UV_SCALE texel, on the exemplar.
+        let at = |x: i64| -> u16 {
+            let c = if view.zoom_in > 0 {
+                ((2 * x + 1) * (UV_SCALE as i64 / 2)) >> view.zoom_in
+            } else if lvl < src.levels() {
+                ((2 * x + 1) * (UV_SCALE as i64 / 2)) << lvl
+            } else {
+                period / 2
+            };
+            c.rem_euclid(period) as u16
+        };
+        let xs: Vec<u16> = (rect.x0..rect.x1).map(at).collect();
+        let uv = (rect.y0..rect.y1).flat_map(|y| xs.iter().map(move |&u| [u, at(y)])).collect();
+        Ok(UvWindow { width: rect.width() as u32, height: rect.height() as u32, uv })
     }
 }

@@ -65,6 +65,8 @@ impl Mode for Umbrella {
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
     const COST: Cost = Cost::Heavy;
+    /// Patches rotate, and tangent-space normals would have to turn with them: not yet.
+    const RENDERS_MAPS: bool = false;
     type Params = UmbrellaParams;
 
     fn specs() -> &'static [ParamSpec] {

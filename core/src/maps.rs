@@ -1,0 +1,246 @@
+//! Material maps (issue 39): images of the same surface as the exemplar, co-registered with it
+//! — a tangent-space normal map, height, specular, roughness, ambient occlusion, metallic or any
+//! named extra map. Modes that synthesize exemplar coordinates look every map up at the same
+//! coordinates (`Source::with_map` in `modes`), so all maps of a tile agree texel for
+//! texel; where a mode blends texels, normals are blended as vectors and renormalised
+//! ([`renormalise`]). Also here: what a request asks for ([`MapChoice`]) and the synthesized
+//! coordinates themselves ([`UvWindow`], `map=uv`).
+//!
+//! Normals are stored and served in glTF's convention: OpenGL, +Y up (green high where the
+//! surface faces the top of the image), `rgb = (n + 1) / 2 · 255`, unit length.
+
+use std::sync::OnceLock;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{CoreError, Result};
+use crate::image::box_stack;
+
+/// The maps every material tool knows by name (any other valid name is an extra map).
+pub const STANDARD: &[&str] = &["normal", "height", "specular", "roughness", "ao", "metallic"];
+/// What `map=` may name besides a texture's maps: the colour, and the coordinates.
+pub const BUILT_IN: &[&str] = &["albedo", "uv"];
+
+/// Fixed point of `map=uv`: coordinates are in `1/UV_SCALE` exemplar texel (so a 512² exemplar
+/// spans 0..32768 of a 16-bit channel, and magnified pixels down to 1/32 texel are exact).
+pub const UV_SCALE: u32 = 64;
+
+/// How a normal map encodes +Y.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NormalConvention {
+    /// +Y up: green high where the surface faces the top of the image (glTF, Blender, Unity).
+    #[serde(rename = "opengl")]
+    OpenGl,
+    /// +Y down: green high where the surface faces the bottom (Direct3D engines, Unreal).
+    #[serde(rename = "directx")]
+    DirectX,
+}
+
+/// One prepared map: texels the size of the exemplar (and of its high-resolution image).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MaterialMap {
+    /// Its name (`normal`, `height`, … or an extra map's).
+    pub name: String,
+    /// Row-major RGB texels, `side × side` like the exemplar's (grey maps in all three).
+    pub texels: Vec<[u8; 3]>,
+    /// Its `2·side` version when the exemplar has one ([`Exemplar::hires`]).
+    pub hires: Option<Vec<[u8; 3]>>,
+    /// Whether it is the normal map (OpenGL convention, unit vectors).
+    pub normal: bool,
+    /// Hash of everything above: part of its tiles' ETags, and of no other map's.
+    pub hash: String,
+    /// Centred box means at every scale, derived on first zoomed-out use.
+    boxes: OnceLock<Vec<Vec<[u8; 3]>>>,
+}
+
+impl MaterialMap {
+    /// Map `name` from its texels, prepared like the exemplar's (and its `2·side`
+    /// version when the exemplar has one): a normal map is converted to the OpenGL convention
+    /// from `convention` (required) and renormalised.
+    pub fn new(
+        name: &str,
+        texels: Vec<[u8; 3]>,
+        hires: Option<Vec<[u8; 3]>>,
+        convention: Option<NormalConvention>,
+    ) -> Result<Self> {
+        check_name(name)?;
+        let normal = name == "normal";
+        let convention = match (normal, convention) {
+            (true, Some(c)) => Some(c),
+            (true, None) => {
+                return Err(CoreError::Map {
+                    name: name.to_string(),
+                    message: "needs normal_convention: \"opengl\" (+Y up, glTF's) or \"directx\" (+Y down)".into(),
+                })
+            }
+            (false, _) => None,
+        };
+        let fix = |px: Vec<[u8; 3]>| match convention {
+            Some(c) => px.into_iter().map(|t| unit(t, c == NormalConvention::DirectX)).collect(),
+            None => px,
+        };
+        let (texels, hires) = (fix(texels), hires.map(fix));
+        let mut h = blake3::Hasher::new();
+        h.update(name.as_bytes());
+        h.update(&[normal as u8]);
+        h.update(texels.as_flattened());
+        if let Some(hi) = &hires {
+            h.update(hi.as_flattened());
+        }
+        let hash = h.finalize().to_hex()[..16].to_string();
+        Ok(MaterialMap { name: name.to_string(), texels, hires, normal, hash, boxes: OnceLock::new() })
+    }
+
+    /// Exemplar side.
+    pub fn side(&self) -> u32 {
+        (self.texels.len() as f64).sqrt() as u32
+    }
+
+    /// The centred `2^k × 2^k` box means of the map, per texel (see [`box_stack`]).
+    pub fn box_colours(&self, k: u32) -> &[[u8; 3]] {
+        let n = self.side() as usize;
+        let stack = self.boxes.get_or_init(|| box_stack(&self.texels, n));
+        &stack[(k as usize).min(stack.len() - 1)]
+    }
+
+    /// The map's mean.
+    pub fn mean(&self) -> [u8; 3] {
+        self.box_colours(u32::MAX)[0]
+    }
+}
+
+/// Check a map name: 1–32 of `a-z 0-9 _`, and not one `map=` gives itself ([`BUILT_IN`]).
+pub fn check_name(name: &str) -> Result<()> {
+    let ok = !name.is_empty()
+        && name.len() <= 32
+        && name.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_');
+    if !ok {
+        return Err(CoreError::Map {
+            name: crate::error::clip(name),
+            message: "a map name must be 1-32 of a-z 0-9 _".into(),
+        });
+    }
+    if BUILT_IN.contains(&name) {
+        return Err(CoreError::Map { name: name.into(), message: "is built in: name the map otherwise".into() });
+    }
+    Ok(())
+}
+
+/// What an image shows: the colour, one of the texture's maps, or the coordinates.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Default)]
+pub enum MapChoice {
+    /// The exemplar's colours (`map=albedo`, the default).
+    #[default]
+    Albedo,
+    /// The map of this name.
+    Map(String),
+    /// The synthesized exemplar coordinates (`map=uv`).
+    Uv,
+}
+
+impl MapChoice {
+    /// As `map=` spells it.
+    pub fn name(&self) -> &str {
+        match self {
+            MapChoice::Albedo => "albedo",
+            MapChoice::Map(m) => m,
+            MapChoice::Uv => "uv",
+        }
+    }
+}
+
+/// The exemplar coordinates a mode shows at each pixel of a window, in `1/UV_SCALE` texel.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UvWindow {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major `[u, v]`.
+    pub uv: Vec<[u16; 2]>,
+}
+
+/// Decode an encoded normal (`c / 127.5 − 1` per channel).
+fn decode(c: [u8; 3]) -> [f64; 3] {
+    c.map(|v| v as f64 / 127.5 - 1.0)
+}
+
+/// Encode a unit vector, rounding each channel.
+fn encode(n: [f64; 3]) -> [u8; 3] {
+    n.map(|v| ((v + 1.0) * 127.5).round().clamp(0.0, 255.0) as u8)
+}
+
+/// The unit normal of encoded `c` (green flipped for a DirectX map); straight up when `c` has
+/// no direction.
+fn unit(c: [u8; 3], flip_g: bool) -> [u8; 3] {
+    let mut n = decode(c);
+    if flip_g {
+        n[1] = -n[1];
+    }
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len < 1e-6 {
+        return [128, 128, 255];
+    }
+    encode(n.map(|v| v / len))
+}
+
+/// How far from unit length an encoded unit vector may be after rounding each channel
+/// (`√3 · 0.5 / 127.5`): normals within it are left exactly as they are.
+const ROUNDING: f64 = 0.0068;
+
+/// Renormalise blended normals in place (RGB bytes): every pixel further from unit length than
+/// rounding leaves a unit vector is made unit length again, so blending two normals gives the
+/// normalised mean vector, and a copied texel stays byte for byte.
+pub fn renormalise(pixels: &mut [u8]) {
+    for px in pixels.chunks_exact_mut(3) {
+        let c = [px[0], px[1], px[2]];
+        let n = decode(c);
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if (len - 1.0).abs() > ROUNDING {
+            px.copy_from_slice(&unit(c, false));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_normals_survive_renormalisation_byte_for_byte_and_are_unit_length() {
+        for r in (0..=255u8).step_by(5) {
+            for g in (0..=255u8).step_by(7) {
+                for b in [0u8, 60, 128, 200, 255] {
+                    let u = unit([r, g, b], false);
+                    let n = decode(u);
+                    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                    assert!((len - 1.0).abs() <= 1.0 / 127.0, "{u:?}: |n| = {len}");
+                    let mut px = u.to_vec();
+                    renormalise(&mut px);
+                    assert_eq!(px, u.to_vec(), "{u:?} changed");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn directx_normals_flip_green_and_blends_renormalise() {
+        assert_eq!(unit([128, 200, 220], true)[1], 255 - unit([128, 200, 220], false)[1]);
+        // The mean of two opposite tilts is straight up.
+        let (a, b) = (unit([228, 128, 200], false), unit([28, 128, 200], false));
+        let mut mean: Vec<u8> = (0..3).map(|i| (a[i] as u16 + b[i] as u16).div_ceil(2) as u8).collect();
+        renormalise(&mut mean);
+        assert_eq!(mean, [128, 128, 255]);
+    }
+
+    #[test]
+    fn map_names_are_checked() {
+        for bad in ["", "Normal", "uv", "albedo", "a-b", &"x".repeat(33)] {
+            assert!(check_name(bad).is_err(), "{bad}");
+        }
+        for good in ["normal", "ao", "detail_2"] {
+            assert!(check_name(good).is_ok(), "{good}");
+        }
+    }
+}
