@@ -5,7 +5,9 @@
 'use strict';
 
 // p: the parameters the user changed, by name, as the query string carries them.
-const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false };
+// a: the map shown (albedo, a material map, or 'lit': colour shaded by the normal map); l: the
+// light's direction in degrees for 'lit'.
+const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false, a: 'albedo', l: 135 };
 let catalog = null, meta = null, map = null, layer = null, grid = null, debounce = null;
 const $ = (id) => document.getElementById(id);
 
@@ -19,6 +21,8 @@ function readHash() {
   if (p.has('x')) state.x = Number(p.get('x'));
   if (p.has('y')) state.y = Number(p.get('y'));
   state.g = p.get('g') === '1';
+  if (p.has('a')) state.a = p.get('a');
+  if (p.has('l') && /^\d+$/.test(p.get('l'))) state.l = Number(p.get('l')) % 360;
 }
 
 function hash() {
@@ -27,6 +31,8 @@ function hash() {
   for (const [k, v] of Object.entries(state.p)) p.set(`p.${k}`, v);
   p.set('z', state.z); p.set('x', Math.round(state.x)); p.set('y', Math.round(state.y));
   if (state.g) p.set('g', '1');
+  if (state.a !== 'albedo') p.set('a', state.a);
+  if (state.a === 'lit') p.set('l', state.l);
   return '#' + p.toString();
 }
 
@@ -42,12 +48,83 @@ function native() { return meta ? meta.native_zoom : 0; }
 function toLatLng(x, y) { const s = 2 ** native(); return L.latLng(-y / s, x / s); }
 function fromLatLng(ll) { const s = 2 ** native(); return { x: ll.lng * s, y: -ll.lat * s }; }
 
-function tileUrl() {
+// The tile URL template of the current view, showing `mapName` (default: the picked map; the
+// lit view fetches the colour and the normals).
+function tileUrl(mapName) {
   const q = new URLSearchParams();
   q.set('mode', state.m);
   q.set('seed', state.s);
   for (const [k, v] of Object.entries(state.p)) q.set(k, v);
+  const shown = mapName || state.a;
+  if (shown !== 'albedo' && shown !== 'lit') q.set('map', shown);
   return `/tiles/${encodeURIComponent(state.t)}/{z}/{x}/{y}.png?` + q.toString();
+}
+
+// The maps the current texture offers in the current mode (from /textures/{id}), plus 'lit'
+// when it has a normal map; the coordinates (uv) are for programs, not for looking at.
+function mapChoices() {
+  const maps = (meta.maps || []).filter((m) => m.name === 'albedo' || (m.kind !== 'coordinates' && m.modes.includes(state.m)));
+  const names = maps.map((m) => m.name);
+  if (maps.some((m) => m.kind === 'normal')) names.push('lit');
+  return names;
+}
+
+function buildMapPicker() {
+  const sel = $('mapsel');
+  sel.textContent = '';
+  const names = mapChoices();
+  for (const n of names) sel.append(new Option(n === 'lit' ? 'lit (colour × normals)' : n, n));
+  if (!names.includes(state.a)) state.a = 'albedo';
+  sel.value = state.a;
+  sel.disabled = names.length < 2;
+  $('lightrow').hidden = state.a !== 'lit';
+  $('light').value = state.l;
+}
+
+// Shade colour by normals under a light from `deg` (azimuth, 45° up), in the page: served
+// normals are OpenGL (+Y up in the image), so the image's up is the light's +Y.
+function shade(out, colour, normal, deg) {
+  const a = (deg * Math.PI) / 180, c = Math.SQRT1_2;
+  const l = [Math.cos(a) * c, Math.sin(a) * c, c];
+  for (let i = 0; i < out.data.length; i += 4) {
+    const n = [normal[i] / 127.5 - 1, normal[i + 1] / 127.5 - 1, normal[i + 2] / 127.5 - 1];
+    const d = Math.max(0, n[0] * l[0] + n[1] * l[1] + n[2] * l[2]);
+    const k = 0.25 + 0.9 * d;
+    for (let j = 0; j < 3; j++) out.data[i + j] = Math.min(255, colour[i + j] * k);
+    out.data[i + 3] = 255;
+  }
+}
+
+// The lit view: each tile a canvas drawn from the colour and normal tiles of the same place.
+const LitLayer = L.GridLayer.extend({
+  createTile(coords, done) {
+    const tile = document.createElement('canvas');
+    tile.width = tile.height = 256;
+    const url = (m) => L.Util.template(tileUrl(m), coords);
+    const load = (src) => new Promise((ok, fail) => {
+      const img = new Image();
+      img.onload = () => ok(img);
+      img.onerror = () => fail(new Error(`tile ${src}`));
+      img.src = src;
+    });
+    Promise.all([load(url('albedo')), load(url('normal'))]).then(([a, n]) => {
+      const ctx = tile.getContext('2d');
+      const pixels = (img) => { ctx.drawImage(img, 0, 0); return ctx.getImageData(0, 0, 256, 256).data; };
+      tile._colour = pixels(a);
+      tile._normal = pixels(n);
+      drawLit(tile);
+      tile.dataset.lit = '1';
+      done(null, tile);
+    }, (e) => done(e, tile));
+    return tile;
+  },
+});
+
+function drawLit(tile) {
+  const ctx = tile.getContext('2d');
+  const out = ctx.createImageData(256, 256);
+  shade(out, tile._colour, tile._normal, state.l);
+  ctx.putImageData(out, 0, 0);
 }
 
 // A tile the server shed under load (503 + Retry-After) is asked for again after a growing,
@@ -67,6 +144,18 @@ function retryShedTile(e) {
 
 function refreshLayer() {
   const url = tileUrl();
+  const lit = state.a === 'lit';
+  if (layer && (layer instanceof LitLayer) !== lit) { map.removeLayer(layer); layer = null; }
+  if (lit) {
+    if (layer) map.removeLayer(layer);
+    layer = new LitLayer({
+      tileSize: 256, noWrap: true, minZoom: meta.minzoom, maxZoom: meta.maxzoom + 2,
+      minNativeZoom: meta.minzoom, maxNativeZoom: meta.maxzoom, keepBuffer: 1,
+      attribution: meta.attribution || '',
+    }).addTo(map);
+    writeHash();
+    return;
+  }
   if (!layer) {
     layer = L.tileLayer(url, {
       tileSize: 256, noWrap: true, minZoom: meta.minzoom, maxZoom: meta.maxzoom + 2,
@@ -192,6 +281,7 @@ async function selectTexture(id, keepView) {
   for (const m of meta.modes) modes.append(new Option(m, m));
   if (!meta.modes.includes(state.m)) state.m = meta.default_mode;
   modes.value = state.m;
+  buildMapPicker();
   buildControls();
   map.setMinZoom(meta.minzoom);
   map.setMaxZoom(meta.maxzoom + 2);
@@ -297,7 +387,19 @@ async function init() {
   setGrid(state.g);
   onMove();
   sel.addEventListener('change', () => selectTexture(sel.value, true));
-  $('mode').addEventListener('change', (e) => { state.m = e.target.value; buildControls(); refreshLayer(); });
+  $('mode').addEventListener('change', (e) => { state.m = e.target.value; buildMapPicker(); buildControls(); refreshLayer(); });
+  $('mapsel').addEventListener('change', (e) => {
+    state.a = e.target.value;
+    $('lightrow').hidden = state.a !== 'lit';
+    refreshLayer();
+  });
+  $('light').addEventListener('input', (e) => {
+    state.l = Number(e.target.value);
+    if (layer instanceof LitLayer) {
+      for (const t of document.querySelectorAll('canvas[data-lit="1"]')) drawLit(t);
+    }
+    writeHash();
+  });
   $('seed').addEventListener('change', (e) => {
     const v = String(e.target.value).trim();
     if (/^\d+$/.test(v)) { state.s = v; refreshLayer(); } else { e.target.value = state.s; }

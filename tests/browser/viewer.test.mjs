@@ -334,6 +334,50 @@ test('every mode is offered from the specs, with its own controls; texture picke
   await page.close();
 });
 
+test('the map picker shows a material\'s maps, and the lit view shades colour by normals under a movable light', async () => {
+  const { page, errors } = await open('/#t=flagstones&z=8&x=0&y=0');
+  await settled(page);
+  const offered = await page.$$eval('#mapsel option', (l) => l.map((o) => o.value));
+  assert.deepEqual(offered, ['albedo', 'height', 'normal', 'specular', 'lit']);
+  await page.selectOption('#mapsel', 'normal');
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('map=normal')));
+  await settled(page);
+  // Normal tiles: mostly facing up (blue high, red and green around the middle).
+  const mean = await page.evaluate(() => {
+    const img = [...document.querySelectorAll('img.leaflet-tile')].find((i) => i.src.includes('map=normal') && i.complete);
+    const c = document.createElement('canvas');
+    c.width = c.height = 256;
+    const ctx = c.getContext('2d');
+    ctx.drawImage(img, 0, 0);
+    const d = ctx.getImageData(0, 0, 256, 256).data;
+    const m = [0, 0, 0];
+    for (let i = 0; i < d.length; i += 4) for (let j = 0; j < 3; j++) m[j] += d[i + j] / (d.length / 4);
+    return m;
+  });
+  assert.ok(mean[2] > 200 && Math.abs(mean[0] - 128) < 30 && Math.abs(mean[1] - 128) < 30, `normal tile means ${mean}`);
+  // Lit: canvases drawn from colour and normals; moving the light changes them; the permalink keeps it.
+  await page.selectOption('#mapsel', 'lit');
+  await page.waitForFunction(() => document.querySelectorAll('canvas[data-lit="1"]').length >= 4);
+  const pixels = () => page.evaluate(() => {
+    const c = document.querySelector('canvas[data-lit="1"]');
+    return Array.from(c.getContext('2d').getImageData(0, 0, 64, 64).data);
+  });
+  const before = await pixels();
+  await page.focus('#light');
+  for (let i = 0; i < 90; i++) await page.keyboard.press('ArrowRight');
+  await page.waitForFunction(() => location.hash.includes('l=225'));
+  const after = await pixels();
+  const changed = before.filter((v, i) => v !== after[i]).length;
+  assert.ok(changed > 1000, `only ${changed} channel values changed with the light`);
+  assert.match(await page.evaluate(() => location.hash), /a=lit/);
+  // A mode that renders no maps offers the colour only.
+  await page.selectOption('#mode', 'umbrella');
+  assert.deepEqual(await page.$$eval('#mapsel option', (l) => l.map((o) => o.value)), ['albedo']);
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('mode=umbrella') && !i.src.includes('map=')));
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('readable on a phone-sized viewport', async () => {
   const { page, errors } = await open('/', { width: 390, height: 844 });
   await settled(page, 1);
