@@ -117,18 +117,80 @@ fn document(quads: &[Quad], generator: &str, views: Vec<Value>, accessors: Vec<V
     })
 }
 
-/// A GLB with each quad's image (`(bytes, mime)`) embedded.
-pub fn glb(quads: &[Quad], images: &[(Vec<u8>, &str)], generator: &str) -> Vec<u8> {
+/// What a material map is to a glTF material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Slot {
+    /// `normalTexture`: tangent-space normals, +Y up (the maps' served convention).
+    Normal,
+    /// `occlusionTexture` (its R channel).
+    Occlusion,
+    /// `KHR_materials_specular`'s `specularColorTexture`: a game's grey specular intensity `s`
+    /// scales the dielectric reflectance, `F0 = 0.04 · s` (1 = a plain dielectric's highlight).
+    Specular,
+}
+
+impl Slot {
+    /// The slot of a material map, by its name (`normal`, `ao`, `specular`).
+    pub fn of(map: &str) -> Option<Slot> {
+        match map {
+            "normal" => Some(Slot::Normal),
+            "ao" => Some(Slot::Occlusion),
+            "specular" => Some(Slot::Specular),
+            _ => None,
+        }
+    }
+}
+
+/// Add material maps (PNG images already in `images`, by index) to material `m` of `doc`.
+fn add_maps(doc: &mut Value, m: usize, maps: &[(Slot, usize)]) {
+    for &(slot, image) in maps {
+        let texture = doc["textures"].as_array().map_or(0, Vec::len);
+        if let Some(t) = doc["textures"].as_array_mut() {
+            t.push(json!({ "sampler": 0, "source": image }));
+        }
+        let mat = &mut doc["materials"][m];
+        match slot {
+            Slot::Normal => mat["normalTexture"] = json!({ "index": texture }),
+            Slot::Occlusion => mat["occlusionTexture"] = json!({ "index": texture }),
+            Slot::Specular => {
+                mat["extensions"]["KHR_materials_specular"] =
+                    json!({ "specularColorTexture": { "index": texture }, "specularFactor": 1.0 });
+                doc["extensionsUsed"] = json!(["KHR_materials_specular"]);
+            }
+        }
+    }
+}
+
+/// A GLB with each quad's image (`(bytes, mime)`) embedded; `maps` are PNG material maps of the
+/// first quad (its tile's normals, occlusion, specular), one texture each.
+pub fn glb(quads: &[Quad], images: &[(Vec<u8>, &str)], maps: &[(Slot, Vec<u8>)], generator: &str) -> Vec<u8> {
     let size = quads.first().map(|q| q.size as f32).unwrap_or(1.0);
     let (mut bin, mut views, accessors) = geometry(size);
     let mut imgs = Vec::new();
-    for (bytes, mime) in images {
+    let all = images.iter().map(|(b, mime)| (b, *mime)).chain(maps.iter().map(|(_, b)| (b, "image/png")));
+    for (bytes, mime) in all {
         imgs.push(json!({ "bufferView": views.len(), "mimeType": mime }));
         views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));
         bin.extend_from_slice(bytes);
         pad4(&mut bin, 0);
     }
+    // A normal map needs a tangent space: +X (increasing u) with w = +1, so that the
+    // bitangent N × T = −Z is north, the image's up, as the maps' +Y.
+    let mut accessors = accessors;
+    let tangent = maps.iter().any(|(s, _)| *s == Slot::Normal).then(|| {
+        let bytes: Vec<u8> = [[1.0f32, 0.0, 0.0, 1.0]; 4].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+        views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len(), "target": 34962 }));
+        bin.extend_from_slice(&bytes);
+        pad4(&mut bin, 0);
+        accessors.push(json!({ "bufferView": views.len() - 1, "componentType": 5126, "count": 4, "type": "VEC4" }));
+        accessors.len() - 1
+    });
     let mut doc = document(quads, generator, views, accessors, imgs);
+    if let Some(t) = tangent {
+        doc["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(t);
+    }
+    let slots: Vec<(Slot, usize)> = maps.iter().enumerate().map(|(i, (s, _))| (*s, images.len() + i)).collect();
+    add_maps(&mut doc, 0, &slots);
     doc["buffers"] = json!([{ "byteLength": bin.len() }]);
     let mut js = serde_json::to_vec(&doc).unwrap_or_default();
     pad4(&mut js, b' ');

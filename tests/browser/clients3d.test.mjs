@@ -123,6 +123,20 @@ test('three.js: mipmapped tiles far away are closer to a supersampled reference'
   await page.close();
 });
 
+test('three.js: a material tile is lit by its normal map, the right way round', async () => {
+  const { page, errors } = await open(THREE_PAGE);
+  await page.waitForFunction(() => window.scenes);
+  const r = await page.evaluate((args) => window.scenes.litView(args),
+    { base: BASE, id: 'flagstones', z: 8, x: 3, y: -2, query: '?seed=2' });
+  console.log(`lit flagstones tile: material ${JSON.stringify(r.holds)}; correlation of east-west light with normal x ` +
+    `${r.ew.toFixed(3)}, north-south with normal y ${r.ns.toFixed(3)} (east-west with y: ${r.swapped.toFixed(3)})`);
+  assert.ok(r.holds.normalMap && r.holds.specular, JSON.stringify(r.holds));
+  assert.ok(r.ew > 0.5 && r.ns > 0.5, `normals light the wrong way: ${r.ew}, ${r.ns}`);
+  assert.ok(Math.abs(r.swapped) < r.ew / 2, `x and y mixed up: ${r.swapped}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 /** Load an X3D document into the page's X_ITE canvas and wait until its texture has arrived
  * (the canvas is not black and two looks in a row agree); the last look stays in the page as
  * `window.shot` (see clients3d/pixels.js). Returns its size, mean level and PNG data URL. */

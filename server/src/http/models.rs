@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 use textile_core::maps::MapChoice;
 use textile_core::{ModeParams, ParamReader, TILE_SIZE};
 
-use crate::assets::{glb, gltf_json, image_side, x3d, Quad, BORDER, LAYOUT};
+use crate::assets::{glb, gltf_json, image_side, x3d, Quad, Slot, BORDER, LAYOUT};
 use crate::encode::Format;
 use crate::error::ApiError;
 use crate::http::content::{if_none_match, image, not_modified};
@@ -101,6 +101,27 @@ impl TileRequest {
 
     /// The image of the tile at `spec` with this request's texture and parameters: the PNG
     /// window of the tile and [`BORDER`] texels around it, at the tile's zoom.
+    /// The material maps of this tile that go into its glTF material, `(slot, name)`: those of
+    /// the texture with a glTF slot, when the mode renders maps.
+    fn material_maps(&self) -> Vec<(Slot, String)> {
+        if !self.params.info().renders_maps {
+            return Vec::new();
+        }
+        self.tex.exemplar.maps.iter().filter_map(|m| Slot::of(&m.name).map(|s| (s, m.name.clone()))).collect()
+    }
+
+    /// What of the texture's maps the glTF material holds, for cache keys: empty without maps.
+    fn material_key(&self) -> String {
+        let maps = self.material_maps();
+        let each: Vec<String> =
+            maps.iter().filter_map(|(_, n)| self.tex.exemplar.map(n).map(|m| format!("{n}:{}", m.hash))).collect();
+        if each.is_empty() {
+            String::new()
+        } else {
+            format!("maps={}", each.join(","))
+        }
+    }
+
     fn image_at(&self, spec: TileSpec) -> ImageJob {
         let (b, side) = (BORDER as i64, image_side() as i64);
         let window = WindowSpec {
@@ -208,7 +229,7 @@ pub async fn gltf_tile(
 /// A tile's GLB answer (conditional requests, tile cache), for `/gltf` and 3D Tiles content.
 pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &HeaderMap) -> Result<Response, ApiError> {
     let cc = &st.config.cache_control;
-    let etag = etag_for(&key(r, "glb", ""));
+    let etag = etag_for(&key(r, "glb", &r.material_key()));
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
@@ -217,8 +238,14 @@ pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &Head
     }
     let job = r.image();
     let png = tile_png(st, &job.etag(), job).await?;
+    let mut maps = Vec::new();
+    for (slot, name) in r.material_maps() {
+        let job = ImageJob { map: MapChoice::Map(name), ..r.image() };
+        maps.push((slot, tile_png(st, &job.etag(), job).await?));
+    }
     let q = quad(&r.tex, &r.spec);
-    let (bytes, hit) = cached(st, &etag, GLTF_LABEL, move |_| Ok(glb(&[q], &[(png, "image/png")], &generator()))).await;
+    let (bytes, hit) =
+        cached(st, &etag, GLTF_LABEL, move |_| Ok(glb(&[q], &[(png, "image/png")], &maps, &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
@@ -292,7 +319,7 @@ pub async fn gltf_patch(
         images.push((tile_png(&st, &job.etag(), job).await?, "image/png"));
         quads.push(quad(&r.tex, &spec));
     }
-    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&quads, &images, &generator()))).await;
+    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&quads, &images, &[], &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 

@@ -219,3 +219,77 @@ export async function farView({ base, id, z, query, view, w, h, n }) {
     pictures: { tiles: png(padded, w, h), reference: png(reference, w, h), bare: png(old, w, h) },
   };
 }
+
+/** Pearson correlation of two equally long arrays. */
+function correlation(a, b) {
+  const n = a.length;
+  let ma = 0, mb = 0;
+  for (let i = 0; i < n; i++) { ma += a[i] / n; mb += b[i] / n; }
+  let ab = 0, aa = 0, bb = 0;
+  for (let i = 0; i < n; i++) {
+    ab += (a[i] - ma) * (b[i] - mb);
+    aa += (a[i] - ma) ** 2;
+    bb += (b[i] - mb) ** 2;
+  }
+  return ab / Math.sqrt(aa * bb);
+}
+
+/** The lit material: one tile's GLB as GLTFLoader gives it, seen straight down (north up, one
+ * pixel per texel) under a low sun from the east, west, north and south in turn. Where the
+ * normal map says the surface faces east, the east sun must light it more than the west one:
+ * the east-minus-west brightness is correlated with the served normals' x (red), and
+ * north-minus-south with their y (green, +Y up = north). Also says what the material holds. */
+export async function litView({ base, id, z, x, y, query }) {
+  const gltf = await loader.loadAsync(`${base}/gltf/${id}/${z}/${x}/${y}.glb${query}`);
+  const mesh = gltf.scene.getObjectByProperty('type', 'Mesh');
+  const m = mesh.material;
+  const holds = { normalMap: Boolean(m.normalMap), specular: Boolean(m.specularColorMap), type: m.type };
+  const box = new THREE.Box3().setFromObject(gltf.scene);
+  const c = box.getCenter(new THREE.Vector3());
+  const half = (box.max.x - box.min.x) / 2;
+  const W = 256;
+  const shot = (dir) => {
+    const r = renderer(W, W);
+    const s = new THREE.Scene();
+    s.background = new THREE.Color(0x000000);
+    s.add(new THREE.AmbientLight(0xffffff, 0.3));
+    const sun = new THREE.DirectionalLight(0xffffff, 3);
+    sun.position.set(c.x + dir[0], 1, c.z + dir[1]);
+    sun.target.position.copy(c);
+    s.add(sun, sun.target, gltf.scene);
+    const cam = new THREE.OrthographicCamera(-half, half, half, -half, 0.1, 1000);
+    cam.position.set(c.x, 100, c.z);
+    cam.up.set(0, 0, -1);
+    cam.lookAt(c);
+    cam.updateMatrixWorld();
+    r.render(s, cam);
+    const gl = r.getContext();
+    const px = new Uint8Array(W * W * 4);
+    gl.readPixels(0, 0, W, W, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    r.dispose();
+    s.remove(gltf.scene);
+    const lum = new Float32Array(W * W);
+    for (let j = 0; j < W; j++) {
+      for (let i = 0; i < W; i++) {
+        const o = 4 * ((W - 1 - j) * W + i);
+        lum[j * W + i] = px[o] + px[o + 1] + px[o + 2];
+      }
+    }
+    return lum;
+  };
+  // A low sun (height 1 for 3 sideways): slopes matter.
+  const [e, w, n, s] = [[3, 0], [-3, 0], [0, -3], [0, 3]].map(shot);
+  const img = new Image();
+  img.src = `${base}/tiles/${id}/${z}/${x}/${y}.png${query}${query ? '&' : '?'}map=normal`;
+  await img.decode();
+  const cv = document.createElement('canvas');
+  cv.width = cv.height = W;
+  const ctx = cv.getContext('2d');
+  ctx.drawImage(img, 0, 0);
+  const nd = ctx.getImageData(0, 0, W, W).data;
+  const nx = new Float32Array(W * W), ny = new Float32Array(W * W);
+  for (let i = 0; i < W * W; i++) { nx[i] = nd[4 * i] - 127.5; ny[i] = nd[4 * i + 1] - 127.5; }
+  const ew = e.map((v, i) => v - w[i]);
+  const ns = n.map((v, i) => v - s[i]);
+  return { holds, ew: correlation(ew, nx), ns: correlation(ns, ny), swapped: correlation(ew, ny) };
+}
