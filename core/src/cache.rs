@@ -107,9 +107,21 @@ struct Lru {
     bytes: u64,
 }
 
-/// A byte-bounded, thread-safe LRU of synthesized blocks shared by any number of streams.
-/// A limit of 0 turns it off: nothing is kept and every synthesis starts cold.
+/// Finished windows a cache keeps, besides its blocks: the coordinates of the last windows
+/// rendered, so that another map of the same tile (issue 39) costs only lookups. At most
+/// [`WINDOW_PIXELS`] each (a `@2x` tile), so they hold at most 16 MiB.
+const WINDOWS: usize = 16;
+/// Largest window whose coordinates are kept.
+const WINDOW_PIXELS: usize = 512 * 512;
+
+/// A window's coordinates: stream, level and pixels.
+type WindowKey = (StreamId, u32, Rect);
+
+/// A byte-bounded, thread-safe LRU of synthesized blocks shared by any number of streams, and
+/// the coordinates of the last [`WINDOWS`] windows synthesized. A limit of 0 turns it off:
+/// nothing is kept and every synthesis starts cold.
 pub struct Pyramid {
+    windows: Mutex<LruCache<WindowKey, Arc<[u32]>>>,
     lru: Mutex<Lru>,
     limit: u64,
     hits: AtomicU64,
@@ -120,7 +132,9 @@ pub struct Pyramid {
 impl Pyramid {
     /// A cache holding at most `limit` bytes.
     pub fn new(limit: u64) -> Self {
+        let windows = std::num::NonZeroUsize::new(WINDOWS).map_or_else(LruCache::unbounded, LruCache::new);
         Pyramid {
+            windows: Mutex::new(windows),
             lru: Mutex::new(Lru { map: LruCache::unbounded(), bytes: 0 }),
             limit,
             hits: AtomicU64::new(0),
@@ -160,6 +174,21 @@ impl Pyramid {
         // A panic while holding the lock cannot leave the map inconsistent (single calls into
         // `LruCache`), so a poisoned lock is still usable.
         self.lru.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The coordinates of a finished window, when kept.
+    pub(crate) fn window(&self, key: &WindowKey) -> Option<Arc<[u32]>> {
+        if !self.is_on() {
+            return None;
+        }
+        self.windows.lock().unwrap_or_else(|e| e.into_inner()).get(key).cloned()
+    }
+
+    /// Keep a finished window's coordinates (the least recently used of [`WINDOWS`] goes).
+    pub(crate) fn keep_window(&self, key: WindowKey, coords: Arc<[u32]>) {
+        if self.is_on() && coords.len() <= WINDOW_PIXELS {
+            self.windows.lock().unwrap_or_else(|e| e.into_inner()).put(key, coords);
+        }
     }
 
     /// The blocks of `level` covering `r`, row-major over the block grid of `r` (see

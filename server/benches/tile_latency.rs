@@ -145,6 +145,47 @@ fn main() {
             }
             println!("{row}");
         }
+        // Materials (issue 39): a cold colour tile of the built-in flagstones, then each other
+        // map of the same tile (its coordinates kept: lookups and encoding only), and cold tiles
+        // of each map alone, at native zoom 8.
+        let per_map = (n / 20).max(10);
+        println!("flagstones material tiles over HTTP, median of {per_map} (synth, native zoom 8):");
+        let mut table: Vec<(String, Vec<f64>)> = Vec::new();
+        let mut time = |name: String, ms: f64| match table.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, v)) => v.push(ms),
+            None => table.push((name, vec![ms])),
+        };
+        for i in 0..per_map as i64 {
+            let (x, y) = ((i * 7919) % 100_003 - 50_000, 700_000 + (i * 104_729) % 997);
+            for (what, map) in [
+                ("cold albedo", "albedo"),
+                ("second map: normal", "normal"),
+                ("second map: height", "height"),
+                ("second map: specular", "specular"),
+                ("second map: uv", "uv"),
+            ] {
+                let t = Instant::now();
+                let r = client.get(format!("{base}/tiles/flagstones/8/{x}/{y}.png?map={map}")).send().await.unwrap();
+                assert_eq!(r.status(), 200);
+                let _ = r.bytes().await.unwrap();
+                time(what.to_string(), t.elapsed().as_secs_f64() * 1e3);
+            }
+            for map in ["normal", "height"] {
+                let t = Instant::now();
+                let r = client
+                    .get(format!("{base}/tiles/flagstones/8/{x}/{}.png?map={map}", y + 5000))
+                    .send()
+                    .await
+                    .unwrap();
+                assert_eq!(r.status(), 200);
+                let _ = r.bytes().await.unwrap();
+                time(format!("cold {map} alone"), t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        for (name, mut v) in table {
+            v.sort_by(f64::total_cmp);
+            println!("  {name:<22} {:6.2} ms", v[v.len() / 2]);
+        }
     });
     let _ = child.kill();
     let _ = child.wait();

@@ -178,11 +178,13 @@ impl ImageJob {
         Ok(r)
     }
 
-    /// Encode a rendered image: tightly for modes whose pixels are expensive, fast for cheap ones.
+    /// Encode a rendered image: tightly for modes whose pixels are expensive, fast for cheap ones
+    /// and for material maps (a second map of a tile costs lookups and encoding only, so the
+    /// encoding is its cost).
     pub fn encode(&self, img: &RgbWindow) -> Result<Vec<u8>, ApiError> {
-        let effort = match self.params.info().cost {
-            Cost::Heavy => Effort::Tight,
-            Cost::Light => Effort::Quick,
+        let effort = match (self.params.info().cost, &self.map) {
+            (Cost::Heavy, MapChoice::Albedo) => Effort::Tight,
+            _ => Effort::Quick,
         };
         encode(&img.pixels, img.width, img.height, self.format(), effort)
             .map_err(|e| ApiError::internal(format!("encoding: {e}")))

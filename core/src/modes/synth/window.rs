@@ -106,8 +106,14 @@ pub fn synthesize_with(
         });
     }
     let ctx = Ctx::new(an, params, pyr, an.randomness_mask()?);
+    // The same window again (another map of a tile just rendered): its coordinates, as kept.
+    let key = (ctx.stream, level, rect);
+    if let Some(coords) = pyr.window(&key) {
+        return Ok(Synthesized { window: CoordWindow { level, rect, coords: coords.to_vec() }, synthesized: 0 });
+    }
     let mut synthesized = 0;
     let buf = ctx.level(level, rect, &mut synthesized);
+    pyr.keep_window(key, buf.s.as_slice().into());
     Ok(Synthesized { window: CoordWindow { level, rect, coords: buf.s }, synthesized })
 }
 
