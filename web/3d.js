@@ -10,8 +10,9 @@ import { ImplicitTilingPlugin } from '3d-tiles-renderer/core/plugins';
 const $ = (id) => document.getElementById(id);
 const num = (v) => String(Number(Number(v).toFixed(3)));
 
-// t: texture, m: mode, seed, p: mode parameters as given, cam: eye and target.
-const state = { t: null, m: null, seed: '0', p: {}, cam: null };
+// t: texture, m: mode, seed, p: mode parameters as given, cam: eye and target, sun: the sun's
+// direction in degrees (materials with normals).
+const state = { t: null, m: null, seed: '0', p: {}, cam: null, sun: 135 };
 let catalog = null, meta = null, tiles = null, debounce = null, retry = null;
 // Every content tile the renderer asked for, by level (the test and the readout use them).
 const requested = [];
@@ -23,6 +24,8 @@ function readHash() {
   state.seed = h.get('seed') ?? '0';
   state.p = {};
   for (const [k, v] of h) if (k.startsWith('p.')) state.p[k.slice(2)] = v;
+  const sun = Number(h.get('sun'));
+  if (h.has('sun') && Number.isFinite(sun)) state.sun = ((Math.round(sun) % 360) + 360) % 360;
   const cam = (h.get('cam') || '').split(',').map(Number);
   state.cam = cam.length === 6 && cam.every(Number.isFinite) ? cam : null;
 }
@@ -33,6 +36,7 @@ function writeHash() {
   h.set('m', state.m);
   h.set('seed', state.seed);
   for (const [k, v] of Object.entries(state.p)) h.set(`p.${k}`, v);
+  if (lit()) h.set('sun', state.sun);
   const e = camera.position, g = controls.target;
   h.set('cam', [e.x, e.y, e.z, g.x, g.y, g.z].map(num).join(','));
   history.replaceState(null, '', `#${h.toString().replace(/%2C/g, ',')}`);
@@ -57,7 +61,27 @@ $('view').append(renderer.domElement);
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0xbfd1e5);
 // A rough, non-metallic ground under ambient light of intensity π shows its texture as it is.
-scene.add(new THREE.AmbientLight(0xffffff, Math.PI));
+// A material with normals is lit instead by a sun 35° up (its direction a slider) and less
+// ambient light, so that its relief shows.
+const ambient = new THREE.AmbientLight(0xffffff, Math.PI);
+const sun = new THREE.DirectionalLight(0xffffff, 0);
+scene.add(ambient, sun, sun.target);
+
+/** Whether the current texture and mode show a lit material (a normal map the mode renders). */
+function lit() {
+  return Boolean(meta && (meta.maps || []).some((m) => m.kind === 'normal' && m.modes.includes(state.m)));
+}
+
+function placeSun() {
+  const on = lit();
+  $('sunrow').hidden = !on;
+  ambient.intensity = on ? 0.9 : Math.PI;
+  sun.intensity = on ? 2.6 : 0;
+  // Azimuth from east, counter-clockwise seen from above (north is −Z).
+  const a = (state.sun * Math.PI) / 180, g = controls.target;
+  sun.target.position.copy(g);
+  sun.position.set(g.x + Math.cos(a) * 0.82, 0.57, g.z - Math.sin(a) * 0.82);
+}
 const camera = new THREE.PerspectiveCamera(50, 1, 0.5, 4e6);
 const controls = new MapControls(camera, renderer.domElement);
 controls.screenSpacePanning = false;
@@ -170,6 +194,8 @@ async function selectTexture(id, keepView) {
   if (!meta.modes.includes(state.m)) state.m = meta.default_mode;
   modes.value = state.m;
   buildParams();
+  $('sun').value = state.sun;
+  placeSun();
   if (!keepView) state.cam = null;
   placeCamera();
   loadTiles();
@@ -179,6 +205,7 @@ function frame() {
   requestAnimationFrame(frame);
   controls.update();
   camera.updateMatrixWorld();
+  if (sun.intensity > 0) placeSun();
   if (tiles) {
     tiles.update();
     const s = tiles.stats;
@@ -198,7 +225,8 @@ async function main() {
   sel.value = state.t;
   $('seed').value = state.seed;
   sel.addEventListener('change', () => { state.p = {}; selectTexture(sel.value, false); });
-  $('mode').addEventListener('change', () => { state.m = $('mode').value; buildParams(); changed(); });
+  $('mode').addEventListener('change', () => { state.m = $('mode').value; buildParams(); placeSun(); changed(); });
+  $('sun').addEventListener('input', () => { state.sun = Number($('sun').value); placeSun(); writeHash(); });
   $('seed').addEventListener('change', () => { state.seed = String(Math.max(0, Math.floor(Number($('seed').value) || 0))); changed(); });
   $('newseed').addEventListener('click', () => {
     state.seed = String(Math.floor(Math.random() * 2 ** 31));
@@ -218,7 +246,7 @@ new PerformanceObserver((list) => {
 }).observe({ type: 'resource', buffered: true });
 
 window.textile3d = {
-  camera, controls, requested, state,
+  camera, controls, requested, state, sun,
   get tiles() { return tiles; },
   /** Move the camera (eye and target) and let the tiles follow. */
   look(eye, target) {

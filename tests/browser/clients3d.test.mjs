@@ -224,6 +224,41 @@ test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the ca
   await page.close();
 });
 
+test('/3d.html lights a material with a sun whose direction a slider turns', async () => {
+  const page = await browser.newPage({ viewport: { width: 800, height: 560 } });
+  const errors = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(`${BASE}/3d.html#t=flagstones&m=synth&seed=2&sun=0&cam=32768,200,32868,32768,0,32768`);
+  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 30000 });
+  await settled3d(page);
+  assert.equal(await page.isVisible('#sunrow'), true, 'a material with normals offers the sun');
+  const grab = () => page.evaluate(() => {
+    const c = document.querySelector('#view canvas');
+    const g = document.createElement('canvas');
+    g.width = 200; g.height = 140;
+    g.getContext('2d').drawImage(c, c.width / 2 - 200, c.height / 2 - 140, 400, 280, 0, 0, 200, 140);
+    return Array.from(g.getContext('2d').getImageData(0, 0, 200, 140).data);
+  });
+  const east = await grab();
+  await page.evaluate(() => { const s = document.querySelector('#sun'); s.value = '180'; s.dispatchEvent(new Event('input')); });
+  await page.waitForTimeout(300);
+  const west = await grab();
+  let diff = 0;
+  for (let i = 0; i < east.length; i += 4) diff += Math.abs(east[i] - west[i]) / (east.length / 4);
+  console.log(`3D page, flagstones: the sun from the east vs the west changes pixels by ${diff.toFixed(1)} levels on average`);
+  assert.ok(diff > 6, `turning the sun barely changes the relief: ${diff}`);
+  assert.match(page.url(), /sun=180/);
+  save('3d-page-material.png', `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
+  // A texture without maps is shown as it is: no sun.
+  await page.selectOption('#texture', 'gravel');
+  await page.waitForFunction(() => window.textile3d.state.t === 'gravel');
+  assert.equal(await page.isVisible('#sunrow'), false);
+  assert.doesNotMatch(page.url(), /sun=/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('CesiumJS loads the tileset anchored on the globe and requests its content', async () => {
   const { page, errors } = await open(CESIUM_PAGE);
   const failed = [];

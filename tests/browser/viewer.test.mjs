@@ -355,8 +355,10 @@ test('the map picker shows a material\'s maps, and the lit view shades colour by
     return m;
   });
   assert.ok(mean[2] > 200 && Math.abs(mean[0] - 128) < 30 && Math.abs(mean[1] - 128) < 30, `normal tile means ${mean}`);
+  assert.equal(await page.isVisible('#lightrow'), false, 'the light shows with the lit view only');
   // Lit: canvases drawn from colour and normals; moving the light changes them; the permalink keeps it.
   await page.selectOption('#mapsel', 'lit');
+  assert.equal(await page.isVisible('#lightrow'), true);
   await page.waitForFunction(() => document.querySelectorAll('canvas[data-lit="1"]').length >= 4);
   const pixels = () => page.evaluate(() => {
     const c = document.querySelector('canvas[data-lit="1"]');
