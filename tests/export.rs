@@ -58,14 +58,32 @@ async fn archives_hold_the_servers_tiles() {
     export(&["--world", "8"], &world);
     export(&["--world", "4", "--mode", "mosaic", "--seed", "3", "--format", "webp"], &mosaic);
     export(&["--bbox", "3,5,9,8", "--zoom", "5..7", "--format", "jpg", "-p", "randomness=0.5"], &bbox);
+    // A material map of the built-in flagstones (archive zooms 0..1 = textile zooms 7..8).
+    let normal = dir.path().join("normal.mbtiles");
+    let data = shared_data_dir();
+    let (code, _, err) = textile(&[
+        "export",
+        "--texture",
+        "flagstones",
+        "--world",
+        "2",
+        "--map",
+        "normal",
+        "--data-dir",
+        data.to_str().unwrap(),
+        "-o",
+        normal.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("'flagstones?map=normal'") || err.contains("map=normal"), "{err}");
     let s = Server::builder().data_dir(&shared_data_dir()).start();
-    for a in [&world, &mosaic, &bbox] {
+    for a in [&world, &mosaic, &bbox, &normal] {
         check(a, &s);
     }
     // Nothing but the archives was left in the directory.
     let names: Vec<String> =
         std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
-    assert_eq!(names.len(), 3, "{names:?}");
+    assert_eq!(names.len(), 4, "{names:?}");
 }
 
 #[test]

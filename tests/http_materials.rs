@@ -77,6 +77,21 @@ async fn every_map_is_its_exemplar_map_looked_up_at_the_uv_coordinates() {
             }
         }
     }
+    // The CLI renders the same bytes as the server, for a map and for the coordinates.
+    let data = common::shared_data_dir();
+    for (map, ext) in [("normal", "png"), ("uv", "png"), ("height", "webp")] {
+        let out = dir.path().join(format!("cli-{map}.{ext}"));
+        let run = std::process::Command::new(binary())
+            .args(["render", "--config", cfg.to_str().unwrap(), "--data-dir", data.to_str().unwrap()])
+            .args(["--texture", "forest", "--x", "1", "--y", "-4", "--seed", "5", "--map", map])
+            .args(["-o", out.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "render --map {map}: {}", String::from_utf8_lossy(&run.stderr));
+        let (status, served) = s.get_bytes(&format!("/tiles/forest/8/1/-4.{ext}?seed=5&map={map}")).await;
+        assert_eq!(status, 200);
+        assert!(std::fs::read(&out).unwrap() == served, "render --map {map} differs from the served tile");
+    }
     // Coordinates and maps of a window are the same pixels as the tiles it covers.
     for map in ["uv", "normal"] {
         let window = uv(&s, &format!("/windows/forest.png?x=-128&y=256&w=512&h=256&z=8&map={map}")).await;

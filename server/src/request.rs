@@ -64,8 +64,15 @@ pub fn params(tex: &Texture, mut r: ParamReader) -> Result<ModeParams, ApiError>
 
 /// Read `map=` (default `albedo`): the colour, one of the texture's maps, or `uv` (PNG only).
 pub fn map_choice(tex: &Texture, r: &mut ParamReader, format: Format) -> Result<MapChoice, ApiError> {
-    let Some(name) = r.take("map") else { return Ok(MapChoice::Albedo) };
-    let choice = match name.as_str() {
+    match r.take("map") {
+        Some(name) => parse_map(tex, &name, format),
+        None => Ok(MapChoice::Albedo),
+    }
+}
+
+/// The map called `name` (`albedo`, one of the texture's maps, or `uv`, PNG only).
+pub fn parse_map(tex: &Texture, name: &str, format: Format) -> Result<MapChoice, ApiError> {
+    let choice = match name {
         "albedo" => MapChoice::Albedo,
         "uv" => MapChoice::Uv,
         n if tex.exemplar.map(n).is_some() => MapChoice::Map(n.to_string()),

@@ -183,6 +183,10 @@ pub struct RenderArgs {
     /// Period in native tiles (power of two): periodic, seamless output.
     #[arg(long)]
     pub world: Option<u64>,
+    /// Material map to render: albedo (the colour), one of the texture's maps (normal,
+    /// height, …: see its [textures.maps]) or uv (the coordinates, 16-bit PNG).
+    #[arg(long, value_name = "NAME", default_value = "albedo")]
+    pub map: String,
     /// Spatial controls (synth's `controls`) from a JSON file: `{"noise": {"scale": 64,
     /// "range": [0.2, 1]}, "strokes": [{"at": [x, y], "radius": 40, "soft": 8, "value": 0}]}`;
     /// renders what the server serves for the same file's base64url as `controls=`.
@@ -235,6 +239,10 @@ pub struct ExportArgs {
     /// Seed.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Material map to export: albedo (the colour) or one of the texture's maps (normal,
+    /// height, …: see its [textures.maps]).
+    #[arg(long, value_name = "NAME", default_value = "albedo")]
+    pub map: String,
     /// A tile query parameter of the mode (repeatable), e.g. `-p randomness=0.5`.
     #[arg(long = "param", short = 'p', value_name = "KEY=VALUE")]
     pub params: Vec<String>,

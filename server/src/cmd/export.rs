@@ -8,7 +8,10 @@ use crate::export;
 /// `textile export`: tiles into a PMTiles or MBTiles archive.
 pub fn run(a: ExportArgs) -> CliResult {
     let tex = configured_texture(&a.config, &a.texture)?;
-    let pairs = param_pairs(&a.params, &a.mode, a.seed, None)?;
+    let mut pairs = param_pairs(&a.params, &a.mode, a.seed, None)?;
+    if a.map != "albedo" {
+        pairs.push(("map".into(), a.map.clone()));
+    }
     let bbox = match &a.bbox {
         Some(b) => {
             let v: Vec<u32> = b

@@ -106,6 +106,10 @@ pub fn run(a: RenderArgs) -> CliResult {
         let (state, _) = step.run(&input, None, false, &|| false, &textile_core::NoProgress, &Cancel::new())?;
         tex.prepared.set(params.name(), state);
     }
+    let map = crate::request::parse_map(&tex, &a.map, output_format(&output).unwrap_or(crate::encode::Format::Png))?;
+    if map != MapChoice::Albedo && (a.sheet || a.camera.is_some()) {
+        return Err("--map applies to tiles and windows (not --sheet or --camera)".into());
+    }
     if a.sheet {
         return sheet(&tex, &params, &output);
     }
@@ -137,7 +141,7 @@ pub fn run(a: RenderArgs) -> CliResult {
         }
         Target::Tile(TileSpec { z, x, y, scale: 1, format })
     };
-    let (bytes, r) = ImageJob { tex, params, target, map: MapChoice::Albedo }.bytes(&Pyramid::off())?;
+    let (bytes, r) = ImageJob { tex, params, target, map }.bytes(&Pyramid::off())?;
     write_atomic(&output, &bytes)?;
     println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
     Ok(())

@@ -65,6 +65,8 @@ pub struct Plan {
     pub tex: Arc<Texture>,
     /// The mode and parameters (request parameters only: what a tile URL can carry).
     pub params: ModeParams,
+    /// The colour or a material map (`map=` among the pairs).
+    pub map: MapChoice,
     /// The query string that gives the server's tiles the same bytes (`world` included).
     pub query: String,
     /// The area.
@@ -140,9 +142,13 @@ impl Plan {
             }
         };
         let query = form_urlencoded::Serializer::new(String::new()).extend_pairs(&pairs).finish();
-        let params = tex.defaults.request(&tex.source(), ParamReader::request(pairs).map_err(|e| e.to_string())?);
-        let params = params.map_err(|e| e.to_string())?;
-        Ok(Plan { tex, params, query, area, zooms: all, format })
+        let mut r = ParamReader::request(pairs).map_err(|e| e.to_string())?;
+        let map = crate::request::map_choice(&tex, &mut r, format).map_err(|e| e.message)?;
+        if map == MapChoice::Uv {
+            return Err("map 'uv': coordinates are not exported; export albedo or a material map".into());
+        }
+        let params = tex.defaults.request(&tex.source(), r).map_err(|e| e.to_string())?;
+        Ok(Plan { tex, params, query, area, zooms: all, format, map })
     }
 
     /// Textile zoom of archive zoom `a`.
@@ -296,7 +302,7 @@ fn write(plan: &Plan, output: &Path, tmp: &Path) -> Result<u64, String> {
                     tex: plan.tex.clone(),
                     params: plan.params.clone(),
                     target: Target::Tile(e.tile),
-                    map: MapChoice::Albedo,
+                    map: plan.map.clone(),
                 };
                 job.bytes(&pyramid).map(|(b, _)| b).map_err(|err| err.message)
             })
