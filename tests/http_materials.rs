@@ -143,6 +143,41 @@ async fn normals_are_unit_length_at_every_zoom_and_follow_the_synthesized_height
         println!("{id}: correlation of normal slopes with height gradients: x {cx:.3}, y {cy:.3}");
         assert!(cx >= 0.5 && cy >= 0.5, "{id}: normals disagree with the height: x {cx:.3}, y {cy:.3}");
     }
+    // Per-sample queries of a map equal its tile's pixels; filtered footprints of normals are
+    // unit vectors.
+    let tile = s.image("/tiles/forest/8/2/3.png?seed=9&map=normal").await;
+    let pts: Vec<[i64; 2]> = (0..40).map(|i| [512 + (i * 37) % 256, 768 + (i * 91) % 256]).collect();
+    let r = s
+        .client
+        .post(s.url("/samples/forest?seed=9&map=normal"))
+        .json(&serde_json::json!({ "points": pts, "z": 8 }))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(r.status(), 200);
+    let colors: serde_json::Value = r.json().await.unwrap();
+    for (p, c) in pts.iter().zip(colors["colors"].as_array().unwrap()) {
+        let px = tile.get_pixel((p[0] - 512) as u32, (p[1] - 768) as u32);
+        let c: Vec<u8> = c.as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as u8).collect();
+        assert_eq!(px.0.to_vec(), c, "sample {p:?}");
+    }
+    let fps: Vec<[f64; 3]> =
+        (0..40).map(|i| [100.3 + i as f64 * 7.7, -50.6 + i as f64 * 3.1, (i % 4) as f64 * 0.7]).collect();
+    let r = s
+        .client
+        .post(s.url("/samples/forest?map=normal"))
+        .json(&serde_json::json!({ "footprints": fps }))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(r.status(), 200);
+    let colors: serde_json::Value = r.json().await.unwrap();
+    for c in colors["colors"].as_array().unwrap() {
+        let p = image::Rgb([0, 1, 2].map(|k| c[k].as_u64().unwrap() as u8));
+        let n = decode(&p);
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        assert!((len - 1.0).abs() <= 1.0 / 127.0, "filtered normal {p:?} has length {len}");
+    }
     // Requests a mode cannot serve, and maps a texture does not have.
     assert_error(&s, "/tiles/forest/8/0/0.png?map=normal&mode=umbrella", 400, "invalid_map").await;
     assert_error(&s, "/tiles/forest/8/0/0.png?map=uv&mode=mosaic", 400, "invalid_map").await;

@@ -11,6 +11,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use serde::Deserialize;
+use textile_core::maps::MapChoice;
 use textile_core::samples::{self, Footprint, Texel};
 use textile_core::{ModeParams, Pyramid, TILE_SIZE};
 
@@ -235,6 +236,7 @@ pub async fn run(
     st: &Arc<AppState>,
     tex: Arc<Texture>,
     params: ModeParams,
+    map: MapChoice,
     points: Points,
 ) -> Result<Answer, ApiError> {
     let mode = params.name();
@@ -252,7 +254,12 @@ pub async fn run(
                 local = Pyramid::new(BATCH_CACHE);
                 &local
             };
-            let src = tex.source();
+            let src = match &map {
+                MapChoice::Map(n) => tex.source().with_map(tex.exemplar.map(n).ok_or_else(|| {
+                    ApiError::bad_request("invalid_map", format!("texture '{}' has no map '{n}'", tex.config.id))
+                })?),
+                _ => tex.source(),
+            };
             let s = match &points {
                 Points::Texels(t) => samples::texels_until(&params, &src, cache, t, cancel)?,
                 Points::Footprints(f) => samples::footprints_until(&params, &src, cache, f, max_zoom_out, cancel)?,
@@ -261,7 +268,12 @@ pub async fn run(
             fig[1].store(s.windows, Ordering::Relaxed);
             synthesized.with_label_values(&[mode]).inc_by(s.synthesized);
             delivered.with_label_values(&[mode]).inc_by(n);
-            Ok(s.colors.into_iter().flatten().collect())
+            let mut rgb: Vec<u8> = s.colors.into_iter().flatten().collect();
+            // Filtered footprints blend texels: blended normals are made unit again.
+            if src.map.is_some_and(|m| m.normal) {
+                textile_core::maps::renormalise(&mut rgb);
+            }
+            Ok(rgb)
         })
         .await?;
     Ok(Answer {

@@ -12,6 +12,7 @@ use axum::extract::{Path, RawQuery, State};
 use axum::http::{header, HeaderMap, HeaderValue};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
+use textile_core::maps::MapChoice;
 
 use crate::error::{ApiError, Kind};
 use crate::http::extract::{media_type, path_error, texture};
@@ -23,6 +24,7 @@ use crate::state::AppState;
 #[utoipa::path(post, path = "/samples/{id}", tag = "tiles",
     params(("id" = String, Path, description = "texture id"),
            ("records" = Option<String>, Query, description = "binary bodies: `texels` (default; 20-byte records i64 x, i64 y, u32 z, little-endian: pixel (x, y) of the tile grid at zoom z) or `footprints` (20-byte records f64 u, f64 v, f32 lod: a position in native texels, filtered bilinearly within a level and linearly between levels)"),
+           ("map" = Option<String>, Query, description = "albedo (default) or one of the texture's material maps (normals filtered as vectors)"),
            ("v" = Option<String>, Query, description = "cache-busting version (content unchanged)")),
     request_body(description = "JSON `{\"points\": [[x, y], …], \"z\": Z}` (a point may be [x, y, z]; z defaults to the native zoom) or `{\"footprints\": [[u, v, lod], …]}`; or binary records (application/octet-stream). At most 262144 samples and 8 MiB.",
         content(("application/json"), ("application/octet-stream"))),
@@ -44,6 +46,13 @@ pub async fn samples(
     let tex = texture(&reg, &id)?;
     let mut r = query_reader(q.as_deref())?;
     let records = r.take("records").map(|s| Records::parse(&s)).transpose()?;
+    let map = crate::request::map_choice(&tex, &mut r, crate::encode::Format::Png)?;
+    if map == MapChoice::Uv {
+        return Err(ApiError::bad_request(
+            "invalid_map",
+            "map 'uv': samples answer colours; the coordinates come as map=uv tiles and windows",
+        ));
+    }
     let params = params(&tex, r)?;
     let binary = match media_type(&headers).as_str() {
         "application/json" => false,
@@ -84,7 +93,7 @@ pub async fn samples(
     } else {
         parse_json(&tex, &bytes)?
     };
-    let a = sampling::run(&st, tex, params, points).await?;
+    let a = sampling::run(&st, tex, params, map, points).await?;
     let mut resp = if binary {
         ([(header::CONTENT_TYPE, "application/octet-stream")], a.rgb).into_response()
     } else {
