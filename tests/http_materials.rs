@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{assert_error, binary, Server};
+use common::{assert_error, binary, f32s, parse_glb, Server};
 
 /// Both embedded materials: flagstones (DirectX normals, wraps) and forest floor (OpenGL, does
 /// not wrap), with `extra` TOML added to the forest floor's maps.
@@ -244,5 +244,56 @@ async fn a_map_change_changes_only_its_own_tiles_and_bad_maps_are_configuration_
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{line}: accepted");
         assert!(err.contains(expected), "{line}: error does not say '{expected}': {err}");
+    }
+}
+
+/// World positions of a relief GLB's vertices (node translation + local), with its grid side.
+async fn relief(s: &Server, path: &str) -> (usize, Vec<[f32; 3]>) {
+    let (status, bytes) = s.get_bytes(path).await;
+    assert_eq!(status, 200, "{path}: {}", String::from_utf8_lossy(&bytes));
+    let (json, bin) = parse_glb(&bytes);
+    let t: Vec<f32> =
+        json["nodes"][0]["translation"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap() as f32).collect();
+    let prim = &json["meshes"][0]["primitives"][0];
+    let pos = f32s(&json, &bin, prim["attributes"]["POSITION"].as_u64().unwrap() as usize);
+    let world: Vec<[f32; 3]> = pos.chunks(3).map(|p| [p[0] + t[0], p[1] + t[1], p[2] + t[2]]).collect();
+    assert!(prim["attributes"]["TANGENT"].is_u64(), "a relief with a normal map has tangents");
+    ((world.len() as f64).sqrt() as usize, world)
+}
+
+#[tokio::test]
+async fn relief_meshes_are_displaced_by_the_height_map_and_neighbours_share_their_edges() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = materials_config(dir.path(), "embedded:materials/forest_floor/height.png");
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    let q = "relief=12&seed=3";
+    let (n, a) = relief(&s, &format!("/gltf/flagstones/8/3/-2.glb?{q}")).await;
+    let (_, right) = relief(&s, &format!("/gltf/flagstones/8/4/-2.glb?{q}")).await;
+    let (_, below) = relief(&s, &format!("/gltf/flagstones/8/3/-1.glb?{q}")).await;
+    assert_eq!(n, 257, "a vertex per texel centre and the neighbours' first");
+    for k in 0..n {
+        // A's last column is its right neighbour's first, A's last row its lower neighbour's first.
+        assert_eq!(a[k * n + n - 1], right[k * n], "shared vertical edge, row {k}");
+        assert_eq!(a[(n - 1) * n + k], below[k], "shared horizontal edge, column {k}");
+    }
+    // Heights are the height tile's texels, 12 texels for white, at texel centres.
+    let height = s.image("/tiles/flagstones/8/3/-2.png?seed=3&map=height").await;
+    for (i, j) in [(0u32, 0u32), (17, 200), (255, 255), (128, 3)] {
+        let v = a[j as usize * n + i as usize];
+        assert_eq!([v[0], v[2]], [768.0 + i as f32 + 0.5, -512.0 + j as f32 + 0.5]);
+        let h = 12.0 * height.get_pixel(i, j).0[0] as f32 / 255.0;
+        assert!((v[1] - h).abs() < 1e-4, "vertex ({i},{j}) at {} not {h}", v[1]);
+    }
+    assert!(a.iter().map(|v| v[1]).fold(0.0, f32::max) > 6.0, "the relief rises");
+    // Where a mesh has no relief, or a texture no height: clear errors.
+    for (path, code) in [
+        ("/gltf/flagstones/8/3/-2.gltf?relief=12", "invalid_parameter"),
+        ("/gltf/flagstones/patch.glb?z=8&x=0&y=0&tiles=2&relief=12", "invalid_parameter"),
+        ("/x3d/flagstones/8/3/-2.x3d?relief=12", "invalid_parameter"),
+        ("/gltf/flagstones/8/3/-2.glb?relief=0", "invalid_parameter"),
+        ("/gltf/flagstones/8/3/-2.glb?relief=1e9", "invalid_parameter"),
+        ("/gltf/flagstones/8/3/-2.glb?relief=12&mode=umbrella", "invalid_parameter"),
+    ] {
+        assert_error(&s, path, 400, code).await;
     }
 }

@@ -117,6 +117,84 @@ fn document(quads: &[Quad], generator: &str, views: Vec<Value>, accessors: Vec<V
     })
 }
 
+/// A displaced mesh (`relief=SCALE`): one vertex per texel centre of the tile and one more
+/// row and column — the neighbouring tiles' first texel centres — so that neighbours share
+/// their edge vertices, heights included.
+pub struct Relief {
+    /// Vertices per side (tile pixels + 1).
+    pub n: usize,
+    /// Heights in world units (native texels), row-major.
+    pub heights: Vec<f32>,
+}
+
+impl Relief {
+    /// The relief of a tile from its bordered height image ([`image_side`]²): white is `scale`
+    /// texels high.
+    pub fn from_border_image(img: &image::GrayImage, scale: f32) -> Relief {
+        let n = TILE_SIZE as usize + 1;
+        let b = BORDER;
+        let mut heights = Vec::with_capacity(n * n);
+        for j in 0..n as u32 {
+            for i in 0..n as u32 {
+                let v = img.get_pixel_checked(b + i, b + j).map_or(0, |p| p.0[0]);
+                heights.push(scale * v as f32 / 255.0);
+            }
+        }
+        Relief { n, heights }
+    }
+}
+
+/// The displaced grid of a `size × size` tile: vertex `(i, j)` at the centre of tile pixel
+/// `(i, j)` (pixels of `size / 256` units), at its height; normals up (the normal map shades
+/// the relief), texture coordinates on the image's texel centres; `u32` indices. The accessors
+/// are in [`geometry`]'s order.
+fn relief_geometry(size: f32, r: &Relief) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
+    let n = r.n;
+    let step = size / TILE_SIZE as f32;
+    let side = image_side() as f32;
+    let mut pos = Vec::with_capacity(n * n * 3);
+    let mut uv = Vec::with_capacity(n * n * 2);
+    let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+    for j in 0..n {
+        for i in 0..n {
+            let h = r.heights[j * n + i];
+            (lo, hi) = (lo.min(h), hi.max(h));
+            pos.extend([(i as f32 + 0.5) * step, h, (j as f32 + 0.5) * step]);
+            uv.extend([(BORDER as f32 + i as f32 + 0.5) / side, (BORDER as f32 + j as f32 + 0.5) / side]);
+        }
+    }
+    let nrm: Vec<f32> = (0..n * n).flat_map(|_| [0.0, 1.0, 0.0]).collect();
+    let mut idx: Vec<u32> = Vec::with_capacity((n - 1) * (n - 1) * 6);
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let (a, b) = ((j * n + i) as u32, (j * n + i + 1) as u32);
+            let (c, d) = (((j + 1) * n + i + 1) as u32, ((j + 1) * n + i) as u32);
+            idx.extend([a, c, b, a, d, c]);
+        }
+    }
+    let mut b = Vec::new();
+    let mut views = Vec::new();
+    let mut push = |b: &mut Vec<u8>, bytes: Vec<u8>, target: u32| {
+        let offset = b.len();
+        b.extend_from_slice(&bytes);
+        views.push(json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target }));
+        pad4(b, 0);
+    };
+    let le = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    push(&mut b, le(&pos), 34962);
+    push(&mut b, le(&nrm), 34962);
+    push(&mut b, le(&uv), 34962);
+    push(&mut b, idx.iter().flat_map(|v| v.to_le_bytes()).collect(), 34963);
+    let (v0, v1) = (0.5 * step, (n as f32 - 0.5) * step);
+    let accessors = vec![
+        json!({ "bufferView": 0, "componentType": 5126, "count": n * n, "type": "VEC3", "min": [v0, lo, v0], "max": [v1, hi, v1] }),
+        json!({ "bufferView": 1, "componentType": 5126, "count": n * n, "type": "VEC3" }),
+        json!({ "bufferView": 2, "componentType": 5126, "count": n * n, "type": "VEC2" }),
+        json!({ "bufferView": 3, "componentType": 5125, "count": idx.len(), "type": "SCALAR" }),
+    ];
+    (b, views, accessors)
+}
+
 /// What a material map is to a glTF material.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Slot {
@@ -163,9 +241,19 @@ fn add_maps(doc: &mut Value, m: usize, maps: &[(Slot, usize)]) {
 
 /// A GLB with each quad's image (`(bytes, mime)`) embedded; `maps` are PNG material maps of the
 /// first quad (its tile's normals, occlusion, specular), one texture each.
-pub fn glb(quads: &[Quad], images: &[(Vec<u8>, &str)], maps: &[(Slot, Vec<u8>)], generator: &str) -> Vec<u8> {
+pub fn glb(
+    quads: &[Quad],
+    images: &[(Vec<u8>, &str)],
+    maps: &[(Slot, Vec<u8>)],
+    relief: Option<&Relief>,
+    generator: &str,
+) -> Vec<u8> {
     let size = quads.first().map(|q| q.size as f32).unwrap_or(1.0);
-    let (mut bin, mut views, accessors) = geometry(size);
+    let (mut bin, mut views, accessors) = match relief {
+        Some(r) => relief_geometry(size, r),
+        None => geometry(size),
+    };
+    let vertices = accessors[0]["count"].as_u64().unwrap_or(4) as usize;
     let mut imgs = Vec::new();
     let all = images.iter().map(|(b, mime)| (b, *mime)).chain(maps.iter().map(|(_, b)| (b, "image/png")));
     for (bytes, mime) in all {
@@ -178,11 +266,13 @@ pub fn glb(quads: &[Quad], images: &[(Vec<u8>, &str)], maps: &[(Slot, Vec<u8>)],
     // bitangent N × T = −Z is north, the image's up, as the maps' +Y.
     let mut accessors = accessors;
     let tangent = maps.iter().any(|(s, _)| *s == Slot::Normal).then(|| {
-        let bytes: Vec<u8> = [[1.0f32, 0.0, 0.0, 1.0]; 4].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+        let bytes: Vec<u8> =
+            vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
         views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len(), "target": 34962 }));
         bin.extend_from_slice(&bytes);
         pad4(&mut bin, 0);
-        accessors.push(json!({ "bufferView": views.len() - 1, "componentType": 5126, "count": 4, "type": "VEC4" }));
+        accessors
+            .push(json!({ "bufferView": views.len() - 1, "componentType": 5126, "count": vertices, "type": "VEC4" }));
         accessors.len() - 1
     });
     let mut doc = document(quads, generator, views, accessors, imgs);

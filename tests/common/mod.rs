@@ -296,3 +296,38 @@ pub fn skip(test: &str, why: &str) {
     use std::io::Write;
     let _ = writeln!(std::io::stderr(), "\n    SKIPPED {test}: {why}\n");
 }
+
+pub fn u32le(b: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+}
+
+/// Check a GLB's container and return (JSON, BIN chunk).
+pub fn parse_glb(b: &[u8]) -> (serde_json::Value, Vec<u8>) {
+    assert_eq!(&b[0..4], b"glTF");
+    assert_eq!(u32le(b, 4), 2);
+    assert_eq!(u32le(b, 8) as usize, b.len());
+    let jlen = u32le(b, 12) as usize;
+    assert_eq!(u32le(b, 16), 0x4E4F_534A);
+    assert_eq!(jlen % 4, 0);
+    let json: serde_json::Value = serde_json::from_slice(&b[20..20 + jlen]).expect("JSON chunk");
+    let at = 20 + jlen;
+    let blen = u32le(b, at) as usize;
+    assert_eq!(u32le(b, at + 4), 0x004E_4942);
+    assert_eq!(blen % 4, 0);
+    assert_eq!(at + 8 + blen, b.len());
+    let bin = b[at + 8..].to_vec();
+    assert_eq!(json["buffers"][0]["byteLength"].as_u64().unwrap() as usize, blen);
+    for v in json["bufferViews"].as_array().unwrap() {
+        let (o, l) = (v["byteOffset"].as_u64().unwrap() as usize, v["byteLength"].as_u64().unwrap() as usize);
+        assert!(o % 4 == 0 && o + l <= blen);
+    }
+    (json, bin)
+}
+
+/// The floats of accessor `accessor` of a GLB.
+pub fn f32s(json: &serde_json::Value, bin: &[u8], accessor: usize) -> Vec<f32> {
+    let a = &json["accessors"][accessor];
+    let view = &json["bufferViews"][a["bufferView"].as_u64().unwrap() as usize];
+    let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+    bin[o..o + l].chunks(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
+}

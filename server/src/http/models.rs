@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 use textile_core::maps::MapChoice;
 use textile_core::{ModeParams, ParamReader, TILE_SIZE};
 
-use crate::assets::{glb, gltf_json, image_side, x3d, Quad, Slot, BORDER, LAYOUT};
+use crate::assets::{glb, gltf_json, image_side, x3d, Quad, Relief, Slot, BORDER, LAYOUT};
 use crate::encode::Format;
 use crate::error::ApiError;
 use crate::http::content::{if_none_match, image, not_modified};
@@ -81,6 +81,8 @@ pub(super) struct TileRequest {
     spec: TileSpec,
     query: Query,
     params: ModeParams,
+    /// `relief=SCALE`: a GLB's mesh displaced by the height map, white `SCALE` texels high.
+    relief: Option<f32>,
 }
 
 impl TileRequest {
@@ -90,8 +92,27 @@ impl TileRequest {
         spec: TileSpec,
         pairs: Vec<(String, String)>,
     ) -> Result<TileRequest, ApiError> {
-        let params = params(&tex, ParamReader::request(pairs.clone())?)?;
-        Ok(TileRequest { tex, spec, query: pairs.into_iter().collect(), params })
+        let mut r = ParamReader::request(pairs.clone())?;
+        let relief = r.take("relief").map(|v| relief_scale(&tex, &v)).transpose()?;
+        let params = params(&tex, r)?;
+        if relief.is_some() && !params.info().renders_maps {
+            return Err(ApiError::bad_request(
+                "invalid_parameter",
+                format!("parameter 'relief': mode={} does not render material maps", params.name()),
+            ));
+        }
+        Ok(TileRequest { tex, spec, query: pairs.into_iter().collect(), params, relief })
+    }
+
+    /// Refuse `relief` where the answer has no mesh to displace.
+    fn flat_only(&self, what: &str) -> Result<(), ApiError> {
+        match self.relief {
+            Some(_) => Err(ApiError::bad_request(
+                "invalid_parameter",
+                format!("parameter 'relief' applies to .glb tiles (and 3D Tiles content), not {what}"),
+            )),
+            None => Ok(()),
+        }
     }
 
     /// The image of the tile this asset shows.
@@ -139,6 +160,20 @@ impl TileRequest {
             map: MapChoice::Albedo,
         }
     }
+}
+
+/// Read `relief=SCALE`: the height in texels of the height map's white, in (0, 256]; the
+/// texture must have a height map.
+fn relief_scale(tex: &Texture, v: &str) -> Result<f32, ApiError> {
+    let bad = |m: String| ApiError::bad_request("invalid_parameter", format!("parameter 'relief': {m}"));
+    let scale: f32 = v.parse().map_err(|_| bad(format!("'{}' is not a number", textile_core::error::clip(v))))?;
+    if !(scale > 0.0 && scale <= 256.0) {
+        return Err(bad(format!("{scale} is outside (0, 256] texels")));
+    }
+    if tex.exemplar.map("height").is_none() {
+        return Err(bad(format!("texture '{}' has no height map", tex.config.id)));
+    }
+    Ok(scale)
 }
 
 /// The bytes of a tile's image, through the pipeline.
@@ -194,6 +229,9 @@ pub async fn gltf_tile(
     peer: Peer,
 ) -> Result<Response, ApiError> {
     let (r, ext) = tile_request(&st, path, raw, &["glb", "gltf", "png"])?;
+    if ext != "glb" {
+        r.flat_only(&format!(".{ext}"))?;
+    }
     let cc = &st.config.cache_control;
     if ext == "png" {
         let job = r.image();
@@ -229,7 +267,8 @@ pub async fn gltf_tile(
 /// A tile's GLB answer (conditional requests, tile cache), for `/gltf` and 3D Tiles content.
 pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &HeaderMap) -> Result<Response, ApiError> {
     let cc = &st.config.cache_control;
-    let etag = etag_for(&key(r, "glb", &r.material_key()));
+    let relief_key = r.relief.map(|v| format!("|relief={v}")).unwrap_or_default();
+    let etag = etag_for(&key(r, "glb", &format!("{}{relief_key}", r.material_key())));
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
@@ -243,9 +282,20 @@ pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &Head
         let job = ImageJob { map: MapChoice::Map(name), ..r.image() };
         maps.push((slot, tile_png(st, &job.etag(), job).await?));
     }
+    let relief = match r.relief {
+        Some(scale) => {
+            let job = ImageJob { map: MapChoice::Map("height".into()), ..r.image() };
+            let png = tile_png(st, &job.etag(), job).await?;
+            let img = image::load_from_memory(&png).map_err(|e| ApiError::internal(format!("height map: {e}")))?;
+            Some(Relief::from_border_image(&img.to_luma8(), scale))
+        }
+        None => None,
+    };
     let q = quad(&r.tex, &r.spec);
-    let (bytes, hit) =
-        cached(st, &etag, GLTF_LABEL, move |_| Ok(glb(&[q], &[(png, "image/png")], &maps, &generator()))).await;
+    let (bytes, hit) = cached(st, &etag, GLTF_LABEL, move |_| {
+        Ok(glb(&[q], &[(png, "image/png")], &maps, relief.as_ref(), &generator()))
+    })
+    .await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
@@ -278,9 +328,10 @@ fn patch_request(
             format!("the patch must end at or before {COORD_MAX}"),
         ));
     }
+    let relief = reader.take("relief").map(|v| relief_scale(&tex, &v)).transpose()?;
     let params = params(&tex, reader)?;
     let query = pairs.into_iter().filter(|(k, _)| !["z", "x", "y", "tiles"].contains(&k.as_str())).collect();
-    Ok((TileRequest { tex, spec: origin, query, params }, n))
+    Ok((TileRequest { tex, spec: origin, query, params, relief }, n))
 }
 
 /// The tiles of an N×N patch, row by row.
@@ -302,6 +353,7 @@ pub async fn gltf_patch(
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     let (r, n) = patch_request(&st, path, raw)?;
+    r.flat_only("patches")?;
     let etag = etag_for(&key(&r, "patch", &n.to_string()));
     let cc = &st.config.cache_control;
     if if_none_match(&headers, &etag) {
@@ -319,7 +371,7 @@ pub async fn gltf_patch(
         images.push((tile_png(&st, &job.etag(), job).await?, "image/png"));
         quads.push(quad(&r.tex, &spec));
     }
-    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&quads, &images, &[], &generator()))).await;
+    let (bytes, hit) = cached(&st, &etag, GLTF_LABEL, move |_| Ok(glb(&quads, &images, &[], None, &generator()))).await;
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
@@ -347,6 +399,7 @@ pub async fn x3d_tile(
     peer: Peer,
 ) -> Result<Response, ApiError> {
     let (r, _) = tile_request(&st, path, raw, &["x3d"])?;
+    r.flat_only("X3D")?;
     let base = base_url(&st, &headers, peer);
     let etag = etag_for(&key(&r, "x3d", &base));
     Ok(x3d_answer(&st, &headers, &etag, || {
@@ -369,6 +422,7 @@ pub async fn x3d_patch(
     peer: Peer,
 ) -> Result<Response, ApiError> {
     let (r, n) = patch_request(&st, path, raw)?;
+    r.flat_only("X3D")?;
     let base = base_url(&st, &headers, peer);
     let etag = etag_for(&key(&r, "x3d-patch", &format!("{n}|{base}")));
     Ok(x3d_answer(&st, &headers, &etag, || {
