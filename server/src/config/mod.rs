@@ -288,7 +288,8 @@ mod tests {
     #[test]
     fn built_in_config_is_valid() {
         let cfg = Config::load(None, &Overrides::default()).unwrap();
-        assert_eq!(cfg.textures.len(), 4);
+        assert_eq!(cfg.textures.len(), 5);
+        assert_eq!(cfg.textures[4].map_images().count(), 3, "the flagstones material");
         assert_eq!(cfg.bind, "127.0.0.1:8080");
         assert_eq!(cfg.textures[3].lattice, Some([2, 4]));
     }
