@@ -11,9 +11,13 @@ use std::process::Command;
 
 use common::Server;
 
+fn dir_of_validator() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/gltf")
+}
+
 #[test]
 fn khronos_validator_accepts_every_gltf_answer() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/gltf");
+    let dir = dir_of_validator();
     if let Err(why) = common::npm_ready(&dir, "gltf-validator") {
         return common::skip("khronos_validator_accepts_every_gltf_answer", &why);
     }
@@ -41,4 +45,29 @@ fn khronos_validator_accepts_every_gltf_answer() {
     eprintln!("{report}{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "the validator reported errors or warnings");
     assert_eq!(report.matches("0 errors, 0 warnings").count(), 11, "{report}");
+    // A material with roughness and metallic maps (packed into metallicRoughnessTexture).
+    let dir = tempfile::tempdir().unwrap();
+    let m = |f: &str| format!("embedded:materials/forest_floor/{f}.png");
+    let cfg = dir.path().join("rough.toml");
+    std::fs::write(
+        &cfg,
+        format!(
+            "[[textures]]\nid = \"rough\"\nexemplar = \"{}\"\n[textures.maps]\nroughness = \"{}\"\nmetallic = \"{}\"\n",
+            m("albedo"),
+            m("height"),
+            m("specular")
+        ),
+    )
+    .unwrap();
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    let out = Command::new("node")
+        .arg("validate.mjs")
+        .arg(&s.base)
+        .arg("/gltf/rough/8/-2/5.glb?seed=4")
+        .current_dir(dir_of_validator())
+        .output()
+        .expect("run node");
+    let report = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{report}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success() && report.contains("0 errors, 0 warnings"), "{report}");
 }

@@ -297,3 +297,41 @@ async fn relief_meshes_are_displaced_by_the_height_map_and_neighbours_share_thei
         assert_error(&s, path, 400, code).await;
     }
 }
+
+/// A texture whose roughness and metallic maps are the forest floor's height and specular maps
+/// (stand-ins: no embedded material has them).
+fn rough_metal_config(dir: &std::path::Path) -> std::path::PathBuf {
+    let m = |f: &str| format!("embedded:materials/forest_floor/{f}.png");
+    let text = format!(
+        "[[textures]]\nid = \"rough\"\nexemplar = \"{}\"\n[textures.maps]\nroughness = \"{}\"\nmetallic = \"{}\"\n",
+        m("albedo"),
+        m("height"),
+        m("specular")
+    );
+    let cfg = dir.join("rough.toml");
+    std::fs::write(&cfg, text).unwrap();
+    cfg
+}
+
+#[tokio::test]
+async fn roughness_and_metallic_maps_are_packed_into_the_gltf_metallic_roughness_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = rough_metal_config(dir.path());
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    let (status, bytes) = s.get_bytes("/gltf/rough/8/-2/5.glb?seed=4").await;
+    assert_eq!(status, 200);
+    let (json, bin) = parse_glb(&bytes);
+    let pbr = &json["materials"][0]["pbrMetallicRoughness"];
+    assert_eq!((pbr["metallicFactor"].as_f64(), pbr["roughnessFactor"].as_f64()), (Some(1.0), Some(1.0)));
+    let texture = pbr["metallicRoughnessTexture"]["index"].as_u64().unwrap() as usize;
+    let image = json["textures"][texture]["source"].as_u64().unwrap() as usize;
+    let view = &json["bufferViews"][json["images"][image]["bufferView"].as_u64().unwrap() as usize];
+    let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+    let packed = image::load_from_memory(&bin[o..o + l]).unwrap().to_rgb8();
+    let window =
+        |map: &str| format!("/windows/rough.png?x={}&y={}&w=288&h=288&z=8&seed=4&map={map}", -512 - 16, 1280 - 16);
+    let (rough, metal) = (s.image(&window("roughness")).await, s.image(&window("metallic")).await);
+    for (x, y, p) in packed.enumerate_pixels() {
+        assert_eq!(p.0, [255, rough.get_pixel(x, y).0[0], metal.get_pixel(x, y).0[0]], "packed texel ({x},{y})");
+    }
+}

@@ -62,6 +62,22 @@ fn pad4(v: &mut Vec<u8>, byte: u8) {
     }
 }
 
+/// Append `bytes` to the binary buffer as a new buffer view (of `target`, when given), 4-aligned.
+fn push_view(bin: &mut Vec<u8>, views: &mut Vec<Value>, bytes: &[u8], target: Option<u32>) {
+    let mut view = json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() });
+    if let Some(t) = target {
+        view["target"] = json!(t);
+    }
+    views.push(view);
+    bin.extend_from_slice(bytes);
+    pad4(bin, 0);
+}
+
+/// Little-endian bytes of floats.
+fn le(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
 /// Geometry shared by every quad of a document: positions, normals, texture coordinates and
 /// indices of a `size × size` quad facing up, as one little-endian byte block with its views.
 fn geometry(size: f32) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
@@ -72,16 +88,10 @@ fn geometry(size: f32) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
     let uv = [[near, near], [far, near], [far, far], [near, far]];
     let idx: [u16; 6] = [0, 2, 1, 0, 3, 2];
     let mut views = Vec::new();
-    let mut push = |b: &mut Vec<u8>, bytes: Vec<u8>, target: u32| {
-        let offset = b.len();
-        b.extend_from_slice(&bytes);
-        views.push(json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target }));
-        pad4(b, 0);
-    };
-    push(&mut b, pos.iter().flatten().flat_map(|v: &f32| v.to_le_bytes()).collect(), 34962);
-    push(&mut b, nrm.iter().flatten().flat_map(|v| v.to_le_bytes()).collect(), 34962);
-    push(&mut b, uv.iter().flatten().flat_map(|v| v.to_le_bytes()).collect(), 34962);
-    push(&mut b, idx.iter().flat_map(|v| v.to_le_bytes()).collect(), 34963);
+    push_view(&mut b, &mut views, &le(pos.as_flattened()), Some(34962));
+    push_view(&mut b, &mut views, &le(nrm.as_flattened()), Some(34962));
+    push_view(&mut b, &mut views, &le(uv.as_flattened()), Some(34962));
+    push_view(&mut b, &mut views, &idx.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>(), Some(34963));
     let accessors = vec![
         json!({ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0.0, 0.0, 0.0], "max": [size, 0.0, size] }),
         json!({ "bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3" }),
@@ -172,19 +182,11 @@ fn relief_geometry(size: f32, r: &Relief) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
             idx.extend([a, c, b, a, d, c]);
         }
     }
-    let mut b = Vec::new();
-    let mut views = Vec::new();
-    let mut push = |b: &mut Vec<u8>, bytes: Vec<u8>, target: u32| {
-        let offset = b.len();
-        b.extend_from_slice(&bytes);
-        views.push(json!({ "buffer": 0, "byteOffset": offset, "byteLength": bytes.len(), "target": target }));
-        pad4(b, 0);
-    };
-    let le = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
-    push(&mut b, le(&pos), 34962);
-    push(&mut b, le(&nrm), 34962);
-    push(&mut b, le(&uv), 34962);
-    push(&mut b, idx.iter().flat_map(|v| v.to_le_bytes()).collect(), 34963);
+    let (mut b, mut views) = (Vec::new(), Vec::new());
+    push_view(&mut b, &mut views, &le(&pos), Some(34962));
+    push_view(&mut b, &mut views, &le(&nrm), Some(34962));
+    push_view(&mut b, &mut views, &le(&uv), Some(34962));
+    push_view(&mut b, &mut views, &idx.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>(), Some(34963));
     let (v0, v1) = (0.5 * step, (n as f32 - 0.5) * step);
     let accessors = vec![
         json!({ "bufferView": 0, "componentType": 5126, "count": n * n, "type": "VEC3", "min": [v0, lo, v0], "max": [v1, hi, v1] }),
@@ -205,6 +207,27 @@ pub enum Slot {
     /// `KHR_materials_specular`'s `specularColorTexture`: a game's grey specular intensity `s`
     /// scales the dielectric reflectance, `F0 = 0.04 · s` (1 = a plain dielectric's highlight).
     Specular,
+    /// A roughness map: the G channel of `metallicRoughnessTexture` ([`metallic_roughness`]).
+    Roughness,
+    /// A metallic map: the B channel of `metallicRoughnessTexture`.
+    Metallic,
+    /// `metallicRoughnessTexture` itself: G roughness, B metalness (factors 1).
+    MetallicRoughness,
+}
+
+/// glTF's packed `metallicRoughnessTexture` of a tile: G from the roughness map (fully rough
+/// where there is none), B from the metallic map (no metal where there is none), R unused
+/// (255). Both images, when given, are the tile's bordered windows of those maps.
+pub fn metallic_roughness(
+    roughness: Option<&image::GrayImage>,
+    metallic: Option<&image::GrayImage>,
+) -> image::RgbImage {
+    let side = image_side();
+    image::RgbImage::from_fn(side, side, |x, y| {
+        let g = roughness.and_then(|r| r.get_pixel_checked(x, y)).map_or(255, |p| p.0[0]);
+        let b = metallic.and_then(|m| m.get_pixel_checked(x, y)).map_or(0, |p| p.0[0]);
+        image::Rgb([255, g, b])
+    })
 }
 
 impl Slot {
@@ -214,6 +237,8 @@ impl Slot {
             "normal" => Some(Slot::Normal),
             "ao" => Some(Slot::Occlusion),
             "specular" => Some(Slot::Specular),
+            "roughness" => Some(Slot::Roughness),
+            "metallic" => Some(Slot::Metallic),
             _ => None,
         }
     }
@@ -235,6 +260,14 @@ fn add_maps(doc: &mut Value, m: usize, maps: &[(Slot, usize)]) {
                     json!({ "specularColorTexture": { "index": texture }, "specularFactor": 1.0 });
                 doc["extensionsUsed"] = json!(["KHR_materials_specular"]);
             }
+            Slot::MetallicRoughness => {
+                let pbr = &mut mat["pbrMetallicRoughness"];
+                pbr["metallicRoughnessTexture"] = json!({ "index": texture });
+                pbr["metallicFactor"] = json!(1.0);
+                pbr["roughnessFactor"] = json!(1.0);
+            }
+            // Packed into MetallicRoughness by the caller.
+            Slot::Roughness | Slot::Metallic => {}
         }
     }
 }
@@ -258,19 +291,13 @@ pub fn glb(
     let all = images.iter().map(|(b, mime)| (b, *mime)).chain(maps.iter().map(|(_, b)| (b, "image/png")));
     for (bytes, mime) in all {
         imgs.push(json!({ "bufferView": views.len(), "mimeType": mime }));
-        views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));
-        bin.extend_from_slice(bytes);
-        pad4(&mut bin, 0);
+        push_view(&mut bin, &mut views, bytes, None);
     }
     // A normal map needs a tangent space: +X (increasing u) with w = +1, so that the
     // bitangent N × T = −Z is north, the image's up, as the maps' +Y.
     let mut accessors = accessors;
     let tangent = maps.iter().any(|(s, _)| *s == Slot::Normal).then(|| {
-        let bytes: Vec<u8> =
-            vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-        views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len(), "target": 34962 }));
-        bin.extend_from_slice(&bytes);
-        pad4(&mut bin, 0);
+        push_view(&mut bin, &mut views, &le(vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].as_flattened()), Some(34962));
         accessors
             .push(json!({ "bufferView": views.len() - 1, "componentType": 5126, "count": vertices, "type": "VEC4" }));
         accessors.len() - 1

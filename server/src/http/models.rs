@@ -17,7 +17,7 @@ use std::collections::BTreeMap;
 use textile_core::maps::MapChoice;
 use textile_core::{ModeParams, ParamReader, TILE_SIZE};
 
-use crate::assets::{glb, gltf_json, image_side, x3d, Quad, Relief, Slot, BORDER, LAYOUT};
+use crate::assets::{glb, gltf_json, image_side, metallic_roughness, x3d, Quad, Relief, Slot, BORDER, LAYOUT};
 use crate::encode::Format;
 use crate::error::ApiError;
 use crate::http::content::{if_none_match, image, not_modified};
@@ -278,9 +278,23 @@ pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &Head
     let job = r.image();
     let png = tile_png(st, &job.etag(), job).await?;
     let mut maps = Vec::new();
+    let (mut roughness, mut metallic) = (None, None);
     for (slot, name) in r.material_maps() {
         let job = ImageJob { map: MapChoice::Map(name), ..r.image() };
-        maps.push((slot, tile_png(st, &job.etag(), job).await?));
+        let png = tile_png(st, &job.etag(), job).await?;
+        let grey = || image::load_from_memory(&png).map(|i| i.to_luma8());
+        match slot {
+            Slot::Roughness => roughness = Some(grey().map_err(|e| ApiError::internal(format!("roughness: {e}")))?),
+            Slot::Metallic => metallic = Some(grey().map_err(|e| ApiError::internal(format!("metallic: {e}")))?),
+            _ => maps.push((slot, png)),
+        }
+    }
+    if roughness.is_some() || metallic.is_some() {
+        let packed = metallic_roughness(roughness.as_ref(), metallic.as_ref());
+        let side = image_side();
+        let png = crate::encode::encode(packed.as_raw(), side, side, Format::Png, crate::encode::Effort::Quick)
+            .map_err(|e| ApiError::internal(format!("encoding: {e}")))?;
+        maps.push((Slot::MetallicRoughness, png));
     }
     let relief = match r.relief {
         Some(scale) => {
