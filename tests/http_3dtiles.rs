@@ -204,3 +204,17 @@ async fn bad_3dtiles_requests_are_json_4xx() {
         assert_error(&s, path, status, code).await;
     }
 }
+
+#[tokio::test]
+async fn a_tileset_with_relief_serves_displaced_content() {
+    let s = Server::builder().start();
+    let tileset = s.json("/3dtiles/flagstones/tileset.json?relief=8").await;
+    let uri = tileset["root"]["content"]["uri"].as_str().unwrap_or_default().to_string();
+    assert!(uri.contains("relief=8"), "content URIs carry the relief: {uri}");
+    let (status, bytes) = s.get_bytes("/3dtiles/flagstones/tiles/2/1/1.glb?relief=8").await;
+    assert_eq!(status, 200);
+    let (json, _) = common::parse_glb(&bytes);
+    assert_eq!(json["accessors"][0]["count"], 257 * 257, "a displaced grid");
+    // A texture without a height map has no relief.
+    assert_error(&s, "/3dtiles/gravel/tileset.json?relief=8", 400, "invalid_parameter").await;
+}

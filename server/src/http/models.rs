@@ -92,15 +92,7 @@ impl TileRequest {
         spec: TileSpec,
         pairs: Vec<(String, String)>,
     ) -> Result<TileRequest, ApiError> {
-        let mut r = ParamReader::request(pairs.clone())?;
-        let relief = r.take("relief").map(|v| relief_scale(&tex, &v)).transpose()?;
-        let params = params(&tex, r)?;
-        if relief.is_some() && !params.info().renders_maps {
-            return Err(ApiError::bad_request(
-                "invalid_parameter",
-                format!("parameter 'relief': mode={} does not render material maps", params.name()),
-            ));
-        }
+        let (params, relief) = params_with_relief(&tex, ParamReader::request(pairs.clone())?)?;
         Ok(TileRequest { tex, spec, query: pairs.into_iter().collect(), params, relief })
     }
 
@@ -162,6 +154,20 @@ impl TileRequest {
     }
 }
 
+/// A 3D asset's query: the mode's parameters and `relief`, which needs a mode that renders
+/// material maps.
+pub(super) fn params_with_relief(tex: &Texture, mut r: ParamReader) -> Result<(ModeParams, Option<f32>), ApiError> {
+    let relief = r.take("relief").map(|v| relief_scale(tex, &v)).transpose()?;
+    let params = params(tex, r)?;
+    if relief.is_some() && !params.info().renders_maps {
+        return Err(ApiError::bad_request(
+            "invalid_parameter",
+            format!("parameter 'relief': mode={} does not render material maps", params.name()),
+        ));
+    }
+    Ok((params, relief))
+}
+
 /// Read `relief=SCALE`: the height in texels of the height map's white, in (0, 256]; the
 /// texture must have a height map.
 fn relief_scale(tex: &Texture, v: &str) -> Result<f32, ApiError> {
@@ -218,7 +224,8 @@ fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
 #[utoipa::path(get, path = "/gltf/{id}/{z}/{x}/{y}.{ext}", tag = "3d",
     params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
            ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row"),
-           ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png`")),
+           ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png`"),
+           ("relief" = Option<f32>, Query, description = "glb of a texture with a height map: the mesh displaced, white this many texels high, (0, 256]")),
     responses((status = 200, description = "model/gltf-binary or model/gltf+json"), (status = 304, description = "not modified"),
               (status = 400, description = "bad coordinates or parameters"), (status = 404, description = "unknown texture")))]
 pub async fn gltf_tile(

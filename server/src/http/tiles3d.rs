@@ -14,9 +14,9 @@ use crate::encode::Format;
 use crate::error::ApiError;
 use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{path_error, texture};
-use crate::http::models::{generator, glb_tile, split_ext, TileRequest};
+use crate::http::models::{generator, glb_tile, params_with_relief, split_ext, TileRequest};
 use crate::pipeline::{cache_key, etag_for};
-use crate::request::{params, query_pairs, query_string, TileSpec};
+use crate::request::{query_pairs, query_string, TileSpec};
 use crate::state::AppState;
 use crate::textures::Texture;
 use crate::tileset::{enu_to_ecef, subtree, tileset, xyz_row, Tree, SUBTREE_LEVELS};
@@ -93,7 +93,7 @@ pub async fn tileset_json(
     };
     // Everything else is the tiles' query: validated here, carried into the content URIs.
     let pairs = without_anchoring(raw.as_deref());
-    let p = params(&tex, ParamReader::request(pairs.clone())?)?;
+    let (p, _) = params_with_relief(&tex, ParamReader::request(pairs.clone())?)?;
     // Sorted: one URI (and cache entry) per set of parameters, however they were ordered.
     let query = query_string(&pairs.into_iter().collect::<std::collections::BTreeMap<_, _>>());
     let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset|{query}|{transform:?}")));
