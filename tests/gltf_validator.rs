@@ -47,18 +47,7 @@ fn khronos_validator_accepts_every_gltf_answer() {
     assert_eq!(report.matches("0 errors, 0 warnings").count(), 11, "{report}");
     // A material with roughness and metallic maps (packed into metallicRoughnessTexture).
     let dir = tempfile::tempdir().unwrap();
-    let m = |f: &str| format!("embedded:materials/forest_floor/{f}.png");
-    let cfg = dir.path().join("rough.toml");
-    std::fs::write(
-        &cfg,
-        format!(
-            "[[textures]]\nid = \"rough\"\nexemplar = \"{}\"\n[textures.maps]\nroughness = \"{}\"\nmetallic = \"{}\"\n",
-            m("albedo"),
-            m("height"),
-            m("specular")
-        ),
-    )
-    .unwrap();
+    let cfg = common::rough_metal_config(dir.path());
     let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
     let out = Command::new("node")
         .arg("validate.mjs")

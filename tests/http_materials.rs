@@ -298,25 +298,10 @@ async fn relief_meshes_are_displaced_by_the_height_map_and_neighbours_share_thei
     }
 }
 
-/// A texture whose roughness and metallic maps are the forest floor's height and specular maps
-/// (stand-ins: no embedded material has them).
-fn rough_metal_config(dir: &std::path::Path) -> std::path::PathBuf {
-    let m = |f: &str| format!("embedded:materials/forest_floor/{f}.png");
-    let text = format!(
-        "[[textures]]\nid = \"rough\"\nexemplar = \"{}\"\n[textures.maps]\nroughness = \"{}\"\nmetallic = \"{}\"\n",
-        m("albedo"),
-        m("height"),
-        m("specular")
-    );
-    let cfg = dir.join("rough.toml");
-    std::fs::write(&cfg, text).unwrap();
-    cfg
-}
-
 #[tokio::test]
 async fn roughness_and_metallic_maps_are_packed_into_the_gltf_metallic_roughness_texture() {
     let dir = tempfile::tempdir().unwrap();
-    let cfg = rough_metal_config(dir.path());
+    let cfg = common::rough_metal_config(dir.path());
     let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
     let (status, bytes) = s.get_bytes("/gltf/rough/8/-2/5.glb?seed=4").await;
     assert_eq!(status, 200);

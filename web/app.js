@@ -144,24 +144,21 @@ function retryShedTile(e) {
 
 function refreshLayer() {
   const url = tileUrl();
+  const options = {
+    tileSize: 256, noWrap: true, minZoom: meta.minzoom, maxZoom: meta.maxzoom + 2,
+    minNativeZoom: meta.minzoom, maxNativeZoom: meta.maxzoom, keepBuffer: 1,
+    attribution: meta.attribution || '',
+  };
+  // The lit layer draws from the current URLs when it is made: a change makes a new one.
   const lit = state.a === 'lit';
-  if (layer && (layer instanceof LitLayer) !== lit) { map.removeLayer(layer); layer = null; }
+  if (layer && (lit || layer instanceof LitLayer)) { map.removeLayer(layer); layer = null; }
   if (lit) {
-    if (layer) map.removeLayer(layer);
-    layer = new LitLayer({
-      tileSize: 256, noWrap: true, minZoom: meta.minzoom, maxZoom: meta.maxzoom + 2,
-      minNativeZoom: meta.minzoom, maxNativeZoom: meta.maxzoom, keepBuffer: 1,
-      attribution: meta.attribution || '',
-    }).addTo(map);
+    layer = new LitLayer(options).addTo(map);
     writeHash();
     return;
   }
   if (!layer) {
-    layer = L.tileLayer(url, {
-      tileSize: 256, noWrap: true, minZoom: meta.minzoom, maxZoom: meta.maxzoom + 2,
-      minNativeZoom: meta.minzoom, maxNativeZoom: meta.maxzoom, keepBuffer: 1,
-      attribution: meta.attribution || '',
-    }).addTo(map);
+    layer = L.tileLayer(url, options).addTo(map);
     layer.on('tileerror', retryShedTile);
   } else if (layer._url !== url) {
     layer.setUrl(url);

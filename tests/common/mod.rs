@@ -331,3 +331,18 @@ pub fn f32s(json: &serde_json::Value, bin: &[u8], accessor: usize) -> Vec<f32> {
     let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
     bin[o..o + l].chunks(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
 }
+
+/// Write `rough.toml` in `dir`: a texture `rough` whose roughness and metallic maps are the
+/// forest floor's height and specular maps (stand-ins: no embedded material has them).
+pub fn rough_metal_config(dir: &Path) -> PathBuf {
+    let m = |f: &str| format!("embedded:materials/forest_floor/{f}.png");
+    let text = format!(
+        "[[textures]]\nid = \"rough\"\nexemplar = \"{}\"\n[textures.maps]\nroughness = \"{}\"\nmetallic = \"{}\"\n",
+        m("albedo"),
+        m("height"),
+        m("specular")
+    );
+    let cfg = dir.join("rough.toml");
+    std::fs::write(&cfg, text).expect("write rough.toml");
+    cfg
+}
