@@ -113,7 +113,7 @@ async fn normals_are_unit_length_at_every_zoom_and_follow_the_synthesized_height
     let cfg = materials_config(dir.path(), "embedded:materials/forest_floor/height.png");
     let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
     for id in ["flagstones", "forest"] {
-        for mode in ["synth", "mosaic", "tiling"] {
+        for mode in ["synth", "mosaic", "tiling", "umbrella"] {
             for z in [6u32, 7, 8, 9, 10] {
                 let tile = s.image(&format!("/tiles/{id}/{z}/5/-2.png?mode={mode}&map=normal")).await;
                 for p in tile.pixels() {
@@ -125,23 +125,28 @@ async fn normals_are_unit_length_at_every_zoom_and_follow_the_synthesized_height
         }
         // Slopes of the synthesized normals against central differences of the synthesized
         // height, in the served (OpenGL, +Y up) convention: x slope ~ -dh/dx, y ~ +dh/drow.
-        let q = "x=1000&y=-3000&w=512&h=512&seed=7";
-        let normal = s.image(&format!("/windows/{id}.png?{q}&map=normal")).await;
-        let height = s.image(&format!("/windows/{id}.png?{q}&map=height")).await;
-        let h = |x: u32, y: u32| height.get_pixel(x, y).0[0] as f64;
-        let (mut sx, mut sy) = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
-        for y in 1..511 {
-            for x in 1..511 {
-                let n = decode(normal.get_pixel(x, y));
-                sx.0.push(n[0] / n[2]);
-                sx.1.push(-(h(x + 1, y) - h(x - 1, y)));
-                sy.0.push(n[1] / n[2]);
-                sy.1.push(h(x, y + 1) - h(x, y - 1));
+        // Umbrella patches are turned (flagstones up to ±91°) and their normals with them;
+        // their rims cut the height where the normal map sees no edge, so they agree less
+        // (0.45-0.50; unturned normals gave 0.33-0.38).
+        for (mode, least) in [("synth", 0.5), ("umbrella", 0.42)] {
+            let q = format!("x=1000&y=-3000&w=512&h=512&seed=7&mode={mode}");
+            let normal = s.image(&format!("/windows/{id}.png?{q}&map=normal")).await;
+            let height = s.image(&format!("/windows/{id}.png?{q}&map=height")).await;
+            let h = |x: u32, y: u32| height.get_pixel(x, y).0[0] as f64;
+            let (mut sx, mut sy) = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
+            for y in 1..511 {
+                for x in 1..511 {
+                    let n = decode(normal.get_pixel(x, y));
+                    sx.0.push(n[0] / n[2]);
+                    sx.1.push(-(h(x + 1, y) - h(x - 1, y)));
+                    sy.0.push(n[1] / n[2]);
+                    sy.1.push(h(x, y + 1) - h(x, y - 1));
+                }
             }
+            let (cx, cy) = (correlation(&sx.0, &sx.1), correlation(&sy.0, &sy.1));
+            println!("{id} {mode}: correlation of normal slopes with height gradients: x {cx:.3}, y {cy:.3}");
+            assert!(cx >= least && cy >= least, "{id} {mode}: normals disagree with the height: x {cx:.3}, y {cy:.3}");
         }
-        let (cx, cy) = (correlation(&sx.0, &sx.1), correlation(&sy.0, &sy.1));
-        println!("{id}: correlation of normal slopes with height gradients: x {cx:.3}, y {cy:.3}");
-        assert!(cx >= 0.5 && cy >= 0.5, "{id}: normals disagree with the height: x {cx:.3}, y {cy:.3}");
     }
     // Per-sample queries of a map equal its tile's pixels; filtered footprints of normals are
     // unit vectors.
@@ -179,7 +184,7 @@ async fn normals_are_unit_length_at_every_zoom_and_follow_the_synthesized_height
         assert!((len - 1.0).abs() <= 1.0 / 127.0, "filtered normal {p:?} has length {len}");
     }
     // Requests a mode cannot serve, and maps a texture does not have.
-    assert_error(&s, "/tiles/forest/8/0/0.png?map=normal&mode=umbrella", 400, "invalid_map").await;
+    assert_error(&s, "/tiles/forest/8/0/0.png?map=uv&mode=umbrella", 400, "invalid_map").await;
     assert_error(&s, "/tiles/forest/8/0/0.png?map=uv&mode=mosaic", 400, "invalid_map").await;
     assert_error(&s, "/tiles/forest/8/0/0.jpg?map=uv", 400, "invalid_map").await;
     assert_error(&s, "/tiles/forest/8/0/0.png?map=roughness", 400, "invalid_map").await;
@@ -292,10 +297,12 @@ async fn relief_meshes_are_displaced_by_the_height_map_and_neighbours_share_thei
         ("/x3d/flagstones/8/3/-2.x3d?relief=12", "invalid_parameter"),
         ("/gltf/flagstones/8/3/-2.glb?relief=0", "invalid_parameter"),
         ("/gltf/flagstones/8/3/-2.glb?relief=1e9", "invalid_parameter"),
-        ("/gltf/flagstones/8/3/-2.glb?relief=12&mode=umbrella", "invalid_parameter"),
     ] {
         assert_error(&s, path, 400, code).await;
     }
+    // Every mode has a height map to displace by, umbrella patches included.
+    let (n, _) = relief(&s, "/gltf/flagstones/8/3/-2.glb?relief=12&mode=umbrella").await;
+    assert_eq!(n, 257);
 }
 
 #[tokio::test]

@@ -25,8 +25,9 @@ fn a_map_of_the_colours_renders_the_colour_in_every_mode_at_every_zoom() {
             let view = View::at(zoom, Rect::new(-37, 1000, 70, 50));
             let colour = p.render(&src, &Pyramid::off(), view);
             let mapped = p.render(&src.with_map(map), &Pyramid::off(), view);
-            if !mode.renders_maps {
-                assert!(matches!(mapped, Err(CoreError::Map { .. })), "{}: {mapped:?}", mode.name);
+            if mode.name == "umbrella" {
+                // Shadows, colour offsets and the gaps' calibration are the colour's alone.
+                assert_eq!(colour.is_ok(), mapped.is_ok(), "{}: {mapped:?}", mode.name);
                 continue;
             }
             rendering += 1;

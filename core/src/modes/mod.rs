@@ -201,9 +201,6 @@ pub trait Mode {
         None
     }
 
-    /// Whether the mode renders material maps ([`Source::map`]): modes that only look texels up
-    /// by coordinate do; a mode that cannot yet says so with `false`.
-    const RENDERS_MAPS: bool = true;
     /// Whether the mode's pixels are exemplar texels looked up by coordinate, which
     /// [`Mode::coordinates`] then gives (`map=uv`).
     const HAS_UV: bool = false;
@@ -250,8 +247,6 @@ pub struct ModeInfo {
     pub specs: &'static [ParamSpec],
     /// What it prepares per texture, if anything.
     pub preparation: Option<&'static dyn Step>,
-    /// Whether it renders material maps ([`Mode::RENDERS_MAPS`]).
-    pub renders_maps: bool,
     /// Whether it gives its coordinates ([`Mode::HAS_UV`]).
     pub has_uv: bool,
 }
@@ -276,7 +271,6 @@ impl ModeInfo {
             cost: M::COST,
             specs,
             preparation: M::preparation(),
-            renders_maps: M::RENDERS_MAPS,
             has_uv: M::HAS_UV,
         }
     }
@@ -379,13 +373,6 @@ macro_rules! modes {
             /// blended normals renormalised).
             pub fn render(&self, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
                 let Some(map) = src.map else { return self.render_texels(src, cache, view) };
-                if !self.info().renders_maps {
-                    return Err(CoreError::Map {
-                        name: map.name.clone(),
-                        message: format!("cannot be rendered in mode={} yet; modes that render maps: {}",
-                            self.name(), all_rendering_maps().join(", ")),
-                    });
-                }
                 let mut r = self.render_texels(src, cache, view)?;
                 if map.normal {
                     crate::maps::renormalise(&mut r.image.pixels);
@@ -420,11 +407,6 @@ impl ModeParams {
     pub fn name(&self) -> &'static str {
         self.info().name
     }
-}
-
-/// Names of the modes that render material maps.
-fn all_rendering_maps() -> Vec<&'static str> {
-    all().into_iter().filter(|m| m.renders_maps).map(|m| m.name).collect()
 }
 
 /// Every mode's parameters, for naming the mode a stray key belongs to.

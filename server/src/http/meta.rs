@@ -414,7 +414,7 @@ pub async fn method_not_allowed(req: axum::extract::Request, next: axum::middlew
 fn maps(t: &crate::textures::Texture) -> Value {
     use textile_core::maps::UV_SCALE;
     let modes = textile_core::modes::all();
-    let with_maps: Vec<&str> = modes.iter().filter(|m| m.renders_maps).map(|m| m.name).collect();
+    let with_maps: Vec<&str> = modes.iter().map(|m| m.name).collect();
     let with_uv: Vec<&str> = modes.iter().filter(|m| m.has_uv).map(|m| m.name).collect();
     let mut list = vec![json!({ "name": "albedo", "kind": "colour" })];
     for m in &t.exemplar.maps {

@@ -115,11 +115,8 @@ impl TileRequest {
     /// The image of the tile at `spec` with this request's texture and parameters: the PNG
     /// window of the tile and [`BORDER`] texels around it, at the tile's zoom.
     /// The material maps of this tile that go into its glTF material, `(slot, name)`: those of
-    /// the texture with a glTF slot, when the mode renders maps.
+    /// the texture with a glTF slot.
     fn material_maps(&self) -> Vec<(Slot, String)> {
-        if !self.params.info().renders_maps {
-            return Vec::new();
-        }
         self.tex.exemplar.maps.iter().filter_map(|m| Slot::of(&m.name).map(|s| (s, m.name.clone()))).collect()
     }
 
@@ -154,18 +151,10 @@ impl TileRequest {
     }
 }
 
-/// A 3D asset's query: the mode's parameters and `relief`, which needs a mode that renders
-/// material maps.
+/// A 3D asset's query: the mode's parameters and `relief`.
 pub(super) fn params_with_relief(tex: &Texture, mut r: ParamReader) -> Result<(ModeParams, Option<f32>), ApiError> {
     let relief = r.take("relief").map(|v| relief_scale(tex, &v)).transpose()?;
-    let params = params(tex, r)?;
-    if relief.is_some() && !params.info().renders_maps {
-        return Err(ApiError::bad_request(
-            "invalid_parameter",
-            format!("parameter 'relief': mode={} does not render material maps", params.name()),
-        ));
-    }
-    Ok((params, relief))
+    Ok((params(tex, r)?, relief))
 }
 
 /// Read `relief=SCALE`: the height in texels of the height map's white, in (0, 256]; the

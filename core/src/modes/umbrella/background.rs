@@ -1,4 +1,5 @@
-//! The background of the umbrella mode — another mode's pixels, or the exemplar's mean colour —
+//! The background of the umbrella mode — another mode's pixels, or the exemplar's mean colour
+//! (of the colour or of the map shown) —
 //! and the colour calibrations that shift it: so that the gaps between umbrellas keep the
 //! exemplar's mean colour, and zooming out past the last drawn zoom changes the detail, not
 //! the colour (memoised in the texture's caches).
@@ -125,7 +126,7 @@ pub(super) fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view
     Ok(match p.background {
         Background::Mosaic => {
             let mp = MosaicParams { seed: p.seed, period: p.period, ..MosaicParams::default() };
-            mosaic::render(ex, &mp, view.zoom_out, view.rect)?
+            mosaic::render_texels(ex, src.texels(), &mp, view.zoom_out, view.rect)?
         }
         Background::Synth => {
             let sp = SynthParams { seed: p.seed, period: p.period, ..SynthParams::default() };
@@ -138,7 +139,10 @@ pub(super) fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view
         Background::Mean => {
             let (w, h) = (view.rect.width() as usize, view.rect.height() as usize);
             // Rounded half up, as the exact integer means were.
-            let mean = mean_colour(ex).map(|v| v.round() as u8);
+            let mean = match src.map {
+                Some(map) => map.mean(),
+                None => mean_colour(ex).map(|v| v.round() as u8),
+            };
             RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) }
         }
     })

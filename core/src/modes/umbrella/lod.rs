@@ -106,7 +106,8 @@ impl Palette<'_> {
         let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
         let t = &self.arr.table[u.modified as usize];
         let hit = t.rim.locate(self.sectors, lx, ly)?;
-        Some(shape::colour(&self.el.bases[t.base], &self.rays, &t.colour, hit, self.footprint * u.inv_scale))
+        let c = shape::colour(&self.el.bases[t.base], &self.rays, &t.colour, hit, self.footprint * u.inv_scale);
+        Some(self.el.oriented(c, u.cos, u.sin, u.inv_scale))
     }
 }
 
@@ -466,7 +467,8 @@ pub fn colour_at(
         let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
         let t = &arr.table[u.modified as usize];
         let hit = t.rim.locate_clamped(sectors, lx, ly);
-        return shape::colour(&el.bases[t.base], rays, &t.colour, hit, footprint * u.inv_scale);
+        let c = shape::colour(&el.bases[t.base], rays, &t.colour, hit, footprint * u.inv_scale);
+        return el.oriented(c, u.cos, u.sin, u.inv_scale);
     }
     merged_colour(l.m, [l.origin[0] + q[0] as f64, l.origin[1] + q[1] as f64]).unwrap_or(l.m.centre)
 }

@@ -14,6 +14,7 @@ mod background;
 pub mod extract;
 pub mod handmade;
 pub mod lod;
+mod maps;
 mod paint;
 mod params;
 pub mod prepared;
@@ -65,8 +66,6 @@ impl Mode for Umbrella {
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
     const COST: Cost = Cost::Heavy;
-    /// Patches rotate, and tangent-space normals would have to turn with them: not yet.
-    const RENDERS_MAPS: bool = false;
     type Params = UmbrellaParams;
 
     fn specs() -> &'static [ParamSpec] {
@@ -146,20 +145,31 @@ impl Mode for Umbrella {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
         let state = state(src)?;
-        let (elements, ident) = state.elements()?;
+        let (elements, ident) = match src.map {
+            Some(map) => state.map_elements(src.exemplar, map)?,
+            None => state.elements()?,
+        };
         let caches = &state.caches;
         let arr = Arrangement::cached(&elements, p, &ident, caches.clone());
+        // Shadows and the colour calibrations are the colour's: a map shows the elements'
+        // own values over its background's.
+        let colour = src.map.is_none();
+        let shadowless = UmbrellaParams { shadow: 0, ..p.clone() };
+        let p = if colour { p } else { &shadowless };
         // Level 0 (every umbrella) while a cell is at least `lod::LOD_PIXELS` wide, then the
         // merged levels of detail, then the background's own zoomed-out pixels.
         let level = lod::level(&arr, view.zoom_out);
         let Some(level) = level else {
             // Shifted to the umbrellas' mean colour, so that zooming out past the last drawn
             // zoom changes the detail, not the colour.
-            let shift = colour_shift(&arr, &elements, p, &ident, src, cache, umbrella_zooms(&arr))?;
+            let shift = match colour {
+                true => colour_shift(&arr, &elements, p, &ident, src, cache, umbrella_zooms(&arr))?,
+                false => [0.0; 3],
+            };
             let image = shifted(background(p, src, cache, view)?, shift);
             return Ok(Rendered { image, synthesized: rect.area() as u64 });
         };
-        let gaps = gap_shift(&arr, &elements, p, &ident, src, cache)?;
+        let gaps = if colour { gap_shift(&arr, &elements, p, &ident, src, cache)? } else { [0.0; 3] };
         let image = paint(&elements, &arr, p, view, level, || Ok(shifted(background(p, src, cache, view)?, gaps)))?;
         Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
     }

@@ -138,7 +138,8 @@ pub(super) fn paint(
                         let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
                         let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
                         let hit = m.rim.locate_clamped(&sectors, lx, ly);
-                        shape::colour(&el.bases[m.base], rays, &m.colour, hit, step as f32 * u.inv_scale).map(|v| v * f * 255.0)
+                        let c = shape::colour(&el.bases[m.base], rays, &m.colour, hit, step as f32 * u.inv_scale);
+                        el.oriented(c, u.cos, u.sin, u.inv_scale).map(|v| v * f * 255.0)
                     };
                     // A pixel whose sub-samples all see the same (most are): one evaluation.
                     // A sample's key: the umbrella it sees and its shadows.

@@ -5,7 +5,7 @@
 //! ([`Preparation::limit_caches`]) and counted in what the texture holds.
 
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use serde_json::{json, Map, Value};
 
@@ -17,6 +17,7 @@ use crate::progress::Progress;
 use crate::cancel::Cancel;
 use crate::error::{AnalysisFileProblem, CoreError, Result};
 use crate::exemplar::Exemplar;
+use crate::maps::MaterialMap;
 use crate::memo::Memo;
 use crate::prepare::{Input, Preparation, Setting};
 
@@ -90,12 +91,38 @@ pub struct Extraction {
     handmade: Option<String>,
     /// The caches its requests share.
     pub caches: Arc<Caches>,
+    /// The elements showing each material map rendered so far, by the map's hash
+    /// ([`Elements::of_map`]; one entry per map of the texture at most).
+    maps: Mutex<Vec<(String, Arc<Elements>)>>,
 }
 
 impl Extraction {
     /// An extraction of `outcome` with id `id`.
     fn new(id: String, outcome: Outcome, handmade: Option<String>) -> Extraction {
-        Extraction { id, outcome, handmade, caches: Arc::new(Caches::default()) }
+        Extraction { id, outcome, handmade, caches: Arc::new(Caches::default()), maps: Mutex::default() }
+    }
+
+    /// The elements showing material `map` of exemplar `ex` instead of its colours, with the
+    /// id that names them (the colour's and the map's hash): the same umbrellas, their
+    /// textures re-cut from the map. A hand-made set, whose elements were not cut from the
+    /// exemplar, has no maps: a map error saying so.
+    pub fn map_elements(&self, ex: &Exemplar, map: &MaterialMap) -> Result<(Arc<Elements>, String)> {
+        let (el, id) = self.elements()?;
+        let fail = |message: &str| CoreError::Map { name: map.name.clone(), message: message.into() };
+        if self.handmade.is_some() {
+            return Err(fail("cannot be rendered with a hand-made umbrella set (`set`): its elements were not cut from the exemplar"));
+        }
+        if map.side() != ex.side {
+            return Err(fail("is not the exemplar's size"));
+        }
+        let id = format!("{id}~{}", map.hash);
+        let mut maps = self.maps.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, e)) = maps.iter().find(|(h, _)| *h == map.hash) {
+            return Ok((e.clone(), id));
+        }
+        let e = Arc::new(el.of_map(&map.texels, ex.side as usize, map.normal));
+        maps.push((map.hash.clone(), e.clone()));
+        Ok((e, id))
     }
 
     /// The elements with the id that names them; none → a parameter error naming the mode.
@@ -207,9 +234,9 @@ impl Preparation for Extraction {
 
     fn memory_bytes(&self) -> u64 {
         // Texture (3 f32s) and alpha per texel, and about a third more for the mipmaps.
-        let elements =
-            self.outcome.as_ref().map_or(0, |e| e.bases.iter().map(|b| b.texture.len() as u64 * 13 * 4 / 3).sum::<u64>());
-        elements + self.caches.bytes()
+        let bytes = |e: &Elements| e.bases.iter().map(|b| b.texture.len() as u64 * 13 * 4 / 3).sum::<u64>();
+        let maps: u64 = self.maps.lock().map_or(0, |m| m.iter().map(|(_, e)| bytes(e)).sum());
+        self.outcome.as_ref().map_or(0, |e| bytes(e)) + maps + self.caches.bytes()
     }
 
     fn limit_caches(&self, bytes: u64) {

@@ -155,6 +155,7 @@ fn from_stored(s: StoredElements) -> std::result::Result<Elements, AnalysisFileP
         segmentation: s.segmentation,
         foreground: s.foreground,
         orientation_spread: s.orientation_spread.min(180),
+        normals: false,
     })
 }
 

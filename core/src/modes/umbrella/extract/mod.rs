@@ -136,6 +136,9 @@ pub struct Elements {
     /// are rotated by at most this either way from the orientation they were cut in. 180 (any
     /// rotation) for round elements or elements pointing every way.
     pub orientation_spread: u32,
+    /// Whether the textures are a tangent-space normal map's (`rgb = (n + 1) / 2`), whose
+    /// vectors turn with their umbrella ([`Elements::oriented`]); the colour's are not.
+    pub normals: bool,
 }
 
 /// A segmented element: its texels (a mask over the exemplar), centre and rim.
@@ -271,6 +274,7 @@ pub(super) fn assemble(px: &[[u8; 3]], m: usize, elements: &[Element], groups: &
         segmentation: s.segmentation,
         foreground: s.foreground,
         orientation_spread: s.orientation_spread,
+        normals: false,
     }
 }
 
