@@ -372,10 +372,12 @@ test('the map picker shows a material\'s maps, and the lit view shades colour by
   const changed = before.filter((v, i) => v !== after[i]).length;
   assert.ok(changed > 1000, `only ${changed} channel values changed with the light`);
   assert.match(await page.evaluate(() => location.hash), /a=lit/);
-  // A mode that renders no maps offers the colour only.
+  // Umbrella patches have every map too: the lit view stays, drawn from umbrella normals.
   await page.selectOption('#mode', 'umbrella');
-  assert.deepEqual(await page.$$eval('#mapsel option', (l) => l.map((o) => o.value)), ['albedo']);
-  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('mode=umbrella') && !i.src.includes('map=')));
+  assert.deepEqual(await page.$$eval('#mapsel option', (l) => l.map((o) => o.value)), offered);
+  assert.equal(await page.$eval('#mapsel', (s) => s.value), 'lit');
+  await page.waitForFunction(() => performance.getEntriesByType('resource').some((e) => e.name.includes('mode=umbrella') && e.name.includes('map=normal')));
+  await page.waitForFunction(() => document.querySelectorAll('canvas[data-lit="1"]').length >= 4);
   assert.deepEqual(errors, []);
   await page.close();
 });
