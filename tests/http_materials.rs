@@ -327,3 +327,127 @@ async fn roughness_and_metallic_maps_are_packed_into_the_gltf_metallic_roughness
         assert_eq!(p.0, [255, rough.get_pixel(x, y).0[0], metal.get_pixel(x, y).0[0]], "packed texel ({x},{y})");
     }
 }
+
+/// An embedded material file's bytes, as the repository holds it.
+fn material_file(material: &str, map: &str) -> Vec<u8> {
+    let path = format!("{}/../config/exemplars/materials/{material}/{map}.png", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+/// POST a multipart upload of the forest floor's colour with `maps` (part name, bytes) and
+/// `fields`: status and JSON body.
+async fn upload_material(
+    s: &Server,
+    token: &str,
+    fields: &[(&str, &str)],
+    maps: &[(&str, Vec<u8>)],
+) -> (u16, serde_json::Value) {
+    let part = |b: Vec<u8>| reqwest::multipart::Part::bytes(b).file_name("m.png").mime_str("image/png").unwrap();
+    let mut form = reqwest::multipart::Form::new().part("image", part(material_file("forest_floor", "albedo")));
+    for (k, v) in fields {
+        form = form.text(k.to_string(), v.to_string());
+    }
+    for (name, bytes) in maps {
+        form = form.part(name.to_string(), part(bytes.clone()));
+    }
+    let r = s.client.post(s.url("/admin/textures")).bearer_auth(token).multipart(form).send().await.unwrap();
+    let status = r.status().as_u16();
+    (status, r.json().await.unwrap_or(serde_json::Value::Null))
+}
+
+/// Wait until the texture at `location` is analysed (or fail after a minute).
+async fn ready(s: &Server, location: &str) {
+    for _ in 0..600 {
+        if s.json(location).await["status"] == "ready" {
+            return;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(100)).await;
+    }
+    panic!("{location} was not analysed within a minute");
+}
+
+fn files_in(dir: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|d| d.flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect())
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+#[tokio::test]
+async fn uploads_carry_maps_that_serve_as_a_configured_material_does() {
+    let (dir, data) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    let cfg = materials_config(dir.path(), "embedded:materials/forest_floor/height.png");
+    let token = "materials-admin-token-0123456789";
+    let start = || {
+        Server::builder()
+            .args(&["--config", cfg.to_str().unwrap()])
+            .data_dir(data.path())
+            .env("TEXTILE_ADMIN_TOKEN", token)
+            .start()
+    };
+    let s = start();
+    let uploads = data.path().join("uploads");
+    let (normal, height) = (material_file("forest_floor", "normal"), material_file("forest_floor", "height"));
+    let small = {
+        let mut buf = std::io::Cursor::new(Vec::new());
+        image::RgbImage::from_pixel(100, 100, image::Rgb([9, 99, 199]))
+            .write_to(&mut buf, image::ImageFormat::Png)
+            .unwrap();
+        buf.into_inner()
+    };
+    // Refused: each with a 400 naming the problem, and nothing stored.
+    type Refusal<'a> = (&'a [(&'a str, &'a str)], Vec<(&'a str, Vec<u8>)>, &'a str, &'a str);
+    let refusals: [Refusal; 5] = [
+        (&[("id", "mat")], vec![("map.normal", normal.clone())], "invalid_upload", "normal_convention"),
+        (
+            &[("id", "mat"), ("normal_convention", "opengl")],
+            vec![("map.normal", small.clone())],
+            "invalid_map",
+            "normal",
+        ),
+        (&[("id", "mat")], vec![("map.height", b"not an image".to_vec())], "invalid_map", "height"),
+        (&[("id", "mat")], vec![("map.uv", height.clone())], "invalid_map", "uv"),
+        (
+            &[("id", "mat"), ("normal_convention", "sideways")],
+            vec![("map.normal", normal.clone())],
+            "invalid_upload",
+            "sideways",
+        ),
+    ];
+    for (fields, maps, code, names) in refusals {
+        let (status, body) = upload_material(&s, token, fields, &maps).await;
+        assert_eq!((status, body["error"].as_str()), (400, Some(code)), "{fields:?}: {body}");
+        let message = body["message"].as_str().unwrap_or_default();
+        assert!(message.contains(names), "{fields:?}: '{message}' does not name {names}");
+        assert!(files_in(&uploads).is_empty(), "{fields:?} left {:?}", files_in(&uploads));
+        common::assert_error(&s, "/textures/mat", 404, "unknown_texture").await;
+    }
+    // Accepted: the forest floor's colour, normals and height, as the configured forest has them.
+    let maps = [("map.normal", normal.clone()), ("map.height", height.clone())];
+    let (status, body) = upload_material(&s, token, &[("id", "mat"), ("normal_convention", "opengl")], &maps).await;
+    assert_eq!(status, 202, "{body}");
+    ready(&s, "/textures/mat").await;
+    let meta = s.json("/textures/mat").await;
+    let names: Vec<&str> = meta["maps"].as_array().unwrap().iter().map(|m| m["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["albedo", "height", "normal", "uv"]);
+    assert_eq!(files_in(&uploads), ["mat.map.height.png", "mat.map.normal.png", "mat.png", "mat.toml"]);
+    let mut served = Vec::new();
+    for (map, mode) in [("normal", "synth"), ("height", "synth"), ("normal", "umbrella"), ("uv", "tiling")] {
+        let q = format!("7/-2.png?seed=4&mode={mode}&map={map}");
+        let (status, mine) = s.get_bytes(&format!("/tiles/mat/8/{q}")).await;
+        let (_, theirs) = s.get_bytes(&format!("/tiles/forest/8/{q}")).await;
+        assert_eq!(status, 200);
+        assert!(mine == theirs, "{map} in {mode}: the upload's tile differs from the configured material's");
+        served.push(mine);
+    }
+    drop(s);
+    // A restart serves the upload's maps with the same bytes; deleting it removes every file.
+    let s = start();
+    ready(&s, "/textures/mat").await;
+    let (_, again) = s.get_bytes("/tiles/mat/8/7/-2.png?seed=4&mode=synth&map=normal").await;
+    assert!(again == served[0], "the restarted server's normal tile differs");
+    let r = s.client.delete(s.url("/admin/textures/mat")).bearer_auth(token).send().await.unwrap();
+    assert_eq!(r.status(), 204);
+    assert!(files_in(&uploads).is_empty(), "{:?}", files_in(&uploads));
+}

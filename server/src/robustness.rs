@@ -101,14 +101,22 @@ pub fn samples_body(data: &[u8]) {
 }
 
 /// An upload: the first line as the query of a raw-body upload (its fields read into a texture
-/// configuration, as `POST /admin/textures` does), the rest as a stored upload record
+/// configuration, as `POST /admin/textures` does; `map.NAME` keys as its map parts), the rest
+/// as a stored upload record
 /// (`uploads/ID.toml`, as read at start-up) and as the image whose format is sniffed.
 pub fn upload(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let (query, rest) = text.split_once('\n').unwrap_or((&text, ""));
     let fields: Vec<(String, String)> =
         form_urlencoded::parse(query.as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
-    let _ = crate::uploads::texture_config(&fields);
+    let (maps, fields): (Vec<_>, Vec<_>) = fields.into_iter().partition(|(k, _)| k.starts_with("map."));
+    let maps: Vec<(String, &str)> = maps.iter().map(|(k, _)| (k["map.".len()..].to_string(), "png")).collect();
+    if let Ok(t) = crate::uploads::texture_config(&fields, &maps) {
+        // Whatever is accepted names files inside the uploads folder only.
+        for (_, f) in t.map_images() {
+            assert!(std::path::Path::new(f).file_name().is_some_and(|n| n == f), "map file {f}");
+        }
+    }
     let _ = crate::uploads::parse_record(rest);
     let _ = crate::uploads::image_extension(rest.as_bytes());
 }

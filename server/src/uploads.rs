@@ -1,9 +1,10 @@
 //! Uploaded textures, without HTTP: the admin token check, an upload's fields read into a
-//! texture configuration, and the store in the data directory's `uploads/` folder — the
-//! exemplar file as sent (`ID.png|jpg|webp`) and its configuration (`ID.toml`), each written to
-//! a temporary file and renamed into place, the configuration last: a configuration present
-//! means a complete upload, and whatever an interrupted upload left is removed at start-up —
-//! and the background analysis of an upload.
+//! texture configuration, and the store in the data directory's `uploads/` folder — its
+//! material maps as sent (`ID.map.NAME.png|jpg|webp`), the exemplar file as sent
+//! (`ID.png|jpg|webp`) and its configuration (`ID.toml`), each written to a temporary file and
+//! renamed into place, the configuration last: a configuration present means a complete
+//! upload, and whatever an interrupted upload left is removed at start-up — and the background
+//! analysis of an upload.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -13,7 +14,7 @@ use textile_core::error::clip;
 
 use std::sync::Arc;
 
-use crate::config::{settings, Config, TextureConfig};
+use crate::config::{settings, Config, TextureConfig, NORMAL_CONVENTION};
 use crate::error::ApiError;
 use crate::state::AppState;
 use crate::textures::analysing::Watch;
@@ -54,12 +55,22 @@ const ORPHAN_AGE: std::time::Duration = std::time::Duration::from_secs(60);
 /// Most fields an upload may carry.
 pub const MAX_FIELDS: usize = 64;
 
+/// Most material maps an upload may carry.
+pub const MAX_MAPS: usize = 16;
+
+/// The file an uploaded texture's map `name` is stored in, beside its record.
+pub fn map_file(id: &str, name: &str, ext: &str) -> String {
+    format!("{id}.map.{name}.{ext}")
+}
+
 /// A texture configuration from an upload's fields (query pairs or multipart fields): `id`
 /// (required), `name`, `toroidal` (`auto|true|false|synthesize`), `index`
 /// (`auto|exact|coherent`), `default_mode`, `default_seed`,
-/// `attribution`, and `MODE.KEY` for a per-mode setting (`synth.kappa=0.5`). Checked as a
-/// configured texture is, so an upload is refused for what a configuration file would be.
-pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiError> {
+/// `attribution`, `normal_convention` (with a normal map), and `MODE.KEY` for a per-mode
+/// setting (`synth.kappa=0.5`); and its material `maps`, `(name, file extension)` (their
+/// images are parts of a multipart form, `map.NAME`). Checked as a configured texture is, so an
+/// upload is refused for what a configuration file would be.
+pub fn texture_config(fields: &[(String, String)], maps: &[(String, &str)]) -> Result<TextureConfig, ApiError> {
     let bad = |m: String| ApiError::bad_request("invalid_upload", m);
     if fields.len() > MAX_FIELDS {
         return Err(bad(format!("{} fields; at most {MAX_FIELDS}", fields.len())));
@@ -88,6 +99,15 @@ pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiE
                 t.toroidal = serde_json::from_value(serde_json::json!(v)).map_err(|e| bad(format!("toroidal: {e}")))?
             }
             "index" => t.candidate_search = IndexChoice::parse(v).map_err(|e| bad(e.to_string()))?,
+            NORMAL_CONVENTION => {
+                t.maps.insert(NORMAL_CONVENTION.into(), v.clone());
+            }
+            other if other.starts_with("map.") => {
+                return Err(bad(format!(
+                    "field '{}': a map is an image, sent as a part of a multipart form",
+                    clip(other)
+                )))
+            }
             other => {
                 let Some((mode, key)) = other.split_once('.') else {
                     let fields: Vec<&str> = settings::TEXTURE_FIELDS.iter().map(|s| s.name).collect();
@@ -105,6 +125,12 @@ pub fn texture_config(fields: &[(String, String)]) -> Result<TextureConfig, ApiE
         }
     }
     t.id = id.ok_or_else(|| bad("the field 'id' is required".into()))?;
+    if maps.len() > MAX_MAPS {
+        return Err(bad(format!("{} maps; at most {MAX_MAPS}", maps.len())));
+    }
+    for (name, ext) in maps {
+        t.maps.insert(name.clone(), map_file(&t.id, name, ext));
+    }
     if t.name.is_empty() {
         t.name = t.id.clone();
     }
@@ -126,30 +152,33 @@ pub enum StoreError {
     Io(#[from] std::io::Error),
 }
 
-/// Store an upload: the exemplar bytes as `ID.EXT`, then its configuration as `ID.toml`, each
-/// written to a temporary file, synced and linked into place only where no file is — so of two
-/// servers sharing the data directory that store the same id, one wins and the other gets
-/// [`StoreError::Taken`] and leaves nothing (it removes only the files it created). An image
-/// without a record older than [`ORPHAN_AGE`] (an interrupted upload) is replaced.
-pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> Result<(), StoreError> {
-    use std::io::ErrorKind::AlreadyExists;
+/// Store an upload: its maps' bytes (`maps`: file name and bytes, the names `t.maps` gives),
+/// then the exemplar bytes as `ID.EXT`, then its configuration as `ID.toml`, each written to a
+/// temporary file, synced and linked into place only where no file is — so of two servers
+/// sharing the data directory that store the same id, one wins and the other gets
+/// [`StoreError::Taken`] and leaves nothing (it removes only the files it created). A file
+/// without a record older than [`ORPHAN_AGE`] (left by an interrupted upload) is replaced.
+pub fn store(
+    dir: &Path,
+    t: &TextureConfig,
+    image: &[u8],
+    ext: &str,
+    maps: &[(String, Vec<u8>)],
+) -> Result<(), StoreError> {
     std::fs::create_dir_all(dir)?;
-    let file = format!("{}.{ext}", t.id);
-    let image_path = dir.join(&file);
     let record = dir.join(format!("{}.toml", t.id));
-    match write_exclusive(&image_path, image) {
-        Err(e) if e.kind() == AlreadyExists => {
-            let age = std::fs::metadata(&image_path).and_then(|m| m.modified()).ok().and_then(|t| t.elapsed().ok());
-            if record.exists() || age.is_none_or(|a| a < ORPHAN_AGE) {
-                return Err(StoreError::Taken);
+    let file = format!("{}.{ext}", t.id);
+    let mut placed: Vec<PathBuf> = Vec::new();
+    let files = maps.iter().map(|(f, b)| (f.as_str(), &b[..])).chain(std::iter::once((file.as_str(), image)));
+    for (name, bytes) in files {
+        let path = dir.join(name);
+        if let Err(e) = place(&path, &record, bytes) {
+            for p in &placed {
+                let _ = std::fs::remove_file(p);
             }
-            std::fs::remove_file(&image_path)?;
-            write_exclusive(&image_path, image).map_err(|e| match e.kind() {
-                AlreadyExists => StoreError::Taken,
-                _ => StoreError::Io(e),
-            })?;
+            return Err(e);
         }
-        other => other?,
+        placed.push(path);
     }
     let mut stored = t.clone();
     stored.exemplar = file;
@@ -157,10 +186,32 @@ pub fn store(dir: &Path, t: &TextureConfig, image: &[u8], ext: &str) -> Result<(
         .map_err(std::io::Error::other)
         .and_then(|text| write_exclusive(&record, text.as_bytes()));
     if let Err(e) = claimed {
-        let _ = std::fs::remove_file(&image_path);
-        return Err(if e.kind() == AlreadyExists { StoreError::Taken } else { StoreError::Io(e) });
+        for p in &placed {
+            let _ = std::fs::remove_file(p);
+        }
+        return Err(if e.kind() == std::io::ErrorKind::AlreadyExists { StoreError::Taken } else { StoreError::Io(e) });
     }
     Ok(())
+}
+
+/// Link `bytes` into place at `path` where no file is, or where an orphan is: a file older
+/// than [`ORPHAN_AGE`] while no `record` owns it.
+fn place(path: &Path, record: &Path, bytes: &[u8]) -> Result<(), StoreError> {
+    use std::io::ErrorKind::AlreadyExists;
+    match write_exclusive(path, bytes) {
+        Err(e) if e.kind() == AlreadyExists => {
+            let age = std::fs::metadata(path).and_then(|m| m.modified()).ok().and_then(|t| t.elapsed().ok());
+            if record.exists() || age.is_none_or(|a| a < ORPHAN_AGE) {
+                return Err(StoreError::Taken);
+            }
+            std::fs::remove_file(path)?;
+            write_exclusive(path, bytes).map_err(|e| match e.kind() {
+                AlreadyExists => StoreError::Taken,
+                _ => StoreError::Io(e),
+            })
+        }
+        other => Ok(other?),
+    }
 }
 
 /// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
@@ -173,6 +224,13 @@ pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
     }
     for ext in ["png", "jpg", "webp"] {
         let _ = std::fs::remove_file(dir.join(format!("{id}.{ext}")));
+    }
+    // Its maps (ids have no dots, so `ID.map.` names only this texture's).
+    let maps = format!("{id}.map.");
+    for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        if e.file_name().to_string_lossy().starts_with(&maps) {
+            let _ = std::fs::remove_file(e.path());
+        }
     }
     for ext in crate::textures::stored_extensions() {
         let _ = std::fs::remove_file(data_dir.join(format!("{id}.{ext}")));
@@ -203,7 +261,13 @@ pub fn stored(dir: &Path, log: &dyn Fn(String)) -> Vec<TextureConfig> {
         let parsed = std::fs::read_to_string(&path).map_err(|e| e.to_string()).and_then(|s| parse_record(&s));
         match parsed {
             Ok(mut t) if path.file_stem().is_some_and(|s| s == t.id.as_str()) => {
-                t.exemplar = dir.join(&t.exemplar).to_string_lossy().into_owned();
+                let absolute = |f: &str| dir.join(f).to_string_lossy().into_owned();
+                t.exemplar = absolute(&t.exemplar);
+                for (name, file) in t.maps.iter_mut() {
+                    if name != NORMAL_CONVENTION {
+                        *file = absolute(file);
+                    }
+                }
                 out.push(t);
             }
             Ok(_) => log(format!("warning: {} is not named after its id; skipped", path.display())),
@@ -211,7 +275,8 @@ pub fn stored(dir: &Path, log: &dyn Fn(String)) -> Vec<TextureConfig> {
         }
     }
     for path in others {
-        let owned = out.iter().any(|t| Path::new(&t.exemplar) == path);
+        let owned =
+            out.iter().any(|t| Path::new(&t.exemplar) == path || t.map_images().any(|(_, f)| Path::new(f) == path));
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let writer = writer_alive(&name);
         if writer == Some(true) {
@@ -230,14 +295,17 @@ pub fn stored(dir: &Path, log: &dyn Fn(String)) -> Vec<TextureConfig> {
     out
 }
 
-/// An upload record (`ID.toml`) read and checked: a texture configuration whose exemplar is a
-/// plain file name beside it.
+/// An upload record (`ID.toml`) read and checked: a texture configuration whose exemplar and
+/// maps are plain file names beside it.
 pub fn parse_record(text: &str) -> Result<TextureConfig, String> {
     let mut t: TextureConfig = toml::from_str(text).map_err(|e| e.to_string())?;
     t.validate("upload").map_err(|(key, msg)| format!("{key}: {msg}"))?;
-    let plain = Path::new(&t.exemplar).file_name().is_some_and(|n| n == t.exemplar.as_str());
-    if !plain || t.exemplar.starts_with('.') {
+    let plain = |f: &str| Path::new(f).file_name().is_some_and(|n| n == f) && !f.starts_with('.');
+    if !plain(&t.exemplar) {
         return Err(format!("exemplar '{}' is not a file name beside the record", clip(&t.exemplar)));
+    }
+    if let Some((name, f)) = t.map_images().find(|(_, f)| !plain(f)) {
+        return Err(format!("map '{name}' ('{}') is not a file name beside the record", clip(f)));
     }
     t.uploaded = true;
     Ok(t)
@@ -324,7 +392,8 @@ mod tests {
 
     #[test]
     fn fields_become_a_checked_texture_configuration() {
-        let t = texture_config(&pairs(&[("id", "cobble"), ("toroidal", "false"), ("synth.kappa", "0.5")])).unwrap();
+        let t =
+            texture_config(&pairs(&[("id", "cobble"), ("toroidal", "false"), ("synth.kappa", "0.5")]), &[]).unwrap();
         assert_eq!((t.id.as_str(), t.name.as_str(), t.toroidal), ("cobble", "cobble", crate::config::Toroidal::False));
         assert_eq!(t.mode_tables()["synth"], vec![("kappa".to_string(), "0.5".to_string())]);
         for bad in [
@@ -335,10 +404,21 @@ mod tests {
             vec![("id", "a"), ("nosuch.key", "1")],
             vec![("id", "a"), ("colour", "red")],
             vec![("id", "a"), ("id", "b")],
+            vec![("id", "a"), ("normal_convention", "opengl")],
+            vec![("id", "a"), ("map.normal", "n.png")],
         ] {
-            let e = texture_config(&pairs(&bad)).unwrap_err();
+            let e = texture_config(&pairs(&bad), &[]).unwrap_err();
             assert_eq!(e.code, "invalid_upload", "{bad:?}");
         }
+        // Maps: a file each beside the record; a normal map needs its convention.
+        let maps = [("normal".to_string(), "png"), ("height".to_string(), "jpg")];
+        let t = texture_config(&pairs(&[("id", "m"), ("normal_convention", "directx")]), &maps).unwrap();
+        assert_eq!(
+            t.map_images().collect::<Vec<_>>(),
+            [("height", "m.map.height.jpg"), ("normal", "m.map.normal.png")]
+        );
+        assert!(texture_config(&pairs(&[("id", "m")]), &maps).is_err(), "a normal map without its convention");
+        assert!(texture_config(&pairs(&[("id", "m")]), &[("uv".to_string(), "png")]).is_err(), "a reserved name");
     }
 
     #[test]
@@ -356,8 +436,8 @@ mod tests {
     fn store_list_and_remove_leave_no_orphans() {
         let d = tempfile::tempdir().unwrap();
         let dir = d.path().join(UPLOADS_DIR);
-        let t = texture_config(&pairs(&[("id", "one"), ("name", "One")])).unwrap();
-        store(&dir, &t, b"\x89PNG fake", "png").unwrap();
+        let t = texture_config(&pairs(&[("id", "one"), ("name", "One")]), &[("height".to_string(), "png")]).unwrap();
+        store(&dir, &t, b"\x89PNG fake", "png", &[("one.map.height.png".into(), b"height".to_vec())]).unwrap();
         let orphan = std::fs::File::create(dir.join("orphan.jpg")).unwrap();
         orphan.set_modified(std::time::SystemTime::now() - 2 * ORPHAN_AGE).unwrap();
         std::fs::write(dir.join("fresh.jpg"), b"x").unwrap();
@@ -365,6 +445,7 @@ mod tests {
         assert_eq!(listed.len(), 1);
         assert_eq!(listed[0].name, "One");
         assert_eq!(std::fs::read(&listed[0].exemplar).unwrap(), b"\x89PNG fake");
+        assert_eq!(std::fs::read(listed[0].map_images().next().unwrap().1).unwrap(), b"height");
         assert!(!dir.join("orphan.jpg").exists());
         assert!(dir.join("fresh.jpg").exists(), "a file just written may be an upload in progress");
         remove(&dir, d.path(), "one").unwrap();

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 pub mod settings;
 mod texture;
 
-pub use texture::{valid_id, TextureConfig, Toroidal};
+pub use texture::{valid_id, TextureConfig, Toroidal, NORMAL_CONVENTION};
 
 /// The built-in layers: every setting's declared default, then `config/textile.toml`.
 fn built_in() -> Figment {

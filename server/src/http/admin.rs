@@ -45,13 +45,17 @@ fn too_large(limit: u64) -> ApiError {
     ApiError::new(Kind::TooLarge, "body_too_large", format!("the upload is over {} MiB", limit >> 20))
 }
 
+/// What an upload sent: its fields, the exemplar's bytes and its maps' (by name).
+struct Sent {
+    fields: Vec<(String, String)>,
+    image: axum::body::Bytes,
+    maps: Vec<(String, Vec<u8>)>,
+}
+
 /// The upload's fields and image bytes, from a raw image body (fields in the query) or a
-/// multipart form (fields as parts, the image as the part named `image`).
-async fn read_upload(
-    req: Request,
-    query: Option<&str>,
-    limit: u64,
-) -> Result<(Vec<(String, String)>, axum::body::Bytes), ApiError> {
+/// multipart form (fields as parts, the image as the part named `image`, material maps as
+/// parts named `map.NAME`).
+async fn read_upload(req: Request, query: Option<&str>, limit: u64) -> Result<Sent, ApiError> {
     let mut fields: Vec<(String, String)> =
         form_urlencoded::parse(query.unwrap_or("").as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
     let media = media_type(req.headers());
@@ -64,14 +68,15 @@ async fn read_upload(
     };
     match media.as_str() {
         "image/png" | "image/jpeg" | "image/webp" | "application/octet-stream" => {
-            let bytes = to_bytes(req.into_body(), limit as usize).await.map_err(|e| read_error(e.to_string()))?;
-            Ok((fields, bytes))
+            let image = to_bytes(req.into_body(), limit as usize).await.map_err(|e| read_error(e.to_string()))?;
+            Ok(Sent { fields, image, maps: Vec::new() })
         }
         "multipart/form-data" => {
             let mut form = Multipart::from_request(req, &()).await.map_err(|e| {
                 ApiError::bad_request("invalid_body", format!("not a multipart form: {}", clip(&e.body_text())))
             })?;
             let mut image = None;
+            let mut maps: Vec<(String, Vec<u8>)> = Vec::new();
             while let Some(part) = form.next_field().await.map_err(|e| read_error(e.body_text()))? {
                 let name = part.name().unwrap_or("").to_string();
                 let bytes = part.bytes().await.map_err(|e| read_error(e.body_text()))?;
@@ -79,6 +84,16 @@ async fn read_upload(
                     if image.replace(bytes).is_some() {
                         return Err(ApiError::bad_request("invalid_upload", "the part 'image' is given twice"));
                     }
+                } else if let Some(map) = name.strip_prefix("map.") {
+                    textile_core::maps::check_name(map)
+                        .map_err(|e| ApiError::bad_request("invalid_map", e.to_string()))?;
+                    if maps.iter().any(|(n, _)| n == map) || maps.len() >= uploads::MAX_MAPS {
+                        return Err(ApiError::bad_request(
+                            "invalid_upload",
+                            format!("the map '{map}' is given twice, or more than {} maps are", uploads::MAX_MAPS),
+                        ));
+                    }
+                    maps.push((map.to_string(), bytes.to_vec()));
                 } else {
                     let value = String::from_utf8(bytes.to_vec()).map_err(|_| {
                         ApiError::bad_request("invalid_upload", format!("field '{}' is not UTF-8 text", clip(&name)))
@@ -94,7 +109,7 @@ async fn read_upload(
             }
             let image =
                 image.ok_or_else(|| ApiError::bad_request("invalid_upload", "the form has no part named 'image'"))?;
-            Ok((fields, image))
+            Ok(Sent { fields, image, maps })
         }
         other => Err(ApiError::new(
             Kind::UnsupportedMediaType,
@@ -120,6 +135,7 @@ fn refused(e: LoadError) -> ApiError {
         LoadError::Core { source: CoreError::FlatExemplar { .. }, .. } => {
             ApiError::bad_request("flat_image", e.to_string())
         }
+        LoadError::Core { source: CoreError::Map { .. }, .. } => ApiError::bad_request("invalid_map", e.to_string()),
         other => ApiError::bad_request("invalid_upload", other.to_string()),
     }
 }
@@ -136,10 +152,10 @@ fn status_body(tex: &crate::textures::Texture) -> serde_json::Value {
 
 /// Add a texture from an uploaded exemplar.
 #[utoipa::path(post, path = "/admin/textures", tag = "admin",
-    request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields (id, required; name, toroidal, index, default_mode, default_seed, attribution) in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). At most max_upload_mib MiB; each side at most max_exemplar_side.",
+    request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields (id, required; name, toroidal, index, default_mode, default_seed, attribution) in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). Material maps are image parts named `map.NAME` (`map.normal`, `map.height`, …; the exemplar's size), a normal map with the field `normal_convention` (opengl or directx). At most max_upload_mib MiB; each side at most max_exemplar_side.",
         content(("image/png"), ("image/jpeg"), ("image/webp"), ("multipart/form-data"))),
     responses((status = 202, description = "accepted: decoded and stored; analysing (Location: the texture's status)"),
-              (status = 400, description = "a field is invalid, the image is corrupt or of another format, or it is flat (code flat_image)"),
+              (status = 400, description = "a field is invalid, the image is corrupt or of another format, or it is flat (code flat_image); a map is corrupt, mis-sized or misnamed (code invalid_map)"),
               (status = 401, description = "no or wrong bearer token"),
               (status = 404, description = "the admin API is off (no admin token configured)"),
               (status = 409, description = "the id is in use, or the upload limit is reached"),
@@ -163,8 +179,18 @@ pub async fn upload(
     }
     // The body and its decoding (the decoder's own allocations are capped by the image limits).
     let _memory = st.reserve((16 << 20) + 2 * declared.unwrap_or(limit)).await?;
-    let (fields, image) = read_upload(req, query.as_deref(), limit).await?;
-    let config = uploads::texture_config(&fields)?;
+    let Sent { fields, image, maps } = read_upload(req, query.as_deref(), limit).await?;
+    let mut kinds = Vec::with_capacity(maps.len());
+    for (name, bytes) in &maps {
+        let Some(ext) = uploads::image_extension(bytes) else {
+            return Err(ApiError::bad_request(
+                "invalid_map",
+                format!("map '{name}': the image is not a PNG, JPEG or WebP file"),
+            ));
+        };
+        kinds.push((name.clone(), ext));
+    }
+    let config = uploads::texture_config(&fields, &kinds)?;
     let id = config.id.clone();
     let exists = |id: &str| {
         ApiError::new(
@@ -180,11 +206,12 @@ pub async fn upload(
         return Err(ApiError::bad_request("invalid_image", "the image is not a PNG, JPEG or WebP file"));
     };
     // Decode and prepare off the async workers (an 8-megapixel JPEG takes a while).
+    let maps = Arc::new(maps);
     let prepared = {
-        let (st, config, image) = (st.clone(), config.clone(), image.clone());
+        let (st, config, image, maps) = (st.clone(), config.clone(), image.clone(), maps.clone());
         tokio::task::spawn_blocking(move || {
             let log = |s: String| tracing::info!("{s}");
-            prepare_texture(&st.config, &config, 0, &image, &log)
+            prepare_texture(&st.config, &config, 0, &image, &maps, &log)
         })
         .await
         .map_err(|_| ApiError::internal("preparing the exemplar failed unexpectedly"))?
@@ -207,7 +234,13 @@ pub async fn upload(
         let dir = uploads::dir(&st.config);
         let stored = {
             let (config, dir) = (config.clone(), dir.clone());
-            tokio::task::spawn_blocking(move || uploads::store(&dir, &config, &image, ext)).await
+            // Each map in the file its configuration names.
+            let files: Vec<(String, Vec<u8>)> = maps
+                .iter()
+                .zip(&kinds)
+                .map(|((name, bytes), (_, ext))| (uploads::map_file(&id, name, ext), bytes.clone()))
+                .collect();
+            tokio::task::spawn_blocking(move || uploads::store(&dir, &config, &image, ext, &files)).await
         };
         match stored {
             Ok(Ok(())) => {}

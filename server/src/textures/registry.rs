@@ -51,12 +51,15 @@ impl Registry {
 }
 
 /// Decode one texture's exemplar from its bytes: a texture without its analysis yet (`index`:
-/// its place in the configuration, for errors). `log` hears of any crop or resize.
+/// its place in the configuration, for errors). Its maps are read from their files, but for
+/// those `given` by name with their bytes (an upload's, not stored yet). `log` hears of any
+/// crop or resize.
 pub fn prepare_texture(
     cfg: &Config,
     t: &TextureConfig,
     index: usize,
     bytes: &[u8],
+    given: &[(String, Vec<u8>)],
     log: &dyn Fn(String),
 ) -> Result<Texture, LoadError> {
     // A lattice tiles the exemplar, which therefore wraps around.
@@ -92,7 +95,15 @@ pub fn prepare_texture(
     }
     // Each map is prepared like the exemplar's image, so that they stay co-registered.
     for (name, image) in t.map_images() {
-        let map = Exemplar::from_bytes(&image_bytes(cfg, t, image)?, &opts).map_err(|e| LoadError::Core {
+        let read;
+        let bytes = match given.iter().find(|(n, _)| n == name) {
+            Some((_, b)) => b,
+            None => {
+                read = image_bytes(cfg, t, image)?;
+                &read
+            }
+        };
+        let map = Exemplar::from_bytes(bytes, &opts).map_err(|e| LoadError::Core {
             id: t.id.clone(),
             source: textile_core::CoreError::Map { name: name.into(), message: format!("({image}): {e}") },
         })?;
@@ -124,7 +135,7 @@ pub fn prepare_texture(
 pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, LoadError> {
     let mut list = Vec::new();
     for (index, t) in cfg.textures.iter().enumerate() {
-        let prepared = exemplar_bytes(cfg, t).and_then(|bytes| prepare_texture(cfg, t, index, &bytes, log));
+        let prepared = exemplar_bytes(cfg, t).and_then(|bytes| prepare_texture(cfg, t, index, &bytes, &[], log));
         match prepared {
             Ok(tex) => list.push(Arc::new(tex)),
             Err(e) if t.uploaded => log(format!("warning: uploaded {e}; not served")),
