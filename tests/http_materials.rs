@@ -451,3 +451,49 @@ async fn uploads_carry_maps_that_serve_as_a_configured_material_does() {
     assert_eq!(r.status(), 204);
     assert!(files_in(&uploads).is_empty(), "{:?}", files_in(&uploads));
 }
+
+#[tokio::test]
+async fn gltf_documents_reference_the_same_material_images_the_glb_embeds() {
+    let dir = tempfile::tempdir().unwrap();
+    // Both embedded materials, and the forest floor with roughness and metallic maps.
+    let both = materials_config(dir.path(), "embedded:materials/forest_floor/height.png");
+    let rough = std::fs::read_to_string(common::rough_metal_config(dir.path())).unwrap();
+    let text = std::fs::read_to_string(&both).unwrap() + "\n" + &rough;
+    std::fs::write(&both, text).unwrap();
+    let s = Server::builder().args(&["--config", both.to_str().unwrap()]).start();
+    for (id, slots) in [
+        ("flagstones", vec![("normalTexture", "normal"), ("specular", "specular")]),
+        ("rough", vec![("metallicRoughnessTexture", "metallic_roughness")]),
+    ] {
+        let base = format!("/gltf/{id}/8/3/-2");
+        let doc = s.json(&format!("{base}.gltf?seed=6")).await;
+        let (status, glb) = s.get_bytes(&format!("{base}.glb?seed=6")).await;
+        assert_eq!(status, 200);
+        let (embedded, bin) = parse_glb(&glb);
+        // The same material, slot for slot; its images by URI beside the document.
+        assert_eq!(doc["materials"], embedded["materials"], "{id}");
+        assert_eq!(
+            doc["meshes"][0]["primitives"][0]["attributes"].get("TANGENT").is_some(),
+            embedded["meshes"][0]["primitives"][0]["attributes"].get("TANGENT").is_some()
+        );
+        let images = doc["images"].as_array().unwrap();
+        assert_eq!(images.len(), 1 + slots.len(), "{id}: {doc}");
+        for (i, image) in images.iter().enumerate() {
+            let uri = image["uri"].as_str().unwrap();
+            let (status, bytes) = s.get_bytes(&format!("/gltf/{id}/8/3/{uri}")).await;
+            assert_eq!(status, 200, "{id}: {uri}");
+            let view = &embedded["bufferViews"][embedded["images"][i]["bufferView"].as_u64().unwrap() as usize];
+            let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+            assert!(bytes == bin[o..o + l], "{id}: image {i} ({uri}) differs from the GLB's");
+        }
+        for (key, _) in &slots {
+            assert!(doc.to_string().contains(key), "{id}: no {key} in {doc}");
+        }
+    }
+    // A slot the texture has no map for, or no slot at all.
+    use base64::Engine;
+    let token = |q: &str| base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(q);
+    assert_error(&s, &format!("/gltf/rough/8/3/-2.{}.png", token("seed=6&slot=normal")), 400, "invalid_map").await;
+    assert_error(&s, &format!("/gltf/flagstones/8/3/-2.{}.png", token("slot=albedo")), 400, "invalid_map").await;
+    assert_error(&s, "/gltf/forest/8/0/0.png?slot=occlusion", 400, "invalid_map").await;
+}

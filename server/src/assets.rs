@@ -242,6 +242,48 @@ impl Slot {
             _ => None,
         }
     }
+
+    /// The name of a slot a material's image fills, in the URIs of `.gltf` documents' images.
+    pub fn name(self) -> &'static str {
+        match self {
+            Slot::Normal => "normal",
+            Slot::Occlusion => "occlusion",
+            Slot::Specular => "specular",
+            Slot::Roughness => "roughness",
+            Slot::Metallic => "metallic",
+            Slot::MetallicRoughness => "metallic_roughness",
+        }
+    }
+
+    /// The material image a map fills: its own, or for roughness and metallic maps the packed
+    /// `metallicRoughnessTexture`.
+    pub fn image(self) -> Slot {
+        match self {
+            Slot::Roughness | Slot::Metallic => Slot::MetallicRoughness,
+            s => s,
+        }
+    }
+
+    /// The slot of a material image, by [`Slot::name`] (packed slots only: roughness and
+    /// metallic maps are in `metallic_roughness`).
+    pub fn parse(name: &str) -> Option<Slot> {
+        [Slot::Normal, Slot::Occlusion, Slot::Specular, Slot::MetallicRoughness].into_iter().find(|s| s.name() == name)
+    }
+}
+
+/// Add a `TANGENT` of +X (increasing u) with w = +1 to the first mesh of `doc`, for a normal
+/// map's tangent space: the bitangent N × T = −Z is north, the image's up, as the maps' +Y.
+fn add_tangent(doc: &mut Value, bin: &mut Vec<u8>) {
+    let vertices = doc["accessors"][0]["count"].as_u64().unwrap_or(4) as usize;
+    let view = doc["bufferViews"].as_array().map_or(0, Vec::len);
+    let mut views = std::mem::take(&mut doc["bufferViews"]).as_array().cloned().unwrap_or_default();
+    push_view(bin, &mut views, &le(vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].as_flattened()), Some(34962));
+    doc["bufferViews"] = json!(views);
+    let accessor = doc["accessors"].as_array().map_or(0, Vec::len);
+    if let Some(a) = doc["accessors"].as_array_mut() {
+        a.push(json!({ "bufferView": view, "componentType": 5126, "count": vertices, "type": "VEC4" }));
+    }
+    doc["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(accessor);
 }
 
 /// Add material maps (PNG images already in `images`, by index) to material `m` of `doc`.
@@ -286,25 +328,15 @@ pub fn glb(
         Some(r) => relief_geometry(size, r),
         None => geometry(size),
     };
-    let vertices = accessors[0]["count"].as_u64().unwrap_or(4) as usize;
     let mut imgs = Vec::new();
     let all = images.iter().map(|(b, mime)| (b, *mime)).chain(maps.iter().map(|(_, b)| (b, "image/png")));
     for (bytes, mime) in all {
         imgs.push(json!({ "bufferView": views.len(), "mimeType": mime }));
         push_view(&mut bin, &mut views, bytes, None);
     }
-    // A normal map needs a tangent space: +X (increasing u) with w = +1, so that the
-    // bitangent N × T = −Z is north, the image's up, as the maps' +Y.
-    let mut accessors = accessors;
-    let tangent = maps.iter().any(|(s, _)| *s == Slot::Normal).then(|| {
-        push_view(&mut bin, &mut views, &le(vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].as_flattened()), Some(34962));
-        accessors
-            .push(json!({ "bufferView": views.len() - 1, "componentType": 5126, "count": vertices, "type": "VEC4" }));
-        accessors.len() - 1
-    });
     let mut doc = document(quads, generator, views, accessors, imgs);
-    if let Some(t) = tangent {
-        doc["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(t);
+    if maps.iter().any(|(s, _)| *s == Slot::Normal) {
+        add_tangent(&mut doc, &mut bin);
     }
     let slots: Vec<(Slot, usize)> = maps.iter().enumerate().map(|(i, (s, _))| (*s, images.len() + i)).collect();
     add_maps(&mut doc, 0, &slots);
@@ -323,13 +355,18 @@ pub fn glb(
     out
 }
 
-/// glTF JSON whose images are URLs (clients fetch the tiles themselves); the geometry is an
-/// embedded base64 buffer.
-pub fn gltf_json(quads: &[Quad], image_urls: &[String], generator: &str) -> Value {
+/// glTF JSON whose images are URLs (clients fetch the tiles themselves), `maps` the URLs of the
+/// first quad's material images by slot; the geometry is an embedded base64 buffer.
+pub fn gltf_json(quads: &[Quad], image_urls: &[String], maps: &[(Slot, String)], generator: &str) -> Value {
     let size = quads.first().map(|q| q.size as f32).unwrap_or(1.0);
-    let (bin, views, accessors) = geometry(size);
-    let imgs = image_urls.iter().map(|u| json!({ "uri": u })).collect();
+    let (mut bin, views, accessors) = geometry(size);
+    let imgs = image_urls.iter().chain(maps.iter().map(|(_, u)| u)).map(|u| json!({ "uri": u })).collect();
     let mut doc = document(quads, generator, views, accessors, imgs);
+    if maps.iter().any(|(s, _)| *s == Slot::Normal) {
+        add_tangent(&mut doc, &mut bin);
+    }
+    let slots: Vec<(Slot, usize)> = maps.iter().enumerate().map(|(i, (s, _))| (*s, image_urls.len() + i)).collect();
+    add_maps(&mut doc, 0, &slots);
     let data = base64::engine::general_purpose::STANDARD.encode(&bin);
     doc["buffers"] =
         json!([{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{data}") }]);

@@ -55,17 +55,25 @@ fn tile_url(base: &str, tex: &Texture, t: &TileSpec, q: &Query) -> String {
 }
 
 /// The relative URI of a tile's image served beside its .gltf document: `{y}.png`, or
-/// `{y}.{token}.png` with the parameters as a base64url token (glTF wants URIs without a query).
-fn sibling_image(r: &TileRequest, spec: &TileSpec) -> String {
-    if r.query.is_empty() {
+/// `{y}.{token}.png` with the parameters as a base64url token (glTF wants URIs without a query);
+/// a material image's (`slot`) has `slot=NAME` among them.
+fn sibling_image(r: &TileRequest, spec: &TileSpec, slot: Option<Slot>) -> String {
+    let mut q = r.query.clone();
+    if let Some(s) = slot {
+        q.insert(SLOT.into(), s.name().into());
+    }
+    if q.is_empty() {
         return format!("{}.png", spec.y);
     }
-    format!("{}.{}.png", spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(query_string(&r.query)))
+    format!("{}.{}.png", spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(query_string(&q)))
 }
+
+/// The parameter of a .gltf document's sibling image naming the material slot it fills.
+const SLOT: &str = "slot";
 
 /// The absolute URL of a tile's image (border included) for X3D documents.
 fn image_url(base: &str, r: &TileRequest, spec: &TileSpec) -> String {
-    format!("{base}/gltf/{}/{}/{}/{}", r.tex.config.id, spec.z, spec.x, sibling_image(r, spec))
+    format!("{base}/gltf/{}/{}/{}/{}", r.tex.config.id, spec.z, spec.x, sibling_image(r, spec, None))
 }
 
 pub(super) fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), ApiError> {
@@ -83,6 +91,8 @@ pub(super) struct TileRequest {
     params: ModeParams,
     /// `relief=SCALE`: a GLB's mesh displaced by the height map, white `SCALE` texels high.
     relief: Option<f32>,
+    /// `slot=NAME` of a .gltf document's sibling image: the material image it is.
+    slot: Option<Slot>,
 }
 
 impl TileRequest {
@@ -93,7 +103,36 @@ impl TileRequest {
         pairs: Vec<(String, String)>,
     ) -> Result<TileRequest, ApiError> {
         let (params, relief) = params_with_relief(&tex, ParamReader::request(pairs.clone())?)?;
-        Ok(TileRequest { tex, spec, query: pairs.into_iter().collect(), params, relief })
+        Ok(TileRequest { tex, spec, query: pairs.into_iter().collect(), params, relief, slot: None })
+    }
+
+    /// A .gltf document's sibling image: [`TileRequest::new`] of the pairs but `slot=NAME`,
+    /// which names the material image it is (the texture must have it).
+    fn sibling(tex: Arc<Texture>, spec: TileSpec, mut pairs: Vec<(String, String)>) -> Result<TileRequest, ApiError> {
+        let slot = match pairs.iter().position(|(k, _)| k == SLOT) {
+            Some(i) => {
+                let (_, v) = pairs.remove(i);
+                let bad = || {
+                    ApiError::bad_request(
+                        "invalid_map",
+                        format!("slot '{}' is not a material image of this texture", textile_core::error::clip(&v)),
+                    )
+                };
+                Some(Slot::parse(&v).ok_or_else(bad)?)
+            }
+            None => None,
+        };
+        let mut r = TileRequest::new(tex, spec, pairs)?;
+        if let Some(slot) = slot {
+            if !r.material_maps().iter().any(|(s, _)| s.image() == slot) {
+                return Err(ApiError::bad_request(
+                    "invalid_map",
+                    format!("slot '{}': the texture has no map for it", slot.name()),
+                ));
+            }
+        }
+        r.slot = slot;
+        Ok(r)
     }
 
     /// Refuse `relief` where the answer has no mesh to displace.
@@ -201,7 +240,9 @@ fn tile_request(
         _ => (y, raw),
     };
     let spec = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
-    Ok((TileRequest::new(tex, spec, query_pairs(raw.as_deref()))?, ext.to_string()))
+    let pairs = query_pairs(raw.as_deref());
+    let r = if ext == "png" { TileRequest::sibling(tex, spec, pairs)? } else { TileRequest::new(tex, spec, pairs)? };
+    Ok((r, ext.to_string()))
 }
 
 fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
@@ -213,7 +254,7 @@ fn key(r: &TileRequest, kind: &str, extra: &str) -> String {
 #[utoipa::path(get, path = "/gltf/{id}/{z}/{x}/{y}.{ext}", tag = "3d",
     params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
            ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row"),
-           ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png`"),
+           ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png` (a material image's token has slot=normal|occlusion|specular|metallic_roughness)"),
            ("relief" = Option<f32>, Query, description = "glb of a texture with a height map: the mesh displaced, white this many texels high, (0, 256]")),
     responses((status = 200, description = "model/gltf-binary or model/gltf+json"), (status = 304, description = "not modified"),
               (status = 400, description = "bad coordinates or parameters"), (status = 404, description = "unknown texture")))]
@@ -230,6 +271,15 @@ pub async fn gltf_tile(
     }
     let cc = &st.config.cache_control;
     if ext == "png" {
+        if let Some(slot) = r.slot {
+            let etag = etag_for(&key(&r, "slot", &format!("{}|{}", slot.name(), r.material_key())));
+            if if_none_match(&headers, &etag) {
+                return Ok(not_modified(&etag, cc));
+            }
+            let png = material_images(&st, &r).await?.into_iter().find(|(s, _)| *s == slot).map(|(_, b)| b);
+            let png = png.ok_or_else(|| ApiError::internal("a material image went missing"))?;
+            return Ok(image(png.into(), "image/png", &etag, cc, false));
+        }
         let job = r.image();
         let etag = job.etag();
         if if_none_match(&headers, &etag) {
@@ -245,14 +295,21 @@ pub async fn gltf_tile(
     }
     if ext == "gltf" {
         let base = base_url(&st, &headers, peer);
-        let etag = etag_for(&key(&r, "gltf", &base));
+        let etag = etag_for(&key(&r, "gltf", &format!("{base}|{}", r.material_key())));
         if if_none_match(&headers, &etag) {
             return Ok(not_modified(&etag, cc));
         }
         // glTF wants relative URIs without a query: the image is served beside this document as
         // `{y}.png` or `{y}.{token}.png` (the parameters, base64url) with the tile's bytes. The
         // tile endpoint's absolute URL is in the image's extras for clients that prefer it.
-        let mut doc = gltf_json(&[quad(&r.tex, &r.spec)], &[sibling_image(&r, &r.spec)], &generator());
+        let mut slots: Vec<Slot> = Vec::new();
+        for (s, _) in r.material_maps() {
+            if !slots.contains(&s.image()) {
+                slots.push(s.image());
+            }
+        }
+        let maps: Vec<(Slot, String)> = slots.iter().map(|&s| (s, sibling_image(&r, &r.spec, Some(s)))).collect();
+        let mut doc = gltf_json(&[quad(&r.tex, &r.spec)], &[sibling_image(&r, &r.spec, None)], &maps, &generator());
         doc["images"][0]["extras"] = serde_json::json!({ "tile_url": tile_url(&base, &r.tex, &r.spec, &r.query) });
         let body = serde_json::to_vec(&doc).map_err(|e| ApiError::internal(e.to_string()))?;
         return Ok(image(body.into(), "model/gltf+json", &etag, cc, false));
@@ -273,6 +330,27 @@ pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &Head
     }
     let job = r.image();
     let png = tile_png(st, &job.etag(), job).await?;
+    let maps = material_images(st, r).await?;
+    let relief = match r.relief {
+        Some(scale) => {
+            let job = ImageJob { map: MapChoice::Map("height".into()), ..r.image() };
+            let png = tile_png(st, &job.etag(), job).await?;
+            let img = image::load_from_memory(&png).map_err(|e| ApiError::internal(format!("height map: {e}")))?;
+            Some(Relief::from_border_image(&img.to_luma8(), scale))
+        }
+        None => None,
+    };
+    let q = quad(&r.tex, &r.spec);
+    let (bytes, hit) = cached(st, &etag, GLTF_LABEL, move |_| {
+        Ok(glb(&[q], &[(png, "image/png")], &maps, relief.as_ref(), &generator()))
+    })
+    .await;
+    Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
+}
+
+/// The material images of a tile's glTF material, by slot: its maps' bordered windows (through
+/// the tile cache), roughness and metallic packed into one `metallicRoughnessTexture`.
+async fn material_images(st: &Arc<AppState>, r: &TileRequest) -> Result<Vec<(Slot, Vec<u8>)>, ApiError> {
     let mut maps = Vec::new();
     let (mut roughness, mut metallic) = (None, None);
     for (slot, name) in r.material_maps() {
@@ -292,21 +370,7 @@ pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &Head
             .map_err(|e| ApiError::internal(format!("encoding: {e}")))?;
         maps.push((Slot::MetallicRoughness, png));
     }
-    let relief = match r.relief {
-        Some(scale) => {
-            let job = ImageJob { map: MapChoice::Map("height".into()), ..r.image() };
-            let png = tile_png(st, &job.etag(), job).await?;
-            let img = image::load_from_memory(&png).map_err(|e| ApiError::internal(format!("height map: {e}")))?;
-            Some(Relief::from_border_image(&img.to_luma8(), scale))
-        }
-        None => None,
-    };
-    let q = quad(&r.tex, &r.spec);
-    let (bytes, hit) = cached(st, &etag, GLTF_LABEL, move |_| {
-        Ok(glb(&[q], &[(png, "image/png")], &maps, relief.as_ref(), &generator()))
-    })
-    .await;
-    Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
+    Ok(maps)
 }
 
 /// A patch's request: the tile request of its top-left tile and its side in tiles, from the
@@ -341,7 +405,7 @@ fn patch_request(
     let relief = reader.take("relief").map(|v| relief_scale(&tex, &v)).transpose()?;
     let params = params(&tex, reader)?;
     let query = pairs.into_iter().filter(|(k, _)| !["z", "x", "y", "tiles"].contains(&k.as_str())).collect();
-    Ok((TileRequest { tex, spec: origin, query, params, relief }, n))
+    Ok((TileRequest { tex, spec: origin, query, params, relief, slot: None }, n))
 }
 
 /// The tiles of an N×N patch, row by row.
