@@ -97,7 +97,7 @@ fn exported_archive_in_headless_chromium() {
 /// textile's 3D documents in the clients users run (`tests/browser/clients3d.test.mjs`): three.js
 /// `GLTFLoader` on bordered, mipmapped glTF tiles (no seams up close, less aliasing far away,
 /// both measured against one-texture references); X_ITE on X3D tile and patch documents (they
-/// show the tile, seen from above); 3DTilesRendererJS streaming the 3D Tiles tileset on
+/// show the tile, seen from above; a material's is lit by its normal map the right way round); 3DTilesRendererJS streaming the 3D Tiles tileset on
 /// `/3d.html` (levels follow the camera); CesiumJS loading it anchored on the globe. Pictures go
 /// to `target/tmp/clients3d/`.
 #[test]

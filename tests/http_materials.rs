@@ -490,6 +490,30 @@ async fn gltf_documents_reference_the_same_material_images_the_glb_embeds() {
             assert!(doc.to_string().contains(key), "{id}: no {key} in {doc}");
         }
     }
+    // X3D: the GLB's colour and normal images in a PhysicalMaterial, with its tangent space.
+    let x3d = s.client.get(s.url("/x3d/flagstones/8/3/-2.x3d?seed=6")).send().await.unwrap().text().await.unwrap();
+    let doc = roxmltree::Document::parse(&x3d).expect("well-formed XML");
+    let textures: Vec<(&str, &str)> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("ImageTexture"))
+        .map(|n| (n.attribute("containerField").unwrap_or_default(), n.attribute("url").unwrap().trim_matches('"')))
+        .collect();
+    assert_eq!(textures.iter().map(|t| t.0).collect::<Vec<_>>(), ["baseTexture", "normalTexture"], "{x3d}");
+    let (_, glb) = s.get_bytes("/gltf/flagstones/8/3/-2.glb?seed=6").await;
+    let (embedded, bin) = parse_glb(&glb);
+    for (i, (field, url)) in textures.iter().enumerate() {
+        let (status, bytes) = s.get_bytes(url.strip_prefix(&s.base).expect("absolute URL")).await;
+        assert_eq!(status, 200, "{field}: {url}");
+        let view = &embedded["bufferViews"][embedded["images"][i]["bufferView"].as_u64().unwrap() as usize];
+        let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+        assert!(bytes == bin[o..o + l], "X3D {field} differs from the GLB's image {i}");
+    }
+    let tangent = doc.descendants().find(|n| n.has_tag_name("Tangent")).expect("a Tangent node");
+    assert_eq!(tangent.attribute("vector"), Some("1 0 0 1, 1 0 0 1, 1 0 0 1, 1 0 0 1"));
+    assert_eq!(doc.root_element().attribute("version"), Some("4.0"));
+    let patch = s.client.get(s.url("/x3d/flagstones/patch.x3d?z=8&x=0&y=0&tiles=2")).send().await.unwrap();
+    let patch = patch.text().await.unwrap();
+    assert_eq!(patch.matches("<PhysicalMaterial").count(), 4, "{patch}");
     // A slot the texture has no map for, or no slot at all.
     use base64::Engine;
     let token = |q: &str| base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(q);

@@ -379,8 +379,11 @@ fn xml_escape(s: &str) -> String {
 
 /// An X3D scene of quads (equal sizes) whose `ImageTexture`s point at `image_urls`, with a
 /// `Viewpoint` looking straight down at them from a height equal to their extent, which frames
-/// them in a square view. There is no `Material`: X3D then shows the texture unlit, as it is.
-pub fn x3d(quads: &[Quad], image_urls: &[String], generator: &str) -> String {
+/// them in a square view. A quad without material images (`maps[i]` empty) has no `Material`:
+/// X3D then shows the texture unlit, as it is. One with them (its normal, occlusion or packed
+/// metallic-roughness images, by slot) has an X3D 4 `PhysicalMaterial` — the glTF material
+/// model — lit by the headlight; the specular map has no X3D field and is left out.
+pub fn x3d(quads: &[Quad], image_urls: &[String], maps: &[Vec<(Slot, String)>], generator: &str) -> String {
     let s = quads.first().map(|q| q.size).unwrap_or(1.0);
     let (mut x0, mut z0, mut x1, mut z1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
     for q in quads {
@@ -391,19 +394,59 @@ pub fn x3d(quads: &[Quad], image_urls: &[String], generator: &str) -> String {
     // Looking down: the default view (along −Z, up +Y) turned −90° about X looks along −Y with
     // north (−Z) up, so the screen shows the texture as its images do.
     let (a, b) = (inset(), 1.0 - inset());
+    let texture = |field: &str, url: &str| {
+        format!(
+            r#"<ImageTexture{field} url='"{url}"' repeatS="false" repeatT="false">
+            <TextureProperties generateMipMaps="true" minificationFilter="AVG_PIXEL_AVG_MIPMAP" magnificationFilter="AVG_PIXEL" boundaryModeS="CLAMP_TO_EDGE" boundaryModeT="CLAMP_TO_EDGE"/>
+          </ImageTexture>"#,
+            url = xml_escape(url)
+        )
+    };
+    let no_maps = Vec::new();
     let mut shapes = String::new();
-    for (q, url) in quads.iter().zip(image_urls) {
+    for (i, (q, url)) in quads.iter().zip(image_urls).enumerate() {
+        let images: Vec<(&str, &String)> = maps
+            .get(i)
+            .unwrap_or(&no_maps)
+            .iter()
+            .filter_map(|(slot, u)| match slot {
+                Slot::Normal => Some(("normalTexture", u)),
+                Slot::Occlusion => Some(("occlusionTexture", u)),
+                Slot::MetallicRoughness => Some(("metallicRoughnessTexture", u)),
+                _ => None,
+            })
+            .collect();
+        // A normal map's tangent space as the GLB's: +X (east, increasing s) with w = +1, so
+        // that the bitangent N × T is north, the image's up, as the maps' +Y. (Left to derive
+        // it from the texture coordinates, X_ITE turns +Y south.)
+        let tangent = if images.iter().any(|(f, _)| *f == "normalTexture") {
+            "\n          <Tangent vector=\"1 0 0 1, 1 0 0 1, 1 0 0 1, 1 0 0 1\"/>"
+        } else {
+            ""
+        };
+        let appearance = if images.is_empty() {
+            texture("", url)
+        } else {
+            let packed = images.iter().any(|(f, _)| *f == "metallicRoughnessTexture");
+            let mut m = format!(
+                "<PhysicalMaterial metallic=\"{}\" roughness=\"1\">\n          {}",
+                if packed { 1 } else { 0 },
+                texture(r#" containerField="baseTexture""#, url)
+            );
+            for (field, u) in images {
+                m += &format!("\n          {}", texture(&format!(r#" containerField="{field}""#), u));
+            }
+            m + "\n          </PhysicalMaterial>"
+        };
         shapes += &format!(
             r#"    <Transform DEF="{def}" translation="{x} 0 {z}">
       <Shape>
         <Appearance>
-          <ImageTexture url='"{url}"' repeatS="false" repeatT="false">
-            <TextureProperties generateMipMaps="true" minificationFilter="AVG_PIXEL_AVG_MIPMAP" magnificationFilter="AVG_PIXEL" boundaryModeS="CLAMP_TO_EDGE" boundaryModeT="CLAMP_TO_EDGE"/>
-          </ImageTexture>
+          {appearance}
         </Appearance>
         <IndexedFaceSet solid="false" coordIndex="0 2 1 -1 0 3 2 -1" texCoordIndex="0 2 1 -1 0 3 2 -1">
           <Coordinate point="0 0 0, {s} 0 0, {s} 0 {s}, 0 0 {s}"/>
-          <TextureCoordinate point="{a} {b}, {b} {b}, {b} {a}, {a} {a}"/>
+          <TextureCoordinate point="{a} {b}, {b} {b}, {b} {a}, {a} {a}"/>{tangent}
         </IndexedFaceSet>
       </Shape>
     </Transform>
@@ -411,15 +454,20 @@ pub fn x3d(quads: &[Quad], image_urls: &[String], generator: &str) -> String {
             def = xml_escape(&q.name),
             x = q.origin.0,
             z = q.origin.1,
-            url = xml_escape(url),
         );
     }
+    // PhysicalMaterial is X3D 4; Tangent, Rendering level 5.
+    let (version, components) = if maps.iter().any(|m| !m.is_empty()) {
+        ("4.0", "\n    <component name=\"Rendering\" level=\"5\"/>")
+    } else {
+        ("3.3", "")
+    };
     let names = quads.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ");
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
-<X3D profile="Interchange" version="3.3" xmlns:xsd="http://www.w3.org/2001/XMLSchema-instance">
+<X3D profile="Interchange" version="{version}" xmlns:xsd="http://www.w3.org/2001/XMLSchema-instance">
   <head>
-    <component name="Texturing" level="3"/>
+    <component name="Texturing" level="3"/>{components}
     <meta name="generator" content="{gen}"/>
     <meta name="description" content="{names}: ground quads (Y up, X east, Z south, 1 unit = 1 native texel)"/>
   </head>

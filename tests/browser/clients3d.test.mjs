@@ -177,6 +177,51 @@ test('X_ITE: a tile document shows the tile, seen from above', async () => {
   await page.close();
 });
 
+test('X_ITE: a material tile document is lit by its normal map, the right way round', async () => {
+  const { page, errors } = await open(X3D_PAGE);
+  await page.waitForFunction(() => window.X3D && window.pixels && document.querySelector('x3d-canvas')?.browser);
+  const doc = '/x3d/flagstones/8/3/-2.x3d?seed=2';
+  await x3dShot(page, doc);
+  // The headlight off, a low sun from each side in turn (X east, Y up, Z south).
+  const lit = async (name, direction) => {
+    await page.evaluate((d) => {
+      const scene = document.querySelector('x3d-canvas').browser.currentScene;
+      if (!window.sun) {
+        for (const n of scene.rootNodes) if (n.getNodeTypeName() === 'NavigationInfo') n.headlight = false;
+        window.sun = scene.createNode('DirectionalLight');
+        scene.addRootNode(window.sun);
+      }
+      window.sun.direction = new X3D.SFVec3f(...d);
+      window.sun.intensity = 1;
+    }, direction);
+    let last;
+    for (let i = 0; i < 40; i++) {
+      await page.waitForTimeout(250);
+      const png = await page.locator('x3d-canvas').screenshot();
+      const next = await page.evaluate((b64) => window.pixels.look(b64), png.toString('base64'));
+      if (last && next.mean === last.mean) break;
+      last = next;
+    }
+    await page.evaluate((n) => window.pixels.keep(n), name);
+    return last;
+  };
+  const east = await lit('east', [-1, -0.6, 0]);
+  save('x3d-material-east.png', east.url);
+  await lit('west', [1, -0.6, 0]);
+  await lit('north', [0, -0.6, 1]);
+  await lit('south', [0, -0.6, -1]);
+  const normals = `${BASE}/tiles/flagstones/8/3/-2.png?seed=2&map=normal`;
+  const ew = await page.evaluate((u) => window.pixels.change('east', 'west', u, 0, 4), normals);
+  const ns = await page.evaluate((u) => window.pixels.change('north', 'south', u, 1, 4), normals);
+  const swapped = await page.evaluate((u) => window.pixels.change('east', 'west', u, 1, 4), normals);
+  console.log(`X_ITE lit flagstones: east-west light vs normal x ${ew.toFixed(3)}, north-south vs y ${ns.toFixed(3)} ` +
+    `(east-west vs y ${swapped.toFixed(3)})`);
+  assert.ok(ew > 0.5 && ns > 0.5, `normals light the wrong way: ${ew}, ${ns}`);
+  assert.ok(Math.abs(swapped) < ew / 2, `x and y mixed up: ${swapped}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 /** Wait until the 3D page's tiles are all loaded for the current view (two looks in a row). */
 async function settled3d(page, timeout = 180000) {
   await page.waitForFunction(() => window.textile3d?.settled(), null, { timeout, polling: 200 });

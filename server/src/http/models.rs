@@ -71,9 +71,15 @@ fn sibling_image(r: &TileRequest, spec: &TileSpec, slot: Option<Slot>) -> String
 /// The parameter of a .gltf document's sibling image naming the material slot it fills.
 const SLOT: &str = "slot";
 
-/// The absolute URL of a tile's image (border included) for X3D documents.
-fn image_url(base: &str, r: &TileRequest, spec: &TileSpec) -> String {
-    format!("{base}/gltf/{}/{}/{}/{}", r.tex.config.id, spec.z, spec.x, sibling_image(r, spec, None))
+/// The absolute URL of a tile's image (border included) for X3D documents, or of one of its
+/// material images (`slot`).
+fn image_url(base: &str, r: &TileRequest, spec: &TileSpec, slot: Option<Slot>) -> String {
+    format!("{base}/gltf/{}/{}/{}/{}", r.tex.config.id, spec.z, spec.x, sibling_image(r, spec, slot))
+}
+
+/// The absolute URLs of a tile's material images by slot, for X3D documents.
+fn material_urls(base: &str, r: &TileRequest, spec: &TileSpec) -> Vec<(Slot, String)> {
+    r.material_slots().into_iter().map(|s| (s, image_url(base, r, spec, Some(s)))).collect()
 }
 
 pub(super) fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), ApiError> {
@@ -157,6 +163,27 @@ impl TileRequest {
     /// the texture with a glTF slot.
     fn material_maps(&self) -> Vec<(Slot, String)> {
         self.tex.exemplar.maps.iter().filter_map(|m| Slot::of(&m.name).map(|s| (s, m.name.clone()))).collect()
+    }
+
+    /// `extra` for a cache key, with [`TileRequest::material_key`] after it when there are maps
+    /// (so that documents of textures without maps keep their keys).
+    fn with_material(&self, extra: &str) -> String {
+        match self.material_key() {
+            m if m.is_empty() => extra.to_string(),
+            m => format!("{extra}|{m}"),
+        }
+    }
+
+    /// The material images of this tile's glTF material, one per slot (roughness and metallic
+    /// maps share the packed one).
+    fn material_slots(&self) -> Vec<Slot> {
+        let mut slots: Vec<Slot> = Vec::new();
+        for (s, _) in self.material_maps() {
+            if !slots.contains(&s.image()) {
+                slots.push(s.image());
+            }
+        }
+        slots
     }
 
     /// What of the texture's maps the glTF material holds, for cache keys: empty without maps.
@@ -295,20 +322,15 @@ pub async fn gltf_tile(
     }
     if ext == "gltf" {
         let base = base_url(&st, &headers, peer);
-        let etag = etag_for(&key(&r, "gltf", &format!("{base}|{}", r.material_key())));
+        let etag = etag_for(&key(&r, "gltf", &r.with_material(&base)));
         if if_none_match(&headers, &etag) {
             return Ok(not_modified(&etag, cc));
         }
         // glTF wants relative URIs without a query: the image is served beside this document as
         // `{y}.png` or `{y}.{token}.png` (the parameters, base64url) with the tile's bytes. The
         // tile endpoint's absolute URL is in the image's extras for clients that prefer it.
-        let mut slots: Vec<Slot> = Vec::new();
-        for (s, _) in r.material_maps() {
-            if !slots.contains(&s.image()) {
-                slots.push(s.image());
-            }
-        }
-        let maps: Vec<(Slot, String)> = slots.iter().map(|&s| (s, sibling_image(&r, &r.spec, Some(s)))).collect();
+        let maps: Vec<(Slot, String)> =
+            r.material_slots().into_iter().map(|s| (s, sibling_image(&r, &r.spec, Some(s)))).collect();
         let mut doc = gltf_json(&[quad(&r.tex, &r.spec)], &[sibling_image(&r, &r.spec, None)], &maps, &generator());
         doc["images"][0]["extras"] = serde_json::json!({ "tile_url": tile_url(&base, &r.tex, &r.spec, &r.query) });
         let body = serde_json::to_vec(&doc).map_err(|e| ApiError::internal(e.to_string()))?;
@@ -459,7 +481,8 @@ fn x3d_answer(st: &AppState, headers: &HeaderMap, etag: &str, doc: impl FnOnce()
 }
 
 /// A tile as an X3D scene (the VRML use case): its ground quad, whose `ImageTexture` points at
-/// the tile's image (border included), and a `Viewpoint` looking down at it.
+/// the tile's image (border included) — for a material, a `PhysicalMaterial` with its maps' images
+/// too — and a `Viewpoint` looking down at it.
 #[utoipa::path(get, path = "/x3d/{id}/{z}/{x}/{y}.x3d", tag = "3d",
     params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
            ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row")),
@@ -475,9 +498,10 @@ pub async fn x3d_tile(
     let (r, _) = tile_request(&st, path, raw, &["x3d"])?;
     r.flat_only("X3D")?;
     let base = base_url(&st, &headers, peer);
-    let etag = etag_for(&key(&r, "x3d", &base));
+    let etag = etag_for(&key(&r, "x3d", &r.with_material(&base)));
     Ok(x3d_answer(&st, &headers, &etag, || {
-        x3d(&[quad(&r.tex, &r.spec)], &[image_url(&base, &r, &r.spec)], &generator())
+        let maps = [material_urls(&base, &r, &r.spec)];
+        x3d(&[quad(&r.tex, &r.spec)], &[image_url(&base, &r, &r.spec, None)], &maps, &generator())
     }))
 }
 
@@ -498,11 +522,12 @@ pub async fn x3d_patch(
     let (r, n) = patch_request(&st, path, raw)?;
     r.flat_only("X3D")?;
     let base = base_url(&st, &headers, peer);
-    let etag = etag_for(&key(&r, "x3d-patch", &format!("{n}|{base}")));
+    let etag = etag_for(&key(&r, "x3d-patch", &r.with_material(&format!("{n}|{base}"))));
     Ok(x3d_answer(&st, &headers, &etag, || {
         let tiles: Vec<TileSpec> = patch_tiles(r.spec, n).collect();
         let quads: Vec<Quad> = tiles.iter().map(|t| quad(&r.tex, t)).collect();
-        let urls: Vec<String> = tiles.iter().map(|t| image_url(&base, &r, t)).collect();
-        x3d(&quads, &urls, &generator())
+        let urls: Vec<String> = tiles.iter().map(|t| image_url(&base, &r, t, None)).collect();
+        let maps: Vec<Vec<(Slot, String)>> = tiles.iter().map(|t| material_urls(&base, &r, t)).collect();
+        x3d(&quads, &urls, &maps, &generator())
     }))
 }

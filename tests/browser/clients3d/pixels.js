@@ -61,3 +61,26 @@ export async function correlate(url, n, k) {
   const cov = sab / m - (sa / m) * (sb / m);
   return cov / Math.sqrt((saa / m - (sa / m) ** 2) * (sbb / m - (sb / m) ** 2));
 }
+
+const kept = {};
+
+/** Keep the last screenshot under `name`. */
+export function keep(name) {
+  kept[name] = shot;
+}
+
+/** Pearson correlation, over k×k blocks, of the luminance of kept screenshot `a` less that of
+ * kept `b` with channel `c` of the image at `url` drawn at the screenshots' size: how far what
+ * changed between two lights follows a map (a normal map's x or y). */
+export async function change(a, b, url, c, k) {
+  const [sa, sb] = [shrink(kept[a], k), shrink(kept[b], k)];
+  const m = shrink(await rgbOf(url, kept[a].w, kept[a].h), k);
+  const lum = (v, i) => 0.299 * v[i] + 0.587 * v[i + 1] + 0.114 * v[i + 2];
+  let n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+  for (let i = 0; i < sa.rgb.length; i += 3) {
+    const x = lum(sa.rgb, i) - lum(sb.rgb, i), y = m.rgb[i + c];
+    n++; sx += x; sy += y; sxx += x * x; syy += y * y; sxy += x * y;
+  }
+  const cov = sxy / n - (sx / n) * (sy / n);
+  return cov / Math.sqrt((sxx / n - (sx / n) ** 2) * (syy / n - (sy / n) ** 2));
+}
