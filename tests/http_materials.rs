@@ -58,6 +58,11 @@ async fn every_map_is_its_exemplar_map_looked_up_at_the_uv_coordinates() {
             maps.push((name, s.image(&format!("/textures/{id}/maps/{name}.png")).await));
         }
         let side = maps[0].1.width();
+        // The prepared maps carry an ETag (their own hash) and answer a conditional request.
+        let r = s.get(&format!("/textures/{id}/maps/normal.png")).await;
+        let etag = r.headers()["etag"].to_str().unwrap().to_string();
+        let again = s.client.get(s.url(&format!("/textures/{id}/maps/normal.png"))).header("If-None-Match", &etag);
+        assert_eq!(again.send().await.unwrap().status(), 304);
         for mode in ["synth", "tiling"] {
             for (x, y) in [(0i64, 0i64), (-3, 2), (40_000, -91_234)] {
                 let q = format!("{x}/{y}.png?mode={mode}&seed=3");

@@ -16,8 +16,9 @@ use textile_core::{MODE_NAMES, TILE_SIZE};
 
 use crate::encode::{Effort, Format};
 use crate::error::{ApiError, Kind};
+use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{base_url, path_error, texture, Peer};
-use crate::pipeline::engine_version;
+use crate::pipeline::{engine_version, etag_for};
 use crate::request::{params, query_pairs, MAX_CALLER_V};
 use crate::state::AppState;
 use crate::textures::Texture;
@@ -257,30 +258,46 @@ pub async fn exemplar(
 pub async fn map_image(
     State(st): State<Arc<AppState>>,
     path: Result<Path<(String, String)>, PathRejection>,
+    headers: HeaderMap,
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path((id, file)) = path.map_err(path_error)?;
     let t = texture(&reg, &id)?;
     let name = file.strip_suffix(".png").unwrap_or(&file);
-    let png = if name == "albedo" {
-        t.exemplar_png.clone()
-    } else {
-        let map = t.exemplar.map(name).ok_or_else(|| {
-            let have: Vec<&str> =
-                std::iter::once("albedo").chain(t.exemplar.maps.iter().map(|m| m.name.as_str())).collect();
-            ApiError::bad_request(
-                "invalid_map",
-                format!("map '{}': texture '{id}' has no such map; it has: {}", clip(name), have.join(", ")),
-            )
-        })?;
-        let side = t.exemplar.side;
-        crate::encode::encode(map.texels.as_flattened(), side, side, Format::Png, Effort::Tight)
-            .map_err(|e| ApiError::internal(format!("encoding: {e}")))?
-    };
-    let mut r = png.into_response();
-    r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
-    r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("public, max-age=3600"));
-    Ok(r)
+    if name == "albedo" {
+        let mut r = t.exemplar_png.clone().into_response();
+        r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
+        r.headers_mut().insert(header::CACHE_CONTROL, HeaderValue::from_static("public, max-age=3600"));
+        return Ok(r);
+    }
+    let map = t.exemplar.map(name).ok_or_else(|| {
+        let have: Vec<&str> =
+            std::iter::once("albedo").chain(t.exemplar.maps.iter().map(|m| m.name.as_str())).collect();
+        ApiError::bad_request(
+            "invalid_map",
+            format!("map '{}': texture '{id}' has no such map; it has: {}", clip(name), have.join(", ")),
+        )
+    })?;
+    // Keyed by the map's own hash; encoded once (off the async workers) into the tile cache.
+    let etag = etag_for(&format!("map-image|{}|{}", engine_version(), map.hash));
+    let cc = &st.config.cache_control;
+    if if_none_match(&headers, &etag) {
+        return Ok(not_modified(&etag, cc));
+    }
+    let (texels, side) = (map.texels.clone(), t.exemplar.side);
+    let (png, hit) = st
+        .cache
+        .get_or_compute(&etag, || async move {
+            tokio::task::spawn_blocking(move || {
+                crate::encode::encode(texels.as_flattened(), side, side, Format::Png, Effort::Tight)
+                    .map(Into::into)
+                    .map_err(|e| ApiError::internal(format!("encoding: {e}")))
+            })
+            .await
+            .map_err(|_| ApiError::internal("encoding the map failed unexpectedly"))?
+        })
+        .await;
+    Ok(image(png?, "image/png", &etag, cc, hit))
 }
 
 /// TileJSON 3.0.0 of a texture; query parameters are validated and carried into `tiles`, with
