@@ -193,11 +193,14 @@ const ROUNDING: f64 = 0.0068;
 /// rounding leaves a unit vector is made unit length again, so blending two normals gives the
 /// normalised mean vector, and a copied texel stays byte for byte.
 pub fn renormalise(pixels: &mut [u8]) {
+    // In integers: a channel `v` decodes to `d / 255` with `d = 2v − 255`, so `|n| = √s / 255`
+    // with `s = Σ d²`, and `||n| − 1| > ROUNDING` is `s` outside these bounds — which lie well
+    // between integers, so the test decides exactly as the square root would, without one.
+    let (lo, hi) = (65025.0 * (1.0 - ROUNDING) * (1.0 - ROUNDING), 65025.0 * (1.0 + ROUNDING) * (1.0 + ROUNDING));
     for px in pixels.chunks_exact_mut(3) {
-        let c = [px[0], px[1], px[2]];
-        let n = decode(c);
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        if (len - 1.0).abs() > ROUNDING {
+        let s: i32 = px.iter().map(|&v| (2 * v as i32 - 255) * (2 * v as i32 - 255)).sum();
+        if (s as f64) < lo || (s as f64) > hi {
+            let c = [px[0], px[1], px[2]];
             px.copy_from_slice(&unit(c, false));
         }
     }
@@ -206,6 +209,26 @@ pub fn renormalise(pixels: &mut [u8]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_integer_test_of_unit_length_decides_as_the_square_root_does() {
+        for r in 0..=255u8 {
+            for g in 0..=255u8 {
+                for b in (0..=255u8).step_by(3) {
+                    let n = decode([r, g, b]);
+                    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                    let mut px = [r, g, b];
+                    renormalise(&mut px);
+                    let kept = px == [r, g, b];
+                    assert!(kept || (len - 1.0).abs() > ROUNDING, "{r} {g} {b}: |n| = {len} changed");
+                    assert!(
+                        !kept || (len - 1.0).abs() <= ROUNDING || unit([r, g, b], false) == [r, g, b],
+                        "{r} {g} {b} kept"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn unit_normals_survive_renormalisation_byte_for_byte_and_are_unit_length() {

@@ -12,7 +12,7 @@ use textile_core::maps::MapChoice;
 use textile_core::modes::{Cost, Needs};
 use textile_core::{Cancel, ModeParams, Pyramid, Rect, Rendered, RgbWindow, Source, View, TILE_SIZE};
 
-use crate::encode::{encode, Effort, Format, ENCODER_VERSION};
+use crate::encode::{encode, Effort, Format, ENCODER_VERSION, MAP_ENCODER_VERSION};
 use crate::error::ApiError;
 use crate::request::{TileSpec, WindowSpec};
 use crate::state::AppState;
@@ -82,9 +82,10 @@ impl ImageJob {
         let f = self.format().ext();
         let map = match &self.map {
             MapChoice::Albedo => String::new(),
-            MapChoice::Uv => "|map=uv".into(),
+            MapChoice::Uv => format!("|map=uv:enc{MAP_ENCODER_VERSION}"),
             MapChoice::Map(n) => {
-                format!("|map={n}:{}", self.tex.exemplar.map(n).map_or("missing", |m| m.hash.as_str()))
+                let hash = self.tex.exemplar.map(n).map_or("missing", |m| m.hash.as_str());
+                format!("|map={n}:{hash}:enc{MAP_ENCODER_VERSION}")
             }
         };
         match self.target {
@@ -178,11 +179,12 @@ impl ImageJob {
         Ok(r)
     }
 
-    /// Encode a rendered image: tightly for modes whose pixels are expensive, fast for cheap ones
-    /// and for material maps (a second map of a tile costs lookups and encoding only, so the
-    /// encoding is its cost).
+    /// Encode a rendered image: tightly for modes whose pixels are expensive, fast for cheap ones,
+    /// fastest for material maps (a second map of a tile costs lookups and encoding only, so the
+    /// encoding is its cost; grey maps as grey PNGs).
     pub fn encode(&self, img: &RgbWindow) -> Result<Vec<u8>, ApiError> {
         let effort = match (self.params.info().cost, &self.map) {
+            (_, MapChoice::Map(_)) => Effort::Map,
             (Cost::Heavy, MapChoice::Albedo) => Effort::Tight,
             _ => Effort::Quick,
         };

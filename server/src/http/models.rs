@@ -194,7 +194,7 @@ impl TileRequest {
         if each.is_empty() {
             String::new()
         } else {
-            format!("maps={}", each.join(","))
+            format!("maps{}={}", crate::encode::MAP_ENCODER_VERSION, each.join(","))
         }
     }
 
@@ -388,7 +388,7 @@ async fn material_images(st: &Arc<AppState>, r: &TileRequest) -> Result<Vec<(Slo
     if roughness.is_some() || metallic.is_some() {
         let packed = metallic_roughness(roughness.as_ref(), metallic.as_ref());
         let side = image_side();
-        let png = crate::encode::encode(packed.as_raw(), side, side, Format::Png, crate::encode::Effort::Quick)
+        let png = crate::encode::encode(packed.as_raw(), side, side, Format::Png, crate::encode::Effort::Map)
             .map_err(|e| ApiError::internal(format!("encoding: {e}")))?;
         maps.push((Slot::MetallicRoughness, png));
     }
