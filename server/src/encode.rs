@@ -126,11 +126,10 @@ fn png(rgb: &[u8], w: u32, h: u32, effort: Effort) -> Result<Vec<u8>, ImageError
 /// encoder takes native-endian samples and writes them big-endian, as PNG stores them);
 /// fdeflate with the Paeth filter, as [`Effort::Map`].
 pub fn png_uv(uv: &textile_core::maps::UvWindow) -> Result<Vec<u8>, ImageError> {
-    let mut bytes = Vec::with_capacity(6 * uv.uv.len());
-    for [u, v] in &uv.uv {
-        bytes.extend_from_slice(&u.to_ne_bytes());
-        bytes.extend_from_slice(&v.to_ne_bytes());
-        bytes.extend_from_slice(&[0, 0]);
+    let mut bytes = vec![0u8; 6 * uv.uv.len()];
+    for (px, [u, v]) in bytes.chunks_exact_mut(6).zip(&uv.uv) {
+        px[..2].copy_from_slice(&u.to_ne_bytes());
+        px[2..4].copy_from_slice(&v.to_ne_bytes());
     }
     let mut out = Cursor::new(Vec::new());
     PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Paeth).write_image(
