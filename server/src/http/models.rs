@@ -303,7 +303,7 @@ pub async fn gltf_tile(
             if if_none_match(&headers, &etag) {
                 return Ok(not_modified(&etag, cc));
             }
-            let png = material_images(&st, &r).await?.into_iter().find(|(s, _)| *s == slot).map(|(_, b)| b);
+            let png = material_images(&st, &r, Some(slot)).await?.pop().map(|(_, b)| b);
             let png = png.ok_or_else(|| ApiError::internal("a material image went missing"))?;
             return Ok(image(png.into(), "image/png", &etag, cc, false));
         }
@@ -352,7 +352,7 @@ pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &Head
     }
     let job = r.image();
     let png = tile_png(st, &job.etag(), job).await?;
-    let maps = material_images(st, r).await?;
+    let maps = material_images(st, r, None).await?;
     let relief = match r.relief {
         Some(scale) => {
             let job = ImageJob { map: MapChoice::Map("height".into()), ..r.image() };
@@ -370,12 +370,17 @@ pub(super) async fn glb_tile(st: &Arc<AppState>, r: &TileRequest, headers: &Head
     Ok(image(bytes?, "model/gltf-binary", &etag, cc, hit))
 }
 
-/// The material images of a tile's glTF material, by slot: its maps' bordered windows (through
-/// the tile cache), roughness and metallic packed into one `metallicRoughnessTexture`.
-async fn material_images(st: &Arc<AppState>, r: &TileRequest) -> Result<Vec<(Slot, Vec<u8>)>, ApiError> {
+/// The material images of a tile's glTF material, by slot (all, or `only` the one): its maps'
+/// bordered windows (through the tile cache), roughness and metallic packed into one
+/// `metallicRoughnessTexture`.
+async fn material_images(
+    st: &Arc<AppState>,
+    r: &TileRequest,
+    only: Option<Slot>,
+) -> Result<Vec<(Slot, Vec<u8>)>, ApiError> {
     let mut maps = Vec::new();
     let (mut roughness, mut metallic) = (None, None);
-    for (slot, name) in r.material_maps() {
+    for (slot, name) in r.material_maps().into_iter().filter(|(s, _)| only.is_none_or(|o| s.image() == o)) {
         let job = ImageJob { map: MapChoice::Map(name), ..r.image() };
         let png = tile_png(st, &job.etag(), job).await?;
         let grey = || image::load_from_memory(&png).map(|i| i.to_luma8());
@@ -424,8 +429,7 @@ fn patch_request(
             format!("the patch must end at or before {COORD_MAX}"),
         ));
     }
-    let relief = reader.take("relief").map(|v| relief_scale(&tex, &v)).transpose()?;
-    let params = params(&tex, reader)?;
+    let (params, relief) = params_with_relief(&tex, reader)?;
     let query = pairs.into_iter().filter(|(k, _)| !["z", "x", "y", "tiles"].contains(&k.as_str())).collect();
     Ok((TileRequest { tex, spec: origin, query, params, relief, slot: None }, n))
 }
