@@ -7,8 +7,8 @@
 //! The pipeline, one module per stage:
 //!
 //! 1. [`exemplar`] — decode and prepare the input (power-of-two square, toroidal flag);
-//! 2. [`analysis`] — Gaussian stack, PCA neighbourhoods, k-coherence candidates, computed once
-//!    and stored in a file;
+//! 2. [`analysis`] — Gaussian stack ([`stack`], also the low-pass of material maps), PCA
+//!    neighbourhoods, k-coherence candidates, computed once and stored in a file;
 //! 3. [`modes`] — the engines, one folder each behind one [`Mode`] trait:
 //!    [`modes::synth`] (Lefebvre & Hoppe's parallel controllable synthesis, the main engine),
 //!    [`modes::mosaic`] (Xu, Guo & Shum's chaos mosaic, the cheap one) and
@@ -57,6 +57,7 @@ pub mod modes;
 pub mod prepare;
 pub mod progress;
 pub mod samples;
+pub mod stack;
 pub mod tileable;
 pub mod tsvq;
 

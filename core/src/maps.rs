@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
 use crate::image::box_stack;
+use crate::stack::low_pass;
 
 /// The maps every material tool knows by name (any other valid name is an extra map).
 pub const STANDARD: &[&str] = &["normal", "height", "specular", "roughness", "ao", "metallic"];
@@ -52,6 +53,8 @@ pub struct MaterialMap {
     pub hash: String,
     /// Centred box means at every scale, derived on first zoomed-out use.
     boxes: OnceLock<Vec<Vec<[u8; 3]>>>,
+    /// The low-pass native views blend seams with, derived on first use.
+    low: OnceLock<Vec<[u8; 3]>>,
 }
 
 impl MaterialMap {
@@ -89,7 +92,15 @@ impl MaterialMap {
             h.update(hi.as_flattened());
         }
         let hash = h.finalize().to_hex()[..16].to_string();
-        Ok(MaterialMap { name: name.to_string(), texels, hires, normal, hash, boxes: OnceLock::new() })
+        Ok(MaterialMap {
+            name: name.to_string(),
+            texels,
+            hires,
+            normal,
+            hash,
+            boxes: OnceLock::new(),
+            low: OnceLock::new(),
+        })
     }
 
     /// Exemplar side.
@@ -102,6 +113,13 @@ impl MaterialMap {
         let n = self.side() as usize;
         let stack = self.boxes.get_or_init(|| box_stack(&self.texels, n));
         &stack[(k as usize).min(stack.len() - 1)]
+    }
+
+    /// The map low-passed `steps` stack levels (see [`crate::stack::low_pass`]),
+    /// with the addressing of a `toroidal` exemplar or not: derived once, so every call on a
+    /// map must ask for the same (its exemplar's).
+    pub fn low_pass(&self, toroidal: bool, steps: u32) -> &[[u8; 3]] {
+        self.low.get_or_init(|| low_pass(&self.texels, self.side() as usize, toroidal, steps))
     }
 
     /// The map's mean.

@@ -68,14 +68,15 @@ fn inside_a_features_inner_radius_the_output_is_the_exemplar_around_its_source()
         for j in 0..rect.height() {
             for i in 0..rect.width() {
                 let (dx, dy) = (rect.x0 + i - x, rect.y0 + j - y);
-                if dx * dx + dy * dy < 100 {
+                // Pixels whose seam blend (3 texels) reads only the feature's coordinates.
+                if dx * dx + dy * dy < 49 {
                     let (u, v) = ((30 + dx).rem_euclid(m), (25 + dy).rem_euclid(m));
                     assert_eq!(img.pixel(i as u32, j as u32), ex.pixels[(v * m + u) as usize], "({dx}, {dy})");
                     inside += 1;
                 }
             }
         }
-        assert!(inside > 250);
+        assert!(inside > 140);
         // The windows that cut the feature in parts agree with the whole.
         for (px, py, pw, ph) in [(0, 0, 40, 30), (40, 30, 40, 34), (31, 12, 20, 40)] {
             let part = render(ex, an, &q, Rect::new(rect.x0 + px, rect.y0 + py, pw, ph));

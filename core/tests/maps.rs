@@ -55,11 +55,32 @@ fn native_coordinates_look_the_colour_up_and_modes_without_them_say_so() {
         }
         let uv = uv.unwrap();
         let img = p.render(&src, &Pyramid::off(), view).unwrap().image;
+        // `synth` blends the low frequencies across seams (3 texels each side): there, pixels
+        // whose 7×7 coordinates continue each other show their texel; elsewhere every pixel.
+        let reach = if mode.name == "synth" { 3 } else { 0 };
+        let texel = |i: usize| (uv.uv[i][0] as i64 / 64, uv.uv[i][1] as i64 / 64);
+        let coherent = |i: usize| {
+            let (x, y) = ((i % 40) as i64, (i / 40) as i64);
+            let (tx, ty) = texel(i);
+            (x >= reach && x < 40 - reach && y >= reach && y < 30 - reach)
+                && (-reach..=reach).all(|dy| {
+                    (-reach..=reach).all(|dx| {
+                        let (qx, qy) = texel(((y + dy) * 40 + x + dx) as usize);
+                        (qx - dx, qy - dy) == (tx, ty)
+                    })
+                })
+        };
+        let mut checked = 0;
         for (i, [u, v]) in uv.uv.iter().enumerate() {
             assert_eq!((u % 64, v % 64), (32, 32), "{}: native pixels show texel centres", mode.name);
+            if !coherent(i) {
+                continue;
+            }
             let t = ex.pixels[(*v as usize / 64) * m + *u as usize / 64];
             assert_eq!(img.pixels[3 * i..3 * i + 3], t, "{} pixel {i}", mode.name);
+            checked += 1;
         }
+        assert!(checked >= 40, "{}: {checked} pixels checked", mode.name);
         // Magnified: each pixel's point lies in the patch of the texel it is in, whose native
         // coordinate is the native view's.
         let native = p.coordinates(&src, &Pyramid::off(), View::native(Rect::new(250, -75, 10, 8))).unwrap();

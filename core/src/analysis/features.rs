@@ -5,7 +5,7 @@
 use nalgebra::{DMatrix, SymmetricEigen};
 use rayon::prelude::*;
 
-use crate::analysis::stack::addr;
+use crate::stack::addr;
 
 /// Dimensions of the runtime (correction) feature vectors.
 pub const RUNTIME_DIMS: usize = 8;

@@ -9,7 +9,6 @@ pub mod kdtree;
 mod preparation;
 
 pub use preparation::INDEX;
-pub mod stack;
 
 use std::sync::OnceLock;
 
@@ -20,13 +19,13 @@ use crate::analysis::features::{
     principal_directions, project_runtime, quantise_projection, InnerTaps, LevelColours, SearchProjection,
     RUNTIME_DIMS, SEARCH_DIMS,
 };
-use crate::analysis::stack::{build_stack, to_u8};
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
 use crate::image::box_stack;
 use crate::lattice::Lattice;
 use crate::mask::RandomnessMask;
+use crate::stack::{build_stack, to_u8};
 
 /// Version of the analysis (its content and file layout; part of the analysis id, so a change
 /// recomputes stored analyses). Each mode's output has its own version (`Mode::VERSION`).

@@ -13,6 +13,7 @@ use crate::error::Result;
 use crate::geom::Rect;
 use super::params::SynthParams;
 use crate::cache::Pyramid;
+use super::seams;
 use super::window::synthesize_with;
 
 /// Render `rect` of the texture viewed `zoom_out` steps coarser than native (0 = native: one
@@ -41,12 +42,15 @@ pub fn render_map(
     let m = an.side() as usize;
     let mut pixels = Vec::with_capacity(3 * w * h);
     if zoom_out == 0 {
-        let sw = synthesize_with(pyr, an, params, levels, rect)?;
+        // The window grown by the blend's reach, blended back to `rect` (super::seams).
+        let sw = synthesize_with(pyr, an, params, levels, rect.grow(seams::RADIUS as i64))?;
         synthesized = sw.synthesized;
-        let texels = map.map_or(&an.exemplar[..], |m| &m.texels);
-        for &v in &sw.window.coords {
-            pixels.extend_from_slice(&texels[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
-        }
+        let toroidal = an.header.toroidal;
+        let (texels, low) = match map {
+            None => (&an.exemplar[..], an.colours8(levels.saturating_sub(seams::LOW_STEPS))),
+            Some(mp) => (&mp.texels[..], mp.low_pass(toroidal, seams::LOW_STEPS)),
+        };
+        seams::blend(&sw.window.coords, w, h, texels, low, m, toroidal, &mut pixels);
     } else if zoom_out <= levels {
         // Level `L − k`, one pixel per pixel: coherent upsampling would give each of them the
         // `2^k × 2^k` exemplar block centred on its coordinate at the finest level, so it shows

@@ -9,6 +9,7 @@
 //! 4. [`params`] — the validated parameters.
 
 pub mod colour;
+mod seams;
 pub mod controls;
 mod generations;
 mod history;
@@ -74,7 +75,7 @@ fn unit_value(v: u32) -> f64 {
 
 impl Mode for Synth {
     const NAME: &'static str = "synth";
-    const VERSION: u32 = 5;
+    const VERSION: u32 = 6;
     const SUMMARY: &'static str = "parallel controllable texture synthesis (Lefebvre & Hoppe 2005)";
     const NEEDS: Needs = Needs::Analysis;
     const COST: Cost = Cost::Heavy;

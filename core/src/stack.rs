@@ -1,6 +1,7 @@
 //! The Gaussian stack (design note §1.2a): one full `m × m` image per synthesis level, blurred
 //! more at coarser levels with an à-trous binomial filter, in exact u16 fixed point (value·256).
-//! Edges are handled by an addressing rule: wrap for toroidal exemplars, mirror otherwise.
+//! Edges are handled by an addressing rule: wrap for toroidal exemplars, mirror otherwise. Also
+//! one level of it alone ([`low_pass`]): what `synth` blends seams with, for maps as for colour.
 
 /// Exemplar texel address for a possibly out-of-range index `i` (wrap or mirror, §1.2a).
 #[inline]
@@ -22,32 +23,7 @@ pub fn build_stack(pixels: &[[u8; 3]], m: usize, toroidal: bool) -> Vec<Vec<[u16
     let mut stack = vec![Vec::new(); levels + 1];
     stack[levels] = pixels.iter().map(|p| p.map(|v| (v as u16) << 8)).collect();
     for l in (1..=levels).rev() {
-        let h = 1i64 << (levels - l);
-        let src = &stack[l];
-        let pass = |src: &[[u16; 3]], horizontal: bool| -> Vec<[u16; 3]> {
-            let mut out = vec![[0u16; 3]; m * m];
-            for y in 0..m {
-                for x in 0..m {
-                    let mut acc = [0u32; 3];
-                    for (k, &t) in TAPS.iter().enumerate() {
-                        let off = (k as i64 - 2) * h;
-                        let (sx, sy) = if horizontal {
-                            (addr(x as i64 + off, m as i64, toroidal), y)
-                        } else {
-                            (x, addr(y as i64 + off, m as i64, toroidal))
-                        };
-                        let p = src[sy * m + sx];
-                        for c in 0..3 {
-                            acc[c] += t * p[c] as u32;
-                        }
-                    }
-                    out[y * m + x] = acc.map(|s| ((s + 8) >> 4) as u16);
-                }
-            }
-            out
-        };
-        let blurred = pass(&pass(src, true), false);
-        stack[l - 1] = blurred;
+        stack[l - 1] = blur(&stack[l], m, 1 << (levels - l), toroidal);
     }
     // Level 0 is the exact mean colour (LH05).
     let n = (m * m) as u64;
@@ -60,6 +36,44 @@ pub fn build_stack(pixels: &[[u8; 3]], m: usize, toroidal: bool) -> Vec<Vec<[u16
     let mean = sum.map(|s| (((s << 8) + n / 2) / n) as u16);
     stack[0] = vec![mean; m * m];
     stack
+}
+
+/// One step of the à-trous filter at stride `h`: the next coarser stack level.
+fn blur(src: &[[u16; 3]], m: usize, h: i64, toroidal: bool) -> Vec<[u16; 3]> {
+    let pass = |src: &[[u16; 3]], horizontal: bool| -> Vec<[u16; 3]> {
+        let mut out = vec![[0u16; 3]; m * m];
+        for y in 0..m {
+            for x in 0..m {
+                let mut acc = [0u32; 3];
+                for (k, &t) in TAPS.iter().enumerate() {
+                    let off = (k as i64 - 2) * h;
+                    let (sx, sy) = if horizontal {
+                        (addr(x as i64 + off, m as i64, toroidal), y)
+                    } else {
+                        (x, addr(y as i64 + off, m as i64, toroidal))
+                    };
+                    let p = src[sy * m + sx];
+                    for c in 0..3 {
+                        acc[c] += t * p[c] as u32;
+                    }
+                }
+                out[y * m + x] = acc.map(|s| ((s + 8) >> 4) as u16);
+            }
+        }
+        out
+    };
+    pass(&pass(src, true), false)
+}
+
+/// Stack level `L − steps` of an `m × m` image, 8-bit: what [`build_stack`] gives there,
+/// without the coarser levels.
+pub fn low_pass(pixels: &[[u8; 3]], m: usize, toroidal: bool, steps: u32) -> Vec<[u8; 3]> {
+    let steps = steps.min(m.trailing_zeros());
+    let mut level: Vec<[u16; 3]> = pixels.iter().map(|p| p.map(|v| (v as u16) << 8)).collect();
+    for s in 0..steps {
+        level = blur(&level, m, 1 << s, toroidal);
+    }
+    level.iter().map(|c| c.map(to_u8)).collect()
 }
 
 /// Round a stack value (value·256) to 8 bits.
