@@ -7,7 +7,10 @@
 #   bench/out/quality/scores.md     the texq table (one block per setting, mean rows)
 #   bench/out/quality/streaks.md    streak per exemplar: default and correction off, native and z−1
 #   docs/contact-sheet.png          exemplar, default output, and a 2048² render zoomed out
-# Usage: bench/quality.sh [extra render args, e.g. --seed 3]
+#   docs/seams-before-after.png     with BEFORE=BINARY (a textile built from the code before):
+#                                   slime, bark and brick rendered by both, side by side
+# texq's table has an `edges` column: hard edges the exemplar lacks (patch seams).
+# Usage: [BEFORE=BINARY] bench/quality.sh [extra render args, e.g. --seed 3]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHARED=${SHARED:-../shared}
@@ -58,4 +61,11 @@ for f in "$SHARED"/exemplars/*.png; do
   echo "$row | $(streak "$OUT/big_p0/$name.png" 128) |" >> "$OUT/streaks.md"
 done
 python3 bench/contact_sheet.py "$OUT/exemplars" "$OUT/default" "$OUT/big" docs/contact-sheet.png
+if [ -n "${BEFORE:-}" ]; then
+  mkdir -p "$OUT/before"
+  for name in slime bark brick; do
+    "$BEFORE" render --exemplar "$SHARED/exemplars/$name.png" "$WIN" "$@" -o "$OUT/before/$name.png" >/dev/null
+  done
+  python3 bench/before_after.py "$OUT/exemplars" "$OUT/before" "$OUT/default" docs/seams-before-after.png slime bark brick
+fi
 cat "$OUT/scores.md" "$OUT/streaks.md"

@@ -137,6 +137,18 @@ pub struct CorrectionLevel {
     pub cands: Vec<[Candidate; 2]>,
 }
 
+/// Sums of squares over an exemplar's texels and channels (8-bit units):
+/// [`Analysis::fine_detail`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FineDetail {
+    /// Of each value's difference from stack level `L − 2`.
+    pub fine: u64,
+    /// Of each value's difference from the mean colour.
+    pub total: u64,
+    /// Values summed (3 per texel).
+    pub samples: u64,
+}
+
 /// Descriptive header of an analysis (stored as JSON in the file).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AnalysisHeader {
@@ -181,6 +193,8 @@ pub struct Analysis {
     /// Derived on first use (zoomed-out views): the exemplar's centred box means at every
     /// scale (not stored; see [`crate::image::box_stack`]).
     pub(crate) boxes: OnceLock<Vec<Vec<[u8; 3]>>>,
+    /// Derived on first use: [`Analysis::fine_detail`].
+    pub(crate) detail: OnceLock<FineDetail>,
     /// The exemplar's randomness mask (not stored: [`Analysis::attach`]).
     pub(crate) randomness_mask: Option<RandomnessMask>,
 }
@@ -249,7 +263,16 @@ impl Analysis {
         };
         let randomness_mask = ex.randomness_mask.clone();
         let boxes = OnceLock::new();
-        Ok(Analysis { header, exemplar: ex.pixels.clone(), stack, corrected, stack8, boxes, randomness_mask })
+        Ok(Analysis {
+            header,
+            exemplar: ex.pixels.clone(),
+            stack,
+            corrected,
+            stack8,
+            boxes,
+            detail: OnceLock::new(),
+            randomness_mask,
+        })
     }
 
     /// The analysis id an exemplar would get with the search `index` chooses: compare with a
@@ -300,6 +323,24 @@ impl Analysis {
         &self.boxes.get_or_init(|| box_stack(&self.exemplar, self.header.side as usize))[k as usize]
     }
 
+    /// How much of the exemplar's variation is fine detail: its energy above stack level
+    /// `L − 2` against its whole variance (exact integer sums over texels and channels).
+    pub fn fine_detail(&self) -> FineDetail {
+        *self.detail.get_or_init(|| {
+            let levels = self.header.levels as usize;
+            let (low, mean) = (&self.stack8[levels.saturating_sub(2)], self.stack8[0][0]);
+            let mut d = FineDetail { fine: 0, total: 0, samples: 0 };
+            for (e, l) in self.exemplar.iter().zip(low) {
+                for c in 0..3 {
+                    d.fine += (e[c] as i64 - l[c] as i64).pow(2) as u64;
+                    d.total += (e[c] as i64 - mean[c] as i64).pow(2) as u64;
+                }
+                d.samples += 3;
+            }
+            d
+        })
+    }
+
     /// Mean colour of the exemplar (8-bit).
     pub fn mean_colour(&self) -> [u8; 3] {
         self.stack8[0][0]
@@ -313,7 +354,16 @@ impl Analysis {
         corrected: Vec<CorrectionLevel>,
     ) -> Analysis {
         let stack8 = derive_stack8(&stack);
-        Analysis { header, exemplar, stack, corrected, stack8, boxes: OnceLock::new(), randomness_mask: None }
+        Analysis {
+            header,
+            exemplar,
+            stack,
+            corrected,
+            stack8,
+            boxes: OnceLock::new(),
+            detail: OnceLock::new(),
+            randomness_mask: None,
+        }
     }
 
     /// Attach what an analysis read from a file keeps with the exemplar instead (its

@@ -46,11 +46,12 @@ pub fn render_map(
         let sw = synthesize_with(pyr, an, params, levels, rect.grow(seams::RADIUS as i64))?;
         synthesized = sw.synthesized;
         let toroidal = an.header.toroidal;
+        let style = seams::Style::of(an.fine_detail());
         let (texels, low) = match map {
-            None => (&an.exemplar[..], an.colours8(levels.saturating_sub(seams::LOW_STEPS))),
-            Some(mp) => (&mp.texels[..], mp.low_pass(toroidal, seams::LOW_STEPS)),
+            None => (&an.exemplar[..], an.colours8(levels.saturating_sub(style.low_steps))),
+            Some(mp) => (&mp.texels[..], mp.low_pass(toroidal, style.low_steps)),
         };
-        seams::blend(&sw.window.coords, w, h, texels, low, m, toroidal, &mut pixels);
+        seams::blend(&sw.window.coords, w, h, texels, low, m, toroidal, style.fade, &mut pixels);
     } else if zoom_out <= levels {
         // Level `L − k`, one pixel per pixel: coherent upsampling would give each of them the
         // `2^k × 2^k` exemplar block centred on its coordinate at the finest level, so it shows

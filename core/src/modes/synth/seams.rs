@@ -7,27 +7,52 @@
 //!
 //! `out(p) = E[S(p)] + fade(Σ_d w(d)·Ē[S(p+d) − d] / Σ w − Ē[S(p)])`
 //!
-//! with `Ē` the exemplar low-passed at stride 4 (stack level `L − 2`). Wherever the
-//! neighbourhood is coherent every prediction is `S(p)` and the pixel stays exactly the texel;
-//! a jump between places of similar low frequencies changes little (`fade` scales corrections
-//! smaller than [`FADE`] down), so sharp detail stays sharp. Integer arithmetic over a window
-//! grown by [`RADIUS`]: deterministic, and a window equals the same pixels cut from any larger
-//! one.
+//! with `Ē` the exemplar low-passed at stride 4 (stack level `L − 2`; a smooth exemplar's
+//! whole colours, [`Style`]). Wherever the neighbourhood is coherent every prediction is `S(p)`
+//! and the pixel stays exactly the texel; a jump between places of similar low frequencies
+//! changes little (`fade` scales corrections smaller than the texture's [`Style::fade`] down),
+//! so sharp detail stays sharp. Integer arithmetic over a window grown by [`RADIUS`]:
+//! deterministic, and a window equals the same pixels cut from any larger one.
 
 use rayon::prelude::*;
+
+use crate::analysis::FineDetail;
 
 /// Radius of the blend, texels: a pixel reads the coordinates within this Chebyshev distance.
 /// 3 (a 7-texel ramp) against 2 and 4 on the development set: slime's `edges` 1.31 (2: 1.34,
 /// 4: 1.27) at less cost in `hist` than 4 (bench/README.md).
 pub const RADIUS: usize = 3;
-/// Stack levels below the finest of the low-pass `Ē` (stride `2^LOW_STEPS`). 2 (stride 4):
-/// the whole ramp is 7 texels, so frequencies finer than it are the pixel's own.
+/// Stack levels below the finest of the low-pass `Ē` of a detailed texture (stride 4): the
+/// ramp is 7 texels, so frequencies finer than it stay the pixel's own.
 pub const LOW_STEPS: u32 = 2;
-/// Corrections whose largest channel is below this (8-bit units) are scaled by
-/// `largest / FADE`: jumps between places of similar brightness stay almost untouched, which
-/// keeps the colour histogram and gradients of busy textures (gravel `hist` 0.0042 with no
-/// fade, 0.0033 with it), while visible steps are ramped fully.
-pub const FADE: i32 = 16;
+/// The largest fade (8-bit units): corrections whose largest channel is below the fade are
+/// scaled by `largest / fade`, so jumps between places of similar brightness stay almost
+/// untouched, which keeps the colour histogram and gradients of busy textures (gravel `hist`
+/// 0.0042 with no fade, 0.0033 with 16), while visible steps are ramped fully.
+pub const MAX_FADE: i32 = 16;
+
+/// How a texture's seams are blended, chosen from its exemplar's fine detail
+/// ([`crate::analysis::Analysis::fine_detail`]): what a visible step is depends on the texture.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Style {
+    /// Stack levels below the finest of the low-pass that is cross-faded: [`LOW_STEPS`], or 0
+    /// (whole colours) for a smooth exemplar, whose detail is under 1/16 of its variance —
+    /// there a seam is a step in every frequency, and cross-fading loses no detail (texq
+    /// `edges` of fractal clouds: 6.0 unblended, 3.6 with the low-pass, 2.2 whole).
+    pub low_steps: u32,
+    /// The fade: the exemplar's RMS fine detail, within `2..=MAX_FADE` (a step that large is
+    /// visible against the texture's own detail).
+    pub fade: i32,
+}
+
+impl Style {
+    /// The style for an exemplar with fine detail `d`.
+    pub fn of(d: FineDetail) -> Style {
+        let rms = (d.fine / d.samples.max(1)).isqrt() as i32;
+        let low_steps = if 16 * d.fine < d.total { 0 } else { LOW_STEPS };
+        Style { low_steps, fade: rms.clamp(2, MAX_FADE) }
+    }
+}
 
 /// The tent weight of offset `d ∈ 0..=2·RADIUS` along one axis.
 #[inline(always)]
@@ -48,6 +73,7 @@ pub(crate) fn blend(
     low: &[[u8; 3]],
     m: usize,
     toroidal: bool,
+    fade: i32,
     out: &mut Vec<u8>,
 ) {
     const R: usize = RADIUS;
@@ -128,7 +154,7 @@ pub(crate) fn blend(
             let corr = acc.map(|a| (a + total / 2).div_euclid(total));
             let size = corr.iter().map(|c| c.abs()).max().unwrap_or(0);
             for k in 0..3 {
-                let c = if size >= FADE { corr[k] } else { corr[k] * size / FADE };
+                let c = if size >= fade { corr[k] } else { corr[k] * size / fade };
                 px[k] = (own[k] as i32 + c).clamp(0, 255) as u8;
             }
         }
@@ -145,6 +171,19 @@ mod tests {
     }
 
     #[test]
+    fn smooth_exemplars_cross_fade_whole_colours_and_busy_ones_low_frequencies() {
+        // Fine detail 2% of the variance, RMS 2: whole colours, the smallest fade.
+        let smooth = FineDetail { fine: 4 * 300, total: 200 * 300, samples: 300 };
+        assert_eq!(Style::of(smooth), Style { low_steps: 0, fade: 2 });
+        // Half the variance, RMS 27 (gravel): the low-pass, the largest fade.
+        let busy = FineDetail { fine: 729 * 300, total: 1458 * 300, samples: 300 };
+        assert_eq!(Style::of(busy), Style { low_steps: LOW_STEPS, fade: MAX_FADE });
+        // In between (slime: a ninth of the variance, RMS 10).
+        let soft = FineDetail { fine: 100 * 300, total: 900 * 300, samples: 300 };
+        assert_eq!(Style::of(soft), Style { low_steps: LOW_STEPS, fade: 10 });
+    }
+
+    #[test]
     fn coherent_windows_are_exemplar_texels() {
         let m = 32;
         let ex = texels(m);
@@ -154,7 +193,7 @@ mod tests {
         // A coherent window that wraps around the torus.
         let coords: Vec<u32> = (0..bw * bh).map(|i| ((i % bw + 25) % m) as u32 | ((((i / bw) + 7) % m) as u32) << 16).collect();
         let mut out = Vec::new();
-        blend(&coords, w, h, &ex, &low, m, true, &mut out);
+        blend(&coords, w, h, &ex, &low, m, true, MAX_FADE, &mut out);
         let want: Vec<u8> = (0..w * h)
             .flat_map(|i| ex[((i / w + RADIUS + 7) % m) * m + (i % w + RADIUS + 25) % m])
             .collect();
@@ -178,7 +217,7 @@ mod tests {
             })
             .collect();
         let mut out = Vec::new();
-        blend(&coords, w, h, &ex, &low, m, false, &mut out);
+        blend(&coords, w, h, &ex, &low, m, false, 2, &mut out);
         let row: Vec<i32> = out.chunks(3).map(|c| c[0] as i32).collect();
         let steps: Vec<i32> = row.windows(2).map(|p| p[1] - p[0]).collect();
         assert!(steps.iter().all(|&s| s >= 0), "monotone: {row:?}");
