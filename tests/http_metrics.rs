@@ -39,19 +39,19 @@ async fn metrics_count_requests_cache_and_syntheses() {
     assert!(text.contains("textile_cache_evictions_total"));
     // Computation ratio parts. One native synth tile at even coordinates (m = 128) computes the
     // padded pyramid of design note §1.6 with level 3 uncorrected (core's FIRST_CORRECTED_LEVEL)
-    // and one pass more at level 5 (L − 2, core's plan::Schedules):
-    // 275×277 + 157×161 + 109×109 + 73×77 + 37×39 + 19×20 + 10×10 + 6×6 = 120 913 pixels for
-    // 65 536 delivered (ratio 1.84). One mosaic tile evaluates
+    // and one pass more at level 5 (L − 2, core's plan::Schedules), for the tile grown by the
+    // seam blend's 3 texels a side (262², core's synth::seams): 126 295 pixels for 65 536
+    // delivered (ratio 1.93; 120 913 for the bare 256²). One mosaic tile evaluates
     // its tile grown by the 4-pixel smoothing margin, 264² = 69 696.
-    assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#), 120_913.0);
+    assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#), 126_295.0);
     assert_eq!(value(&text, r#"textile_pixels_delivered_total{mode="synth"}"#), 65_536.0);
     assert_eq!(value(&text, r#"textile_pixels_synthesized_total{mode="mosaic"}"#), 69_696.0);
     assert_eq!(value(&text, r#"textile_pixels_delivered_total{mode="mosaic"}"#), 65_536.0);
     // The right-hand neighbour reuses the first tile's coarse levels and shared padding from the
-    // pyramidal cache: it synthesizes less than a cold tile (120 913), at least its own pixels.
+    // pyramidal cache: it synthesizes less than a cold tile (126 295), at least its own pixels.
     assert_eq!(s.get("/tiles/gravel/7/5/5.png").await.status(), 200);
     let text = s.get("/metrics").await.text().await.unwrap();
-    let second = value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#) - 120_913.0;
+    let second = value(&text, r#"textile_pixels_synthesized_total{mode="synth"}"#) - 126_295.0;
     assert!((65_536.0..110_000.0).contains(&second), "neighbour synthesized {second}");
     assert!(value(&text, "textile_level_cache_hits_total") > 0.0);
     assert!(value(&text, "textile_level_cache_bytes") > 0.0);
