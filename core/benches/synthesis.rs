@@ -1,5 +1,6 @@
 //! Engine benchmarks (criterion): analysis time for 64², 128² and 256² exemplars, a cold
-//! 256×256 native window (full padded pyramid, nothing cached), the same with a randomness
+//! 256×256 native window (full padded pyramid, nothing cached) and its coordinates alone (the
+//! difference is the seam blend), the same with a randomness
 //! mask and with request controls (noise and 64 strokes), a zoomed-out tile, a tile magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
 //! 512² windows; cold 256² umbrella tiles from native zoom to the exemplar's minzoom.
 //!
@@ -11,7 +12,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use textile_core::modes::mosaic::MosaicParams;
 use textile_core::modes::synth::controls::Controls;
-use textile_core::modes::synth::{render, Synth, SynthParams};
+use textile_core::modes::synth::{render, synthesize, Synth, SynthParams};
 use textile_core::{Analysis, Exemplar, ExemplarOptions, Mode, NoProgress, Pyramid, Rect, Source};
 
 fn exemplar(side: u32) -> Exemplar {
@@ -53,6 +54,14 @@ fn windows(c: &mut Criterion) {
         b.iter(|| {
             i += 1;
             render(&an, &p, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
+        })
+    });
+    // The coordinates alone of the same window grown by the seam blend's reach: the difference
+    // from `cold_256_native` is what the blend costs.
+    g.bench_function("cold_256_native_coords", |b| {
+        b.iter(|| {
+            i += 1;
+            synthesize(&an, &p, an.levels(), Rect::new(256 * i - 3, -256 * i - 3, 262, 262)).unwrap()
         })
     });
     g.bench_function("cold_256_zoom_out_1", |b| {

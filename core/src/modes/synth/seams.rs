@@ -91,17 +91,34 @@ pub(crate) fn blend(
     // stays below 255 · 256 < 2^21 per channel.
     let pack = |c: [u8; 3]| c[0] as u64 | (c[1] as u64) << 21 | (c[2] as u64) << 42;
     let padded: Vec<u64> = (0..pm * pm)
+        .into_par_iter()
         .map(|i| {
             let (x, y) = ((i % pm) as i64 - R as i64, (i / pm) as i64 - R as i64);
             let (x, y) = if toroidal { (x & mask, y & mask) } else { (x.clamp(0, mask), y.clamp(0, mask)) };
             pack(low[y as usize * m + x as usize])
         })
         .collect();
-    // Each buffer pixel's coordinate as an index into `padded`, and the index offset of each
-    // tap `d` (subtracted: the prediction of `q = p + d` is `S(q) − d`).
-    let base: Vec<usize> = coords.iter().map(|&v| ((v >> 16) as usize + R) * pm + (v & 0xFFFF) as usize + R).collect();
-    let offsets: [[usize; SIDE]; SIDE] = std::array::from_fn(|dy| std::array::from_fn(|dx| dy * pm + dx));
-    let centre = R * pm + R;
+    // Each buffer pixel's translation `t(q)`: its coordinate as an index into `padded` less its
+    // own position `lin(q)` at `padded`'s stride, so that what `q` predicts for `p` (`S(q) −
+    // (q − p)`) is `padded[t(q) + lin(p)]`. Neighbours with equal translations predict alike:
+    // along a row they form runs, and a pixel weighs each run of its window at once (the same
+    // integer sum as tap by tap, in a fraction of the reads).
+    let lin = |x: usize, y: usize| (y * pm + x) as isize;
+    let trans: Vec<isize> = coords
+        .par_iter()
+        .enumerate()
+        .map(|(i, &v)| (((v >> 16) as usize + R) * pm + (v & 0xFFFF) as usize + R) as isize - lin(i % bw, i / bw))
+        .collect();
+    // Where each pixel's run of equal translations ends along its row (exclusive).
+    let mut run_end = vec![0u32; bw * bh];
+    run_end.par_chunks_exact_mut(bw).zip(trans.par_chunks_exact(bw)).for_each(|(row_e, row_t)| {
+        row_e[bw - 1] = bw as u32;
+        for x in (0..bw - 1).rev() {
+            row_e[x] = if row_t[x + 1] == row_t[x] { row_e[x + 1] } else { x as u32 + 1 };
+        }
+    });
+    // Tent weights summed over the first `k` taps of a row.
+    let prefix: [u64; SIDE + 1] = std::array::from_fn(|k| (0..k).map(|d| weight(d) as u64).sum());
     let index = |v: u32| (v >> 16) as usize * m + (v & 0xFFFF) as usize;
     // Pixels whose right or lower neighbour does not continue them, then whether one lies
     // within `R` along each row: a pixel with none in its window is its texel.
@@ -114,19 +131,26 @@ pub(crate) fn blend(
         }
     };
     let seam: Vec<bool> = (0..bw * bh)
+        .into_par_iter()
         .map(|i| {
             let v = coords[i];
             (i % bw + 1 < bw && coords[i + 1] != next(v, 1, 0)) || (i + bw < bw * bh && coords[i + bw] != next(v, 0, 1))
         })
         .collect();
     let near_row: Vec<bool> = (0..bw * bh)
+        .into_par_iter()
         .map(|i| {
             let x = i % bw;
             x >= R && x + R < bw && seam[i - R..=i + R].iter().any(|&s| s)
         })
         .collect();
-    let weights: [[u64; SIDE]; SIDE] = std::array::from_fn(|dy| std::array::from_fn(|dx| (weight(dy) * weight(dx)) as u64));
-    let total = weights.iter().flatten().sum::<u64>() as i32;
+    // The weights sum to 2^8: the mean is a rounding shift.
+    const SHIFT: u32 = 8;
+    let total = 1i32 << SHIFT;
+    debug_assert_eq!(prefix[SIDE] * prefix[SIDE], total as u64);
+    // `c · size / fade` for every correction `|c| ≤ size < fade` (indexed `[size][c + fade]`):
+    // a lookup instead of a division per channel.
+    let faded: Vec<Vec<i32>> = (0..fade).map(|size| (-fade..=fade).map(|c| c * size / fade).collect()).collect();
     let start = out.len();
     out.resize(start + 3 * w * h, 0);
     out[start..].par_chunks_mut(3 * w).enumerate().for_each(|(y, line)| {
@@ -143,18 +167,24 @@ pub(crate) fn blend(
             // colour (those that continue `v` predict `v`: nothing), branch-free.
             let mine = low[index(v)].map(i32::from);
             let mut sum = 0u64;
-            for ((wrow, orow), dy) in weights.iter().zip(&offsets).zip(0..) {
-                let row = &base[(cy + dy - R) * bw + cx - R..][..SIDE];
-                for ((&b, &wt), &o) in row.iter().zip(wrow).zip(orow) {
-                    sum += wt * padded[b + centre - o];
+            let here = lin(cx, cy);
+            for dy in 0..SIDE {
+                let row = (cy + dy - R) * bw;
+                let wy = weight(dy) as u64;
+                let mut x = cx - R;
+                while x <= cx + R {
+                    let end = (run_end[row + x] as usize).min(cx + R + 1);
+                    let wx = prefix[end + R - cx] - prefix[x + R - cx];
+                    sum += wy * wx * padded[(trans[row + x] + here) as usize];
+                    x = end;
                 }
             }
             let acc: [i32; 3] = std::array::from_fn(|k| ((sum >> (21 * k)) & 0x1F_FFFF) as i32);
             let acc: [i32; 3] = std::array::from_fn(|k| acc[k] - total * mine[k]);
-            let corr = acc.map(|a| (a + total / 2).div_euclid(total));
+            let corr = acc.map(|a| (a + total / 2) >> SHIFT);
             let size = corr.iter().map(|c| c.abs()).max().unwrap_or(0);
             for k in 0..3 {
-                let c = if size >= fade { corr[k] } else { corr[k] * size / fade };
+                let c = if size >= fade { corr[k] } else { faded[size as usize][(corr[k] + fade) as usize] };
                 px[k] = (own[k] as i32 + c).clamp(0, 255) as u8;
             }
         }
