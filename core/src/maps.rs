@@ -9,6 +9,7 @@
 //! Normals are stored and served in glTF's convention: OpenGL, +Y up (green high where the
 //! surface faces the top of the image), `rgb = (n + 1) / 2 · 255`, unit length.
 
+use std::borrow::Cow;
 use std::sync::OnceLock;
 
 use serde::{Deserialize, Serialize};
@@ -53,9 +54,13 @@ pub struct MaterialMap {
     pub hash: String,
     /// Centred box means at every scale, derived on first zoomed-out use.
     boxes: OnceLock<Vec<Vec<[u8; 3]>>>,
-    /// The low-pass native views blend seams with, derived on first use.
-    low: OnceLock<Vec<[u8; 3]>>,
+    /// The low-pass native views blend seams with, derived on first use, with the
+    /// `(toroidal, steps)` it was asked for.
+    low: OnceLock<HeldLowPass>,
 }
+
+/// A derived low-pass with the `(toroidal, steps)` it was derived for.
+type HeldLowPass = ((bool, u32), Vec<[u8; 3]>);
 
 impl MaterialMap {
     /// Map `name` from its texels, prepared like the exemplar's (and its `2·side`
@@ -115,11 +120,15 @@ impl MaterialMap {
         &stack[(k as usize).min(stack.len() - 1)]
     }
 
-    /// The map low-passed `steps` stack levels (see [`crate::stack::low_pass`]),
-    /// with the addressing of a `toroidal` exemplar or not: derived once, so every call on a
-    /// map must ask for the same (its exemplar's).
-    pub fn low_pass(&self, toroidal: bool, steps: u32) -> &[[u8; 3]] {
-        self.low.get_or_init(|| low_pass(&self.texels, self.side() as usize, toroidal, steps))
+    /// The map low-passed `steps` stack levels (see [`crate::stack::low_pass`]), with the
+    /// addressing of a `toroidal` exemplar or not: held for the arguments of the first call
+    /// (a texture always asks with its exemplar's), derived afresh for others.
+    pub fn low_pass(&self, toroidal: bool, steps: u32) -> Cow<'_, [[u8; 3]]> {
+        let derive = || low_pass(&self.texels, self.side() as usize, toroidal, steps);
+        match self.low.get_or_init(|| ((toroidal, steps), derive())) {
+            (key, held) if *key == (toroidal, steps) => Cow::Borrowed(held),
+            _ => Cow::Owned(derive()),
+        }
     }
 
     /// The map's mean.
@@ -227,6 +236,21 @@ pub fn renormalise(pixels: &mut [u8]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_low_pass_is_the_one_asked_for_whatever_was_asked_before() {
+        let m = 16usize;
+        let texels: Vec<[u8; 3]> =
+            (0..m * m).map(|i| [(i * 37 % 251) as u8, (i % m * 16) as u8, (i / m * 16) as u8]).collect();
+        let map = MaterialMap::new("height", texels.clone(), None, None).unwrap();
+        for (toroidal, steps) in [(true, 2), (false, 2), (true, 1), (true, 2)] {
+            assert_eq!(
+                &map.low_pass(toroidal, steps)[..],
+                &low_pass(&texels, m, toroidal, steps)[..],
+                "{toroidal} {steps}"
+            );
+        }
+    }
 
     #[test]
     fn the_integer_test_of_unit_length_decides_as_the_square_root_does() {

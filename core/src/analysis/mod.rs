@@ -42,6 +42,11 @@ pub const FIRST_CORRECTED_LEVEL: u32 = 4;
 /// ([`IndexChoice::Auto`]); smaller ones exactly.
 pub const COHERENT_FROM_SIDE: u32 = 256;
 
+/// Stack levels below the finest that separate an exemplar's fine detail from its low
+/// frequencies ([`Analysis::fine_detail`]; the synth mode's seam blend cross-fades that
+/// low-pass, stride 4).
+pub const FINE_DETAIL_STEPS: u32 = 2;
+
 /// Version of the coherent search (part of coherent analyses' ids): 2 since its k-d tree
 /// queries are approximate.
 pub const COHERENT_VERSION: u32 = 2;
@@ -324,11 +329,12 @@ impl Analysis {
     }
 
     /// How much of the exemplar's variation is fine detail: its energy above stack level
-    /// `L − 2` against its whole variance (exact integer sums over texels and channels).
+    /// `L −` [`FINE_DETAIL_STEPS`] against its whole variance (exact integer sums over texels
+    /// and channels).
     pub fn fine_detail(&self) -> FineDetail {
         *self.detail.get_or_init(|| {
             let levels = self.header.levels as usize;
-            let (low, mean) = (&self.stack8[levels.saturating_sub(2)], self.stack8[0][0]);
+            let (low, mean) = (&self.stack8[levels.saturating_sub(FINE_DETAIL_STEPS as usize)], self.stack8[0][0]);
             let mut d = FineDetail { fine: 0, total: 0, samples: 0 };
             for (e, l) in self.exemplar.iter().zip(low) {
                 for c in 0..3 {

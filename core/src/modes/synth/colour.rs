@@ -47,9 +47,13 @@ pub fn render_map(
         synthesized = sw.synthesized;
         let toroidal = an.header.toroidal;
         let style = seams::Style::of(an.fine_detail());
+        let map_low;
         let (texels, low) = match map {
             None => (&an.exemplar[..], an.colours8(levels.saturating_sub(style.low_steps))),
-            Some(mp) => (&mp.texels[..], mp.low_pass(toroidal, style.low_steps)),
+            Some(mp) => {
+                map_low = mp.low_pass(toroidal, style.low_steps);
+                (&mp.texels[..], &map_low[..])
+            }
         };
         seams::blend(&sw.window.coords, w, h, texels, low, m, toroidal, style.fade, &mut pixels);
     } else if zoom_out <= levels {

@@ -24,7 +24,7 @@ use crate::analysis::FineDetail;
 pub const RADIUS: usize = 3;
 /// Stack levels below the finest of the low-pass `Ē` of a detailed texture (stride 4): the
 /// ramp is 7 texels, so frequencies finer than it stay the pixel's own.
-pub const LOW_STEPS: u32 = 2;
+pub const LOW_STEPS: u32 = crate::analysis::FINE_DETAIL_STEPS;
 /// The largest fade (8-bit units): corrections whose largest channel is below the fade are
 /// scaled by `largest / fade`, so jumps between places of similar brightness stay almost
 /// untouched, which keeps the colour histogram and gradients of busy textures (gravel `hist`
