@@ -102,6 +102,11 @@ impl Palette<'_> {
     fn colour(&self, m: &Member, q: [f64; 2]) -> Option<[f32; 3]> {
         let u = &m.u;
         let (dx, dy) = ((q[0] - m.x) as f32, (q[1] - m.y) as f32);
+        // Beyond its reach (with a margin far above rounding) no umbrella covers a point: the
+        // same answer as the rim test, without it for most members a point is tested against.
+        if dx * dx + dy * dy > u.reach2 * 1.01 + 1e-3 {
+            return None;
+        }
         let lx = (u.cos * dx + u.sin * dy) * u.inv_scale;
         let ly = (-u.sin * dx + u.cos * dy) * u.inv_scale;
         let t = &self.arr.table[u.modified as usize];
