@@ -145,15 +145,22 @@ fn hull(points: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
     // Points well inside the quadrilateral of the extreme points in x and y cannot be hull
     // vertices: left out before sorting (Akl–Toussaint). The margin keeps any point that
     // rounding could put on the hull.
-    let extreme = |better: fn(&[f64; 2], &[f64; 2]) -> bool| {
-        points.iter().copied().reduce(|a, b| if better(&b, &a) { b } else { a }).unwrap_or([0.0; 2])
-    };
-    let quad = [
-        extreme(|a, b| a[0] < b[0]),
-        extreme(|a, b| a[1] < b[1]),
-        extreme(|a, b| a[0] > b[0]),
-        extreme(|a, b| a[1] > b[1]),
-    ];
+    // The first point of least x, of least y, of greatest x and of greatest y, in one pass.
+    let mut quad = [points.first().copied().unwrap_or([0.0; 2]); 4];
+    for &p in points.iter().skip(1) {
+        if p[0] < quad[0][0] {
+            quad[0] = p;
+        }
+        if p[1] < quad[1][1] {
+            quad[1] = p;
+        }
+        if p[0] > quad[2][0] {
+            quad[2] = p;
+        }
+        if p[1] > quad[3][1] {
+            quad[3] = p;
+        }
+    }
     let span = (quad[2][0] - quad[0][0]).max(quad[3][1] - quad[1][1]);
     let margin = 1e-9 * span * span;
     let inside = |p: &[f64; 2]| (0..4).all(|i| cross(quad[i], quad[(i + 1) % 4], *p) > margin);
@@ -183,11 +190,10 @@ fn chain(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
         return points.to_vec();
     }
     let mut h: Vec<[f64; 2]> = Vec::with_capacity(2 * points.len());
-    for pass in 0..2 {
+    // The lower chain left to right, then the upper right to left.
+    fn half(h: &mut Vec<[f64; 2]>, it: impl Iterator<Item = [f64; 2]>) {
         let start = h.len();
-        let it: Box<dyn Iterator<Item = &[f64; 2]>> =
-            if pass == 0 { Box::new(points.iter()) } else { Box::new(points.iter().rev()) };
-        for &p in it {
+        for p in it {
             while h.len() >= start + 2 && cross(h[h.len() - 2], h[h.len() - 1], p) <= 0.0 {
                 h.pop();
             }
@@ -195,6 +201,8 @@ fn chain(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
         }
         h.pop();
     }
+    half(&mut h, points.iter().copied());
+    half(&mut h, points.iter().rev().copied());
     h
 }
 
