@@ -95,6 +95,20 @@ mod tests {
     }
 
     #[test]
+    fn a_low_pass_is_the_stack_level_it_names() {
+        let m = 16usize;
+        let px: Vec<[u8; 3]> =
+            (0..m * m).map(|i| [(i * 37 % 251) as u8, (i * 11 % 256) as u8, (i / m * 16) as u8]).collect();
+        for toroidal in [false, true] {
+            let stack = build_stack(&px, m, toroidal);
+            for steps in 0..=3u32 {
+                let level: Vec<[u8; 3]> = stack[4 - steps as usize].iter().map(|c| c.map(to_u8)).collect();
+                assert_eq!(low_pass(&px, m, toroidal, steps), level, "toroidal {toroidal}, {steps} steps");
+            }
+        }
+    }
+
+    #[test]
     fn flat_exemplar_gives_flat_stack() {
         let px = vec![[7u8, 8, 9]; 32 * 32];
         let s = build_stack(&px, 32, false);

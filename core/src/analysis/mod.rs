@@ -146,7 +146,7 @@ pub struct CorrectionLevel {
 /// [`Analysis::fine_detail`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FineDetail {
-    /// Of each value's difference from stack level `L − 2`.
+    /// Of each value's difference from stack level `L −` [`FINE_DETAIL_STEPS`].
     pub fine: u64,
     /// Of each value's difference from the mean colour.
     pub total: u64,

@@ -163,8 +163,9 @@ pub(crate) fn blend(
                 px.copy_from_slice(&own);
                 continue;
             }
-            // Every neighbour adds the difference of its prediction from `v`'s own low-pass
-            // colour (those that continue `v` predict `v`: nothing), branch-free.
+            // The tent-weighted sum of the neighbours' predictions, a row run at a time, less
+            // `v`'s own low-pass colour at full weight (neighbours that continue `v` predict it:
+            // they add nothing to the correction).
             let mine = low[index(v)].map(i32::from);
             let mut sum = 0u64;
             let here = lin(cx, cy);
