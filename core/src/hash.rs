@@ -20,8 +20,20 @@ pub fn mix(mut z: u64) -> u64 {
 /// Hash of three signed integers under a tag and a seed.
 #[inline]
 pub fn hash(tag: u64, seed: u64, a: i64, b: i64, c: i64) -> u64 {
-    let h = mix(seed ^ tag);
-    let h = mix(h ^ a as u64);
+    hash_keyed(key(tag, seed), a, b, c)
+}
+
+/// The part of [`hash`] that depends on the tag and the seed alone, for callers hashing many
+/// coordinates under one of them: `hash(tag, seed, a, b, c) = hash_keyed(key(tag, seed), a, b, c)`.
+#[inline]
+pub fn key(tag: u64, seed: u64) -> u64 {
+    mix(seed ^ tag)
+}
+
+/// [`hash`] under a precomputed [`key`].
+#[inline]
+pub fn hash_keyed(key: u64, a: i64, b: i64, c: i64) -> u64 {
+    let h = mix(key ^ a as u64);
     let h = mix(h ^ (b as u64).rotate_left(21));
     mix(h ^ (c as u64).rotate_left(42))
 }

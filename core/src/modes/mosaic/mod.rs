@@ -134,8 +134,8 @@ pub fn render_texels(ex: &Exemplar, texels: &[[u8; 3]], p: &MosaicParams, zoom_o
     Ok(sampled(ex, texels, &layout, zoom_out, rect))
 }
 
-/// Rows per band of [`sampled`]'s parallel labelling.
-const SAMPLED_BAND: i64 = 32;
+/// Pixels per parallel piece of [`sampled`]'s colouring.
+const SAMPLED_PIXELS: usize = 1 << 13;
 
 /// Zoomed out `k` steps (`2^k` texels per pixel) by labelling each pixel with its centre
 /// texel's source, like the paper's reduced-scale rendering, coloured with the mean of the
@@ -151,22 +151,24 @@ fn sampled(ex: &Exemplar, texels: &[[u8; 3]], layout: &Layout, k: u32, rect: Rec
         let mean = box_mip(texels, n, levels as usize)[0];
         return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
     }
-    let sums = Integral::new(texels, n, step as usize);
-    // Bands of rows in parallel (each pixel's label depends on its position alone).
-    let pixels: Vec<Vec<u8>> = (rect.y0..rect.y1)
-        .step_by(SAMPLED_BAND as usize)
-        .collect::<Vec<i64>>()
-        .into_par_iter()
-        .map(|y0| {
-            let band = Rect { y0, y1: rect.y1.min(y0 + SAMPLED_BAND), ..rect };
-            let mut pixels = Vec::with_capacity(3 * w * band.height() as usize);
-            for v in &sources(layout, band, ex.toroidal, step, step / 2) {
-                pixels.extend_from_slice(&sums.mean_around((v & 0xFFFF) as usize, (v >> 16) as usize));
-            }
-            pixels
-        })
-        .collect();
-    RgbWindow { width: w as u32, height: h as u32, pixels: pixels.concat() }
+    // The integral image (serial) while the labels are painted.
+    let (sums, src) =
+        rayon::join(|| Integral::new(texels, n, step as usize), || sources(layout, rect, ex.toroidal, step, step / 2));
+    let mut pixels = vec![0u8; 3 * w * h];
+    // With fewer exemplar texels than pixels (a small exemplar far out), every texel's mean
+    // once and a lookup per pixel cost less than a mean per pixel.
+    let table: Option<Vec<[u8; 3]>> =
+        (n * n < w * h).then(|| (0..n * n).into_par_iter().map(|i| sums.mean_around(i % n, i / n)).collect());
+    pixels.par_chunks_mut(3 * SAMPLED_PIXELS).zip(src.par_chunks(SAMPLED_PIXELS)).for_each(|(out, src)| {
+        for (o, &v) in out.chunks_exact_mut(3).zip(src) {
+            let (x, y) = ((v & 0xFFFF) as usize, (v >> 16) as usize);
+            o.copy_from_slice(&match &table {
+                Some(t) => t[y * n + x],
+                None => sums.mean_around(x, y),
+            });
+        }
+    });
+    RgbWindow { width: w as u32, height: h as u32, pixels }
 }
 
 
