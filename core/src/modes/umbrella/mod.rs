@@ -53,15 +53,29 @@ pub use paint::storage_words;
 /// Largest window, in pixels, one call may render (2^24: sub-sampling makes pixels dear).
 pub const MAX_PIXELS: i64 = 1 << 24;
 
-/// Sub-samples per pixel side.
+/// Sub-samples per pixel side at native zoom (and the most at any zoom).
 const AA: usize = 4;
+
+/// Sub-samples per pixel side of a view `zoom_out` steps out at level of detail `level`:
+/// [`AA`] at native zoom; 2 zoomed out while level-0 umbrellas are drawn, which puts a
+/// sub-sample at every native pixel's centre (spacing one texel, as at native zoom four
+/// sub-samples a side of a pixel two texels wide would be half a texel apart: the fill's cost
+/// is its sample rows, so a tile one step out filled as many rows as it has umbrellas twice).
+/// Merged levels keep [`AA`] (2 there breaks the zoom-consistency bound).
+fn sub_samples(zoom_out: u32, level: u32) -> usize {
+    if zoom_out > 0 && level == 0 {
+        2
+    } else {
+        AA
+    }
+}
 
 /// The umbrella mode.
 pub struct Umbrella;
 
 impl Mode for Umbrella {
     const NAME: &'static str = "umbrella";
-    const VERSION: u32 = 11;
+    const VERSION: u32 = 12;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
     const NEEDS: Needs = Needs::Exemplar;
@@ -171,7 +185,8 @@ impl Mode for Umbrella {
         };
         let gaps = if colour { gap_shift(&arr, &elements, p, &ident, src, cache)? } else { [0.0; 3] };
         let image = paint(&elements, &arr, p, view, level, || Ok(shifted(background(p, src, cache, view)?, gaps)))?;
-        Ok(Rendered { image, synthesized: (rect.area() * (AA * AA) as i64) as u64 })
+        let aa = sub_samples(view.zoom_out, level) as i64;
+        Ok(Rendered { image, synthesized: (rect.area() * aa * aa) as u64 })
     }
 }
 

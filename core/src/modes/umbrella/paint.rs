@@ -5,14 +5,14 @@
 use super::*;
 
 /// Render a view at level of detail `level` (whose cells are at least two pixels wide) over a
-/// background (rendered meanwhile): band by band — one row of cells each, a
-/// frame of [`lod::FRAME`] cells at a time — the coverage of every pixel's fixed 4×4
-/// sub-samples ([`raster`]) by the cells' umbrellas (level 0: the union of the cells' lists,
-/// each umbrella masked to the cells that list it; merged levels: the merged umbrellas around
-/// the row, [`lod::list`]), then per pixel the colour of each umbrella (or the background) its
-/// sub-samples see, evaluated once at their centroid and weighted by their number, darkened by
-/// their shadows: multisample anti-aliasing, with one colour evaluation for a pixel inside one
-/// umbrella.
+/// background (rendered meanwhile): band by band — one row of cells each, a frame of
+/// [`lod::FRAME`] cells at a time — the coverage of every pixel's fixed sub-samples
+/// ([`sub_samples`]: 4×4, or 2×2 zoomed out at level 0; [`raster`]) by the cells' umbrellas
+/// (level 0: the union of the cells' lists, each umbrella masked to the cells that list it;
+/// merged levels: the merged umbrellas around the row, [`lod::list`]), then per pixel the
+/// colour of each umbrella (or the background) its sub-samples see, evaluated once at their
+/// centroid and weighted by their number, darkened by their shadows: multisample
+/// anti-aliasing, with one colour evaluation for a pixel inside one umbrella.
 pub(super) fn paint(
     el: &Elements,
     arr: &Arrangement,
@@ -27,8 +27,9 @@ pub(super) fn paint(
     debug_assert!(2 * step <= side, "umbrellas are drawn while a cell is two pixels wide");
     // Pixels per cell side.
     let ppc = (side / step).max(1);
-    let (w, a) = (rect.width() as usize, AA as i64);
-    let sp = step as f32 / AA as f32;
+    let aa = sub_samples(view.zoom_out, level);
+    let (w, a) = (rect.width() as usize, aa as i64);
+    let sp = step as f32 / aa as f32;
     let shadow = p.shadow as f32 / ONE_Q16 as f32;
     let shadows = (shadow > 0.0 && arr.shadow_offset > 0.0).then_some(arr.shadow_offset);
     let mut darken = [1f32; 256];
@@ -70,7 +71,7 @@ pub(super) fn paint(
         .map(|cy| {
             let (j0, j1) = (rect.y0.max(cy * ppc), rect.y1.min((cy + 1) * ppc));
             let rows_px = (j1 - j0) as usize;
-            let mut cov = raster::Coverage::new(w * AA, rows_px * AA);
+            let mut cov = raster::Coverage::new(w * aa, rows_px * aa);
             let rows = ((j0 - cy * ppc) * a, (j1 - cy * ppc) * a);
             let own;
             let mut placed: Vec<Placed> = Vec::new();
@@ -143,43 +144,11 @@ pub(super) fn paint(
                     };
                     // A pixel whose sub-samples all see the same (most are): one evaluation.
                     // A sample's key: the umbrella it sees and its shadows.
-                    let key = |k: usize| (cov.hit[k] as u64) << 8 | cov.shade[k] as u64;
-                    let k0 = j * AA * cov.width + i * AA;
-                    let (h0, s0) = (cov.hit[k0], cov.shade[k0]);
-                    let uniform = (0..AA).all(|sy| {
-                        let k = k0 + sy * cov.width;
-                        cov.hit[k..k + AA].iter().all(|&h| h == h0) && cov.shade[k..k + AA].iter().all(|&s| s == s0)
-                    });
-                    let out = if uniform {
-                        eval(key(k0), ox + 0.5 * step as f32, oy + 0.5 * step as f32)
-                    } else {
-                        let keys: [u64; AA * AA] = std::array::from_fn(|n| key(k0 + (n / AA) * cov.width + n % AA));
-                        // Groups of equal sub-samples: key, count, sum of positions.
-                        let mut groups = [(0u64, 0u32, 0f32, 0f32); AA * AA];
-                        let mut ng = 0;
-                        for (n, &key) in keys.iter().enumerate() {
-                            let qx = ox + ((n % AA) as f32 + 0.5) * sp;
-                            let qy = oy + ((n / AA) as f32 + 0.5) * sp;
-                            match groups[..ng].iter_mut().find(|g| g.0 == key) {
-                                Some(g) => {
-                                    g.1 += 1;
-                                    g.2 += qx;
-                                    g.3 += qy;
-                                }
-                                None => {
-                                    groups[ng] = (key, 1, qx, qy);
-                                    ng += 1;
-                                }
-                            }
-                        }
-                        let mut acc = [0f32; 3];
-                        for &(key, n, sx, sy) in &groups[..ng] {
-                            let c = eval(key, sx / n as f32, sy / n as f32);
-                            for k in 0..3 {
-                                acc[k] += c[k] * n as f32;
-                            }
-                        }
-                        acc.map(|v| v / (AA * AA) as f32)
+                    let k0 = j * aa * cov.width + i * aa;
+                    let centre = [ox + 0.5 * step as f32, oy + 0.5 * step as f32];
+                    let out = match aa {
+                        2 => resolve::<2>(&cov, k0, [ox, oy], sp, centre, eval),
+                        _ => resolve::<AA>(&cov, k0, [ox, oy], sp, centre, eval),
                     };
                     for k in 0..3 {
                         // Rounded half up (non-negative; `f32::round` is a call without SSE4.1).
@@ -191,6 +160,58 @@ pub(super) fn paint(
         })
         .collect();
     Ok(RgbWindow { width: w as u32, height: rect.height() as u32, pixels: bands.concat() })
+}
+
+/// A pixel's colour from its `A × A` sub-samples starting at `k0` in `cov` (the pixel's corner
+/// at `o`, sub-samples `sp` apart): one evaluation at the pixel's `centre` when all see the
+/// same (most do), else one per group of equal sub-samples at the group's centroid, weighted by
+/// its size. `eval(key, x, y)` colours what a key (the umbrella seen and its shadows) shows.
+/// Generic in `A` so that each sub-sample count's loops are unrolled.
+#[inline]
+fn resolve<const A: usize>(
+    cov: &raster::Coverage,
+    k0: usize,
+    o: [f32; 2],
+    sp: f32,
+    centre: [f32; 2],
+    eval: impl Fn(u64, f32, f32) -> [f32; 3],
+) -> [f32; 3] {
+    let key = |k: usize| (cov.hit[k] as u64) << 8 | cov.shade[k] as u64;
+    let (h0, s0) = (cov.hit[k0], cov.shade[k0]);
+    let uniform = (0..A).all(|sy| {
+        let k = k0 + sy * cov.width;
+        cov.hit[k..k + A].iter().all(|&h| h == h0) && cov.shade[k..k + A].iter().all(|&s| s == s0)
+    });
+    if uniform {
+        return eval(key(k0), centre[0], centre[1]);
+    }
+    // Groups of equal sub-samples: key, count, sum of positions.
+    let mut groups = [(0u64, 0u32, 0f32, 0f32); AA * AA];
+    let mut ng = 0;
+    for n in 0..A * A {
+        let key = key(k0 + (n / A) * cov.width + n % A);
+        let qx = o[0] + ((n % A) as f32 + 0.5) * sp;
+        let qy = o[1] + ((n / A) as f32 + 0.5) * sp;
+        match groups[..ng].iter_mut().find(|g| g.0 == key) {
+            Some(g) => {
+                g.1 += 1;
+                g.2 += qx;
+                g.3 += qy;
+            }
+            None => {
+                groups[ng] = (key, 1, qx, qy);
+                ng += 1;
+            }
+        }
+    }
+    let mut acc = [0f32; 3];
+    for &(key, n, sx, sy) in &groups[..ng] {
+        let c = eval(key, sx / n as f32, sy / n as f32);
+        for k in 0..3 {
+            acc[k] += c[k] * n as f32;
+        }
+    }
+    acc.map(|v| v / (A * A) as f32)
 }
 
 /// Words of storage of the paper's Table 1, `J = b·w·h + 2·b·v + n·(1 + 3v) + k·W·H`, for a
