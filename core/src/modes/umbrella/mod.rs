@@ -57,11 +57,10 @@ pub const MAX_PIXELS: i64 = 1 << 24;
 const AA: usize = 4;
 
 /// Sub-samples per pixel side of a view `zoom_out` steps out at level of detail `level`:
-/// [`AA`] at native zoom; 2 zoomed out while level-0 umbrellas are drawn, which puts a
-/// sub-sample at every native pixel's centre (spacing one texel, as at native zoom four
-/// sub-samples a side of a pixel two texels wide would be half a texel apart: the fill's cost
-/// is its sample rows, so a tile one step out filled as many rows as it has umbrellas twice).
-/// Merged levels keep [`AA`] (2 there breaks the zoom-consistency bound).
+/// [`AA`] at native zoom and at merged levels (2 there breaks the zoom-consistency bound);
+/// 2 zoomed out while the level-0 umbrellas are still drawn. One step out that is a sub-sample
+/// at every native pixel's centre, where 4 would be half a texel apart: the fill's cost is its
+/// sample rows, and a tile one step out holds 4× the umbrellas at half the rows each.
 fn sub_samples(zoom_out: u32, level: u32) -> usize {
     if zoom_out > 0 && level == 0 {
         2
