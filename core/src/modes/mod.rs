@@ -97,6 +97,15 @@ impl<'a> Source<'a> {
         self.map.map_or(&self.exemplar.pixels, |m| &m.texels)
     }
 
+    /// The centred `2^k × 2^k` box means of [`Source::texels`] (`k ≤ levels`), when something
+    /// holds them: the map, or the analysis for the colour (each derives them once).
+    pub fn box_colours(&self, k: u32) -> Option<&'a [[u8; 3]]> {
+        match self.map {
+            Some(m) => Some(m.box_colours(k)),
+            None => self.analysis.map(|a| a.box_colours(k)),
+        }
+    }
+
     /// The high-resolution texels magnified views sample, when the texture has them.
     pub fn hires(&self) -> Option<&'a [[u8; 3]]> {
         match self.map {

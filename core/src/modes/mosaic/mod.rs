@@ -99,7 +99,7 @@ impl Mode for Mosaic {
 
     fn render(p: &MosaicParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
         Ok(Rendered {
-            image: render_texels(src.exemplar, src.texels(), p, view.zoom_out, view.rect)?,
+            image: render_texels(src, p, view.zoom_out, view.rect)?,
             synthesized: render_cost(view.zoom_out, view.rect),
         })
     }
@@ -119,19 +119,20 @@ pub fn render_cost(zoom_out: u32, rect: Rect) -> u64 {
 /// [`sampled`]): as cheap at every zoom as at native, and the box filter of the native pixels
 /// but where a pixel spans a block edge.
 pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
-    render_texels(ex, &ex.pixels, p, zoom_out, rect)
+    render_texels(&Source::exemplar(ex), p, zoom_out, rect)
 }
 
-/// [`render`] showing `texels` at the exemplar's coordinates: its colours, or one of its
+/// [`render`] showing `src`'s texels at the exemplar's coordinates: its colours, or one of its
 /// material maps.
-pub fn render_texels(ex: &Exemplar, texels: &[[u8; 3]], p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+pub fn render_texels(src: &Source, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+    let ex = src.exemplar;
     p.validate(ex.side)?;
     check_window(rect, MAX_PIXELS)?;
     let layout = Layout::new(ex.side as i64, p);
     if zoom_out == 0 {
-        return Ok(native(ex, texels, &layout, rect));
+        return Ok(native(ex, src.texels(), &layout, rect));
     }
-    Ok(sampled(ex, texels, &layout, zoom_out, rect))
+    Ok(sampled(src, &layout, zoom_out, rect))
 }
 
 /// Pixels per parallel piece of [`sampled`]'s colouring.
@@ -139,10 +140,12 @@ const SAMPLED_PIXELS: usize = 1 << 13;
 
 /// Zoomed out `k` steps (`2^k` texels per pixel) by labelling each pixel with its centre
 /// texel's source, like the paper's reduced-scale rendering, coloured with the mean of the
-/// `2^k × 2^k` exemplar texels around that source (toroidally, from an integral image): the
-/// exact box filter of the native pixels wherever they all share the label, all but a block
-/// edge's pixels; the mean colour once a pixel covers the whole exemplar.
-fn sampled(ex: &Exemplar, texels: &[[u8; 3]], layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
+/// `2^k × 2^k` exemplar texels around that source, toroidally (the box means the analysis or
+/// the map holds, else from an integral image): the exact box filter of the native pixels
+/// wherever they all share the label, all but a block edge's pixels; the mean colour once a
+/// pixel covers the whole exemplar.
+fn sampled(src: &Source, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
+    let (ex, texels) = (src.exemplar, src.texels());
     let n = layout.n as usize;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let step = 1i64 << k.min(40);
@@ -151,21 +154,19 @@ fn sampled(ex: &Exemplar, texels: &[[u8; 3]], layout: &Layout, k: u32, rect: Rec
         let mean = box_mip(texels, n, levels as usize)[0];
         return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
     }
-    // The integral image (serial) while the labels are painted.
-    let (sums, src) =
-        rayon::join(|| Integral::new(texels, n, step as usize), || sources(layout, rect, ex.toroidal, step, step / 2));
+    let labels = sources(layout, rect, ex.toroidal, step, step / 2);
+    // The box means the analysis or the map holds, else each pixel's from an integral image.
+    let mean: Box<dyn Fn(usize, usize) -> [u8; 3] + Sync> = match src.box_colours(k) {
+        Some(boxes) => Box::new(move |x, y| boxes[y * n + x]),
+        None => {
+            let sums = Integral::new(texels, n, step as usize);
+            Box::new(move |x, y| sums.mean_around(x, y))
+        }
+    };
     let mut pixels = vec![0u8; 3 * w * h];
-    // With fewer exemplar texels than pixels (a small exemplar far out), every texel's mean
-    // once and a lookup per pixel cost less than a mean per pixel.
-    let table: Option<Vec<[u8; 3]>> =
-        (n * n < w * h).then(|| (0..n * n).into_par_iter().map(|i| sums.mean_around(i % n, i / n)).collect());
-    pixels.par_chunks_mut(3 * SAMPLED_PIXELS).zip(src.par_chunks(SAMPLED_PIXELS)).for_each(|(out, src)| {
-        for (o, &v) in out.chunks_exact_mut(3).zip(src) {
-            let (x, y) = ((v & 0xFFFF) as usize, (v >> 16) as usize);
-            o.copy_from_slice(&match &table {
-                Some(t) => t[y * n + x],
-                None => sums.mean_around(x, y),
-            });
+    pixels.par_chunks_mut(3 * SAMPLED_PIXELS).zip(labels.par_chunks(SAMPLED_PIXELS)).for_each(|(out, labels)| {
+        for (o, &v) in out.chunks_exact_mut(3).zip(labels) {
+            o.copy_from_slice(&mean((v & 0xFFFF) as usize, (v >> 16) as usize));
         }
     });
     RgbWindow { width: w as u32, height: h as u32, pixels }
