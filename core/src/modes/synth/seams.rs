@@ -54,12 +54,6 @@ impl Style {
     }
 }
 
-/// The tent weight of offset `d ∈ 0..=2·RADIUS` along one axis.
-#[inline(always)]
-fn weight(d: usize) -> i32 {
-    (RADIUS + 1 - d.abs_diff(RADIUS)) as i32
-}
-
 /// Appends to `out` (RGB8) the blended colours of the `w × h` pixels at the centre of
 /// `coords`, a `(w + 2·RADIUS) × (h + 2·RADIUS)` window of packed exemplar coordinates
 /// `x | y << 16`, from the `m × m` exemplar `texels` and their low-pass `low`. Rows run in
@@ -90,35 +84,26 @@ pub(crate) fn blend(
     // Channels packed 21 bits apart, so one multiply-add weighs all three: a weighted sum
     // stays below 255 · 256 < 2^21 per channel.
     let pack = |c: [u8; 3]| c[0] as u64 | (c[1] as u64) << 21 | (c[2] as u64) << 42;
-    let padded: Vec<u64> = (0..pm * pm)
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = ((i % pm) as i64 - R as i64, (i / pm) as i64 - R as i64);
-            let (x, y) = if toroidal { (x & mask, y & mask) } else { (x.clamp(0, mask), y.clamp(0, mask)) };
-            pack(low[y as usize * m + x as usize])
-        })
-        .collect();
-    // Each buffer pixel's translation `t(q)`: its coordinate as an index into `padded` less its
-    // own position `lin(q)` at `padded`'s stride, so that what `q` predicts for `p` (`S(q) −
-    // (q − p)`) is `padded[t(q) + lin(p)]`. Neighbours with equal translations predict alike:
-    // along a row they form runs, and a pixel weighs each run of its window at once (the same
-    // integer sum as tap by tap, in a fraction of the reads).
-    let lin = |x: usize, y: usize| (y * pm + x) as isize;
-    let trans: Vec<isize> = coords
-        .par_iter()
-        .enumerate()
-        .map(|(i, &v)| (((v >> 16) as usize + R) * pm + (v & 0xFFFF) as usize + R) as isize - lin(i % bw, i / bw))
-        .collect();
-    // Where each pixel's run of equal translations ends along its row (exclusive).
-    let mut run_end = vec![0u32; bw * bh];
-    run_end.par_chunks_exact_mut(bw).zip(trans.par_chunks_exact(bw)).for_each(|(row_e, row_t)| {
-        row_e[bw - 1] = bw as u32;
-        for x in (0..bw - 1).rev() {
-            row_e[x] = if row_t[x + 1] == row_t[x] { row_e[x + 1] } else { x as u32 + 1 };
+    let mut padded = vec![0u64; pm * pm];
+    padded.par_chunks_exact_mut(pm).enumerate().for_each(|(py, row)| {
+        let y = py as i64 - R as i64;
+        let y = if toroidal { y & mask } else { y.clamp(0, mask) } as usize;
+        for (px, out) in row.iter_mut().enumerate() {
+            let x = px as i64 - R as i64;
+            let x = if toroidal { x & mask } else { x.clamp(0, mask) } as usize;
+            *out = pack(low[y * m + x]);
         }
     });
-    // Tent weights summed over the first `k` taps of a row.
-    let prefix: [u64; SIDE + 1] = std::array::from_fn(|k| (0..k).map(|d| weight(d) as u64).sum());
+    // Each buffer pixel's translation `t(q)`: its coordinate as an index into `padded` less its
+    // own position `lin(q)` at `padded`'s stride, so that what `q` predicts for `p` (`S(q) −
+    // (q − p)`) is `padded[t(q) + lin(p)]`.
+    let lin = |x: usize, y: usize| (y * pm + x) as isize;
+    let mut trans = vec![0isize; bw * bh];
+    trans.par_chunks_exact_mut(bw).zip(coords.par_chunks_exact(bw)).enumerate().for_each(|(y, (row_t, row_c))| {
+        for (x, (t, &v)) in row_t.iter_mut().zip(row_c).enumerate() {
+            *t = (((v >> 16) as usize + R) * pm + (v & 0xFFFF) as usize + R) as isize - lin(x, y);
+        }
+    });
     let index = |v: u32| (v >> 16) as usize * m + (v & 0xFFFF) as usize;
     // Pixels whose right or lower neighbour does not continue them, then whether one lies
     // within `R` along each row: a pixel with none in its window is its texel.
@@ -130,24 +115,34 @@ pub(crate) fn blend(
             (x | y << 16) as u32
         }
     };
-    let seam: Vec<bool> = (0..bw * bh)
-        .into_par_iter()
-        .map(|i| {
-            let v = coords[i];
-            (i % bw + 1 < bw && coords[i + 1] != next(v, 1, 0)) || (i + bw < bw * bh && coords[i + bw] != next(v, 0, 1))
-        })
-        .collect();
-    let near_row: Vec<bool> = (0..bw * bh)
-        .into_par_iter()
-        .map(|i| {
-            let x = i % bw;
-            x >= R && x + R < bw && seam[i - R..=i + R].iter().any(|&s| s)
-        })
-        .collect();
+    let mut seam = vec![false; bw * bh];
+    seam.par_chunks_exact_mut(bw).enumerate().for_each(|(y, row)| {
+        let (here, below) = (&coords[y * bw..(y + 1) * bw], coords.get((y + 1) * bw..(y + 2) * bw));
+        for (x, out) in row.iter_mut().enumerate() {
+            let v = here[x];
+            *out = (x + 1 < bw && here[x + 1] != next(v, 1, 0)) || below.is_some_and(|b| b[x] != next(v, 0, 1));
+        }
+    });
+    let mut near_row = vec![false; bw * bh];
+    near_row.par_chunks_exact_mut(bw).zip(seam.par_chunks_exact(bw)).for_each(|(row, s)| {
+        for x in R..bw.saturating_sub(R) {
+            row[x] = s[x - R..=x + R].iter().any(|&s| s);
+        }
+    });
+    // The tent weights along one axis.
+    const WEIGHTS: [u64; SIDE] = {
+        let mut w = [0; SIDE];
+        let mut d = 0;
+        while d < SIDE {
+            w[d] = (R + 1 - d.abs_diff(R)) as u64;
+            d += 1;
+        }
+        w
+    };
     // The weights sum to 2^8: the mean is a rounding shift.
     const SHIFT: u32 = 8;
     let total = 1i32 << SHIFT;
-    debug_assert_eq!(prefix[SIDE] * prefix[SIDE], total as u64);
+    debug_assert_eq!(WEIGHTS.iter().sum::<u64>().pow(2), total as u64);
     // `c · size / fade` for every correction `|c| ≤ size < fade` (indexed `[size][c + fade]`):
     // a lookup instead of a division per channel.
     let faded: Vec<Vec<i32>> = (0..fade).map(|size| (-fade..=fade).map(|c| c * size / fade).collect()).collect();
@@ -163,22 +158,19 @@ pub(crate) fn blend(
                 px.copy_from_slice(&own);
                 continue;
             }
-            // The tent-weighted sum of the neighbours' predictions, a row run at a time, less
-            // `v`'s own low-pass colour at full weight (neighbours that continue `v` predict it:
-            // they add nothing to the correction).
+            // The tent-weighted sum of the neighbours' predictions, less `v`'s own low-pass
+            // colour at full weight (neighbours that continue `v` predict it: they add nothing
+            // to the correction). Every tap is read: a fixed, branch-free sum.
             let mine = low[index(v)].map(i32::from);
-            let mut sum = 0u64;
             let here = lin(cx, cy);
-            for dy in 0..SIDE {
-                let row = (cy + dy - R) * bw;
-                let wy = weight(dy) as u64;
-                let mut x = cx - R;
-                while x <= cx + R {
-                    let end = (run_end[row + x] as usize).min(cx + R + 1);
-                    let wx = prefix[end + R - cx] - prefix[x + R - cx];
-                    sum += wy * wx * padded[(trans[row + x] + here) as usize];
-                    x = end;
+            let mut sum = 0u64;
+            for (dy, &wy) in WEIGHTS.iter().enumerate() {
+                let row = (cy + dy - R) * bw + cx - R;
+                let mut along = 0u64;
+                for (&t, &wx) in trans[row..row + SIDE].iter().zip(&WEIGHTS) {
+                    along += wx * padded[(t + here) as usize];
                 }
+                sum += wy * along;
             }
             let acc: [i32; 3] = std::array::from_fn(|k| ((sum >> (21 * k)) & 0x1F_FFFF) as i32);
             let acc: [i32; 3] = std::array::from_fn(|k| acc[k] - total * mine[k]);
