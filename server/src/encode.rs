@@ -151,12 +151,12 @@ fn png_parts(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, ImageError> {
     }
     // The image data: each row's filter type, 0 (none), then the row.
     let mut raw = Vec::with_capacity((stride + 1) * h as usize);
-    for row in rgb.chunks_exact(stride.max(1)) {
+    for row in rgb.chunks_exact(stride) {
         raw.push(0);
         raw.extend_from_slice(row);
     }
     let part = (stride + 1) * PART_ROWS as usize;
-    let starts: Vec<usize> = (0..raw.len()).step_by(part.max(1)).collect();
+    let starts: Vec<usize> = (0..raw.len()).step_by(part).collect();
     let parts: Vec<Result<Vec<u8>, flate2::CompressError>> = starts
         .par_iter()
         .map(|&start| {
@@ -186,24 +186,24 @@ fn png_parts(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, ImageError> {
     // The zlib header (deflate, 32 KiB window; FLEVEL 1: a fast level), the parts, Adler-32.
     let mut zlib = vec![0x78, 0x5E];
     for part in parts {
-        zlib.extend_from_slice(&part.map_err(|e| encoding_error(e.to_string()))?);
+        zlib.extend_from_slice(&part.map_err(encoding_error)?);
     }
     zlib.extend_from_slice(&simd_adler32::adler32(&raw.as_slice()).to_be_bytes());
     let mut out = Vec::with_capacity(zlib.len() + 64);
     let mut enc = png::Encoder::new(&mut out, w, h);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
-    let mut writer = enc.write_header().map_err(|e| encoding_error(e.to_string()))?;
-    writer.write_chunk(png::chunk::IDAT, &zlib).map_err(|e| encoding_error(e.to_string()))?;
-    writer.finish().map_err(|e| encoding_error(e.to_string()))?;
+    let mut writer = enc.write_header().map_err(encoding_error)?;
+    writer.write_chunk(png::chunk::IDAT, &zlib).map_err(encoding_error)?;
+    writer.finish().map_err(encoding_error)?;
     Ok(out)
 }
 
 /// A PNG encoding failure as the image crate reports one.
-fn encoding_error(message: String) -> ImageError {
+fn encoding_error(e: impl std::fmt::Display) -> ImageError {
     ImageError::Encoding(image::error::EncodingError::new(
         image::error::ImageFormatHint::Exact(image::ImageFormat::Png),
-        message,
+        e.to_string(),
     ))
 }
 
