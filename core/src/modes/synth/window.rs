@@ -20,7 +20,7 @@ use crate::mask::RandomnessMask;
 use crate::modes::params::ONE_Q16;
 use super::controls::Controls;
 use super::history::{block_index, capture, for_rows, overlay, pending};
-use super::kernel::{projection_pairs, projection_run_pairs, tap_spans, Kernel};
+use super::kernel::{projection_pairs, projection_run_pairs, tap_shifts, tap_spans, Kernel};
 use super::params::SynthParams;
 use super::Synth;
 use crate::modes::Mode;
@@ -413,6 +413,7 @@ impl<'a> Ctx<'a> {
             h: h as u32,
             edged: !self.an.header.toroidal,
             span: tap_spans(m as u32, h as u32),
+            shift: tap_shifts(m as u32, h as u32),
         }
     }
 }

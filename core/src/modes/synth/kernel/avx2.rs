@@ -56,8 +56,13 @@ impl Kernel<'_> {
         {
             return self.row_portable(s, col, start, step, out);
         }
+        let coherent = Coherence::new(self);
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
+            if !full_search_forced() && coherent.at(self, idx, s) {
+                *o = s[idx];
+                continue;
+            }
             let (texel, coord, edge) = self.candidates_avx2(idx, s, &nb);
             let mut acc = _mm256_setzero_si256();
             // The 5×5 taps are five runs of five adjacent pixels: one bounds check per run.
@@ -297,6 +302,55 @@ impl Neighbours {
             low: _mm256_set1_epi32(0xFFFF),
             log2m: _mm_cvtsi32_si128(k.m.trailing_zeros() as i32),
         }
+    }
+}
+
+/// [`Kernel::coherent`] for AVX2: each row of five taps compared at once.
+#[cfg(target_arch = "x86_64")]
+struct Coherence {
+    /// Per row of taps, the shifts of its five taps (lanes 5–7 unused).
+    shift: [std::arch::x86_64::__m256i; 5],
+    /// Both packed coordinates' masks.
+    mask: std::arch::x86_64::__m256i,
+    /// Lanes 0–4 of a row: loaded and compared.
+    lanes: std::arch::x86_64::__m256i,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Coherence {
+    #[target_feature(enable = "avx2")]
+    fn new(k: &Kernel) -> Self {
+        use std::arch::x86_64::*;
+        let load = |v: [u32; 8]| {
+            // SAFETY: 8 u32 = 256 bits; unaligned load.
+            unsafe { _mm256_loadu_si256(v.as_ptr() as *const __m256i) }
+        };
+        Coherence {
+            shift: std::array::from_fn(|r| load(std::array::from_fn(|c| if c < 5 { k.shift[5 * r + c] } else { 0 }))),
+            mask: _mm256_set1_epi32((k.mask | k.mask << 16) as i32),
+            lanes: load(std::array::from_fn(|c| if c < 5 { u32::MAX } else { 0 })),
+        }
+    }
+
+    /// Whether the 5×5 neighbourhood of buffer index `idx` is coherent.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn at(&self, k: &Kernel, idx: usize, s: &[u32]) -> bool {
+        use std::arch::x86_64::*;
+        let v = _mm256_set1_epi32(s[idx] as i32);
+        // The centre row first, then outwards: most pixels that are not coherent show it
+        // there, and leave after one row.
+        for r in [2, 1, 3, 0, 4] {
+            let at = (idx as isize + k.taps[5 * r]) as usize;
+            let Some(run) = s.get(at..at + 5) else { return k.coherent(idx, s) };
+            // SAFETY: only lanes 0–4 are read (`lanes`), all inside `run`.
+            let got = unsafe { _mm256_maskload_epi32(run.as_ptr() as *const i32, self.lanes) };
+            let want = _mm256_and_si256(_mm256_add_epi32(v, self.shift[r]), self.mask);
+            if _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(got, want))) & 0x1F != 0x1F {
+                return false;
+            }
+        }
+        true
     }
 }
 

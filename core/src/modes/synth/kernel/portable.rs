@@ -9,6 +9,10 @@ impl Kernel<'_> {
     pub(super) fn row_portable(&self, s: &[u32], col: &[u32], start: usize, step: usize, out: &mut [u32]) {
         for (i, o) in out.iter_mut().enumerate() {
             let idx = start + i * step;
+            if !full_search_forced() && self.coherent(idx, s) {
+                *o = s[idx];
+                continue;
+            }
             let terms = self.tap_terms(idx, col);
             *o = self.best(idx, s, &terms, sum_taps(&terms, 0..5, 0..5));
         }
