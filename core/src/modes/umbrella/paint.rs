@@ -7,7 +7,8 @@ use super::*;
 /// Render a view at level of detail `level` (whose cells are at least two pixels wide) over a
 /// background (rendered meanwhile): band by band — one row of cells each, a frame of
 /// [`lod::FRAME`] cells at a time — the coverage of every pixel's fixed sub-samples
-/// ([`sub_samples`]: 4×4, or 2×2 zoomed out at level 0; [`raster`]) by the cells' umbrellas
+/// ([`sub_samples`]: 4×4 at native zoom, 2×2 zoomed out at level 0, 3×3 at merged levels;
+/// [`raster`]) by the cells' umbrellas
 /// (level 0: the union of the cells' lists, each umbrella masked to the cells that list it;
 /// merged levels: the merged umbrellas around the row, [`lod::list`]), then per pixel the
 /// colour of each umbrella (or the background) its sub-samples see, evaluated once at their
@@ -148,6 +149,7 @@ pub(super) fn paint(
                     let centre = [ox + 0.5 * step as f32, oy + 0.5 * step as f32];
                     let out = match aa {
                         2 => resolve::<2>(&cov, k0, [ox, oy], sp, centre, eval),
+                        3 => resolve::<3>(&cov, k0, [ox, oy], sp, centre, eval),
                         _ => resolve::<AA>(&cov, k0, [ox, oy], sp, centre, eval),
                     };
                     for k in 0..3 {
