@@ -416,40 +416,43 @@ pub struct Local<'a> {
 }
 
 /// The merged umbrellas that may cover level-`j` cells `cx0..cx1` of row `cy` or shade them,
-/// front to back, relative to the origin of cell `(frame, cy)`: those of the cells around them
-/// whose disc, grown by the shadow offset, meets them. (Merged levels keep every umbrella of a
-/// cell, not the first `k`, so the list of a stretch of cells is the union of its cells'
-/// lists: each umbrella is rasterised once per stretch, not once per cell it reaches.)
-pub fn list<'a>(
+/// front to back, relative to the origin of cell `(frame, cy)`, appended to `out`: those of the
+/// cells around them whose disc, grown by the shadow offset, meets them. (Merged levels keep
+/// every umbrella of a cell, not the first `k`, so the list of a stretch of cells is the union
+/// of its cells' lists: each umbrella is rasterised once per stretch, not once per cell it
+/// reaches.) The umbrellas are ordered by reference (their depth and id, unique), and their
+/// rims built in that order, so no rim is moved.
+pub fn list_into<'a>(
     cells: impl Iterator<Item = &'a Vec<Merged>>,
     arr: &Arrangement,
     j: u32,
     frame: i64,
     (cx0, cx1): (i64, i64),
     cy: i64,
-) -> Vec<Local<'a>> {
+    out: &mut Vec<Local<'a>>,
+) {
     let side = (arr.g << j) as f64;
     let origin = [frame as f64 * side, cy as f64 * side];
     let grow = 1.5 * arr.shadow_offset as f64;
     let extent = [((cx0 - frame) as f64 * side) as f32, ((cx1 - frame) as f64 * side) as f32, 0.0, side as f32];
-    let mut out: Vec<Local> = cells
+    let centre = |m: &Merged| [(m.o[0] - origin[0]) as f32, (m.o[1] - origin[1]) as f32];
+    let mut near: Vec<&Merged> = cells
         .flat_map(|ms| ms.iter())
-        .filter_map(|m| {
-            let o = [(m.o[0] - origin[0]) as f32, (m.o[1] - origin[1]) as f32];
+        .filter(|m| {
+            let o = centre(m);
             let r = (m.reach + grow) as f32;
-            if !disc_reaches(o[0], o[1], r * r, extent) && !disc_reaches(o[0] + grow as f32, o[1] + grow as f32, r * r, extent) {
-                return None;
-            }
-            let mut v = [[0f32; 2]; RAYS];
-            for (d, s) in v.iter_mut().zip(&m.rim) {
-                *d = [(s[0] - origin[0]) as f32, (s[1] - origin[1]) as f32];
-            }
-            let reach2 = (m.reach * m.reach) as f32;
-            Some(Local { m, o, reach2, rim: Poly::new(v, m.rim.len()), origin })
+            disc_reaches(o[0], o[1], r * r, extent) || disc_reaches(o[0] + grow as f32, o[1] + grow as f32, r * r, extent)
         })
         .collect();
-    out.sort_unstable_by(|a, b| b.m.depth.cmp(&a.m.depth).then(a.m.id.cmp(&b.m.id)));
-    out
+    near.sort_unstable_by(|a, b| b.depth.cmp(&a.depth).then(a.id.cmp(&b.id)));
+    out.extend(near.into_iter().map(|m| {
+        let mut v = [[0f32; 2]; RAYS];
+        for (d, s) in v.iter_mut().zip(&m.rim) {
+            *d = [(s[0] - origin[0]) as f32, (s[1] - origin[1]) as f32];
+        }
+        let reach2 = (m.reach * m.reach) as f32;
+        Local { m, o: centre(m), reach2, rim: Poly::new(v, m.rim.len()), origin }
+    }));
 }
 
 /// How many level-`j` cells away a merged umbrella may still cover or shade a cell: a rim

@@ -10,7 +10,7 @@ use super::*;
 /// ([`sub_samples`]: 4×4 at native zoom, 2×2 zoomed out at level 0, 3×3 at merged levels;
 /// [`raster`]) by the cells' umbrellas
 /// (level 0: the union of the cells' lists, each umbrella masked to the cells that list it;
-/// merged levels: the merged umbrellas around the row, [`lod::list`]), then per pixel the
+/// merged levels: the merged umbrellas around the row, [`lod::list_into`]), then per pixel the
 /// colour of each umbrella (or the background) its sub-samples see, evaluated once at their
 /// centroid and weighted by their number, darkened by their shadows: multisample
 /// anti-aliasing, with one colour evaluation for a pixel inside one umbrella.
@@ -106,13 +106,14 @@ pub(super) fn paint(
                     let near = (cy - reach..=cy + reach)
                         .flat_map(|y| (fx - reach..end + reach).map(move |x| (x, y)))
                         .map(|(x, y)| &*merged[(y - my0) as usize * mw + (x - mx0) as usize].2);
-                    let list = lod::list(near, arr, level, frame, (fx, end), cy);
+                    let first = locals.len();
+                    lod::list_into(near, arr, level, frame, (fx, end), cy, &mut locals);
+                    let list = &locals[first..];
                     let shape = |n: usize, o: f32, extent: [f32; 4]| {
                         let l = &list[n];
                         raster::disc_reaches(l.o[0] + o, l.o[1] + o, l.reach2, extent).then(|| (l.rim.shifted(o), u64::MAX))
                     };
-                    cov.fill_list(list.len(), shape, raster::Cells::ALL, locals.len() as u32, sp, rows, cols, band, shadows);
-                    locals.extend(list);
+                    cov.fill_list(list.len(), shape, raster::Cells::ALL, first as u32, sp, rows, cols, band, shadows);
                 }
                 fx = end;
             }
