@@ -11,7 +11,7 @@ use image::codecs::webp::WebPEncoder;
 use image::{ExtendedColorType, ImageEncoder, ImageError};
 
 /// Version of the encoder settings (bump when they change).
-pub const ENCODER_VERSION: u32 = 5;
+pub const ENCODER_VERSION: u32 = 6;
 
 /// Version of the material maps' encoding ([`Effort::Map`]), in their tiles' keys only: a change
 /// of it changes the maps' ETags, not the colour's.
@@ -56,8 +56,9 @@ impl Format {
     }
 }
 
-/// How hard PNG compression works. Synthesized tiles (Tight) are deflated in parallel parts
-/// ([`png_parts`]): 2.3 → 1.3 ms for a 256² gravel tile on two cores, 84 KiB either way.
+/// How hard PNG compression works. Synthesized (Tight) and mosaic (Quick) tiles are deflated in
+/// parallel parts ([`png_parts`]): on two cores a 256² gravel tile 2.3 → 1.3 ms (84 KiB either
+/// way), a mosaic one 1.04 → 0.69 ms (106 → 105 KiB).
 /// Measured on 256² gravel tiles (synth / mosaic), one stream, through
 /// zlib-rs: level 4 gives 83 / 71 KiB in 1.7 / 1.5 ms, level 1 gives 113 / 102 KiB in 0.8 / 0.7 ms
 /// (the former miniz_oxide level 2: 84 / 80 KiB in 1.5 ms; fdeflate's "fast": 190 KiB in 0.2 ms,
@@ -104,19 +105,18 @@ fn encode_into_vec(rgb: &[u8], w: u32, h: u32, fmt: Format, effort: Effort) -> R
 }
 
 /// Encode RGB8 pixels as PNG with the fixed settings of an effort: Tight is level 4 unfiltered
-/// (synthesized texture repeats exemplar texels, which deflate finds unfiltered) in parallel
-/// parts ([`png_parts`]), Quick is
-/// level 1 with the Paeth filter, Map is fdeflate with the Paeth filter, grey when the pixels are.
+/// (synthesized texture repeats exemplar texels, which deflate finds unfiltered), Quick is
+/// level 1 with the Paeth filter, both in parallel parts ([`png_parts`]); Map is fdeflate with
+/// the Paeth filter, grey when the pixels are.
 fn png(rgb: &[u8], w: u32, h: u32, effort: Effort) -> Result<Vec<u8>, ImageError> {
-    let (compression, filter) = match effort {
-        Effort::Tight => return png_parts(rgb, w, h),
-        Effort::Quick => (CompressionType::Level(1), FilterType::Paeth),
-        Effort::Map => (CompressionType::Fast, FilterType::Paeth),
-    };
+    match effort {
+        Effort::Tight => return png_parts(rgb, w, h, TIGHT_LEVEL, RowFilter::None),
+        Effort::Quick => return png_parts(rgb, w, h, QUICK_LEVEL, RowFilter::Paeth),
+        Effort::Map => {}
+    }
     let mut out = Cursor::new(Vec::new());
-    let encoder = PngEncoder::new_with_quality(&mut out, compression, filter);
-    let grey = effort == Effort::Map && rgb.chunks_exact(3).all(|p| p[0] == p[1] && p[1] == p[2]);
-    if grey {
+    let encoder = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Paeth);
+    if rgb.chunks_exact(3).all(|p| p[0] == p[1] && p[1] == p[2]) {
         let l: Vec<u8> = rgb.chunks_exact(3).map(|p| p[0]).collect();
         encoder.write_image(&l, w, h, ExtendedColorType::L8)?;
     } else {
@@ -131,16 +131,76 @@ const PART_ROWS: u32 = 64;
 const WINDOW: usize = 32 * 1024;
 /// The deflate level of [`Effort::Tight`].
 const TIGHT_LEVEL: u32 = 4;
+/// The deflate level of [`Effort::Quick`].
+const QUICK_LEVEL: u32 = 1;
 
-/// [`Effort::Tight`]: RGB8 unfiltered, its image data deflated at level 4 in parts of
-/// [`PART_ROWS`] rows at once on the pool's threads — each part a run of deflate blocks ended by
-/// a sync flush (the last by the final block), so that their concatenation is one zlib stream,
-/// and primed with the 32 KiB of data before it, the window a decoder then holds (pigz's
-/// scheme): a part refers back across its start as one stream would. The parts depend on the
-/// image's size only: the same bytes whatever the thread count. A 256² synthesized tile: four
-/// parts, about half the time of one stream on two cores, for the same size (81 089 → 81 121
-/// bytes on a gravel tile; bench/README.md).
-fn png_parts(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, ImageError> {
+/// The PNG row filter [`png_parts`] applies to every row (PNG filter method 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RowFilter {
+    /// Type 0: the row as it is.
+    None,
+    /// Type 4: each byte less the Paeth predictor of its left, upper and upper-left bytes.
+    Paeth,
+}
+
+impl RowFilter {
+    /// Append `row`'s filter type byte and its filtered bytes to `out`; `prev` is the row above
+    /// (`None` for the first, whose upper bytes count as 0).
+    fn push(self, prev: Option<&[u8]>, row: &[u8], out: &mut Vec<u8>) {
+        match self {
+            RowFilter::None => {
+                out.push(0);
+                out.extend_from_slice(row);
+            }
+            RowFilter::Paeth => {
+                out.push(4);
+                let zeros;
+                let up = match prev {
+                    Some(p) => p,
+                    None => {
+                        zeros = vec![0; row.len()];
+                        &zeros
+                    }
+                };
+                // The first pixel has no left neighbours: its predictor is the byte above.
+                let first = row.len().min(3);
+                out.extend(row[..first].iter().zip(up).map(|(&x, &b)| x.wrapping_sub(b)));
+                // The others: x, a (left), b (above), c (upper left), as four aligned slices.
+                let (x, a) = (&row[first..], &row[..row.len() - first]);
+                let (b, c) = (&up[first..], &up[..row.len() - first]);
+                let predicted = a.iter().zip(b).zip(c).map(|((&a, &b), &c)| paeth(a, b, c));
+                out.extend(x.iter().zip(predicted).map(|(&x, p)| x.wrapping_sub(p)));
+            }
+        }
+    }
+}
+
+/// The Paeth predictor (PNG specification, section 9.4): of left `a`, above `b` and upper-left
+/// `c`, the one closest to `a + b − c`, ties going to `a`, then `b`.
+fn paeth(a: u8, b: u8, c: u8) -> u8 {
+    let (ia, ib, ic) = (i16::from(a), i16::from(b), i16::from(c));
+    let pa = (ib - ic).abs();
+    let pb = (ia - ic).abs();
+    let pc = (ia + ib - 2 * ic).abs();
+    if pa <= pb && pa <= pc {
+        a
+    } else if pb <= pc {
+        b
+    } else {
+        c
+    }
+}
+
+/// RGB8 with one row filter, its image data deflated at `level` in parts of [`PART_ROWS`] rows
+/// at once on the pool's threads — each part a run of deflate blocks ended by a sync flush (the
+/// last by the final block), so that their concatenation is one zlib stream, and primed with the
+/// 32 KiB of data before it, the window a decoder then holds (pigz's scheme): a part refers back
+/// across its start as one stream would. The parts depend on the image's size only: the same
+/// bytes whatever the thread count. A 256² synthesized tile at level 4: four parts, about half
+/// the time of one stream on two cores, for the same size (81 089 → 81 121 bytes on a gravel
+/// tile; bench/README.md). The png crate filters rows only inside its own single stream, hence
+/// the filter here.
+fn png_parts(rgb: &[u8], w: u32, h: u32, level: u32, filter: RowFilter) -> Result<Vec<u8>, ImageError> {
     use flate2::{Compress, Compression, FlushCompress, Status};
     use rayon::prelude::*;
     let stride = 3 * w as usize;
@@ -149,12 +209,22 @@ fn png_parts(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, ImageError> {
             image::error::ParameterErrorKind::DimensionMismatch,
         )));
     }
-    // The image data: each row's filter type, 0 (none), then the row.
-    let mut raw = Vec::with_capacity((stride + 1) * h as usize);
-    for row in rgb.chunks_exact(stride) {
-        raw.push(0);
-        raw.extend_from_slice(row);
-    }
+    // The image data: each row's filter type, then the filtered row (bands filtered in parallel).
+    let band = stride * PART_ROWS as usize;
+    let bands: Vec<Vec<u8>> = rgb
+        .par_chunks(band)
+        .enumerate()
+        .map(|(i, rows)| {
+            let mut out = Vec::with_capacity(rows.len() + rows.len() / stride);
+            let mut prev = (i > 0).then(|| &rgb[i * band - stride..i * band]);
+            for row in rows.chunks_exact(stride) {
+                filter.push(prev, row, &mut out);
+                prev = Some(row);
+            }
+            out
+        })
+        .collect();
+    let raw = bands.concat();
     let part = (stride + 1) * PART_ROWS as usize;
     let starts: Vec<usize> = (0..raw.len()).step_by(part).collect();
     let parts: Vec<Result<Vec<u8>, flate2::CompressError>> = starts
@@ -163,7 +233,7 @@ fn png_parts(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, ImageError> {
             let end = (start + part).min(raw.len());
             let last = end == raw.len();
             let flush = if last { FlushCompress::Finish } else { FlushCompress::Sync };
-            let mut z = Compress::new(Compression::new(TIGHT_LEVEL), false);
+            let mut z = Compress::new(Compression::new(level), false);
             // What a decoder holds in its window when it reaches this part (as pigz does).
             if start > 0 {
                 z.set_dictionary(&raw[start.saturating_sub(WINDOW)..start])?;
@@ -254,44 +324,71 @@ mod tests {
     }
 
     #[test]
-    fn tight_pngs_deflated_in_parts_are_one_valid_stream_whatever_the_threads() {
+    fn pngs_deflated_in_parts_are_one_valid_stream_whatever_the_threads() {
         // Texture-like data with long repeats (as synthesized tiles copy exemplar texels), at
         // sizes with no, one, several and a ragged last part.
         let exemplar: Vec<u8> = (0..97 * 3u32).map(|i| ((i * 7919) >> 3) as u8).collect();
-        for (w, h) in [(1, 1), (5, 63), (256, 64), (300, 131), (256, 256)] {
-            let rgb: Vec<u8> =
-                (0..w * h * 3).map(|i| exemplar[(i as usize * 5 / 3 + i as usize / 700) % exemplar.len()]).collect();
-            let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
-            let one = pool(1).install(|| encode(&rgb, w, h, Format::Png, Effort::Tight).unwrap());
-            let four = pool(4).install(|| encode(&rgb, w, h, Format::Png, Effort::Tight).unwrap());
-            assert_eq!(one, four, "{w}×{h}: the same bytes on 1 and 4 threads");
-            let img = image::load_from_memory(&one).unwrap().to_rgb8();
-            assert_eq!((img.dimensions(), img.into_raw()), ((w, h), rgb.clone()), "{w}×{h}");
-            // The image data as zlib itself reads it (the png decoder skips the Adler-32).
-            let (mut at, mut idat) = (8, Vec::new());
-            while at + 12 <= one.len() {
-                let n = u32::from_be_bytes(one[at..at + 4].try_into().unwrap()) as usize;
-                if &one[at + 4..at + 8] == b"IDAT" {
-                    idat.extend_from_slice(&one[at + 8..at + 8 + n]);
+        // Size allowed beyond one stream, in percent: level 1 loses a little more at each
+        // part's flush (300×131: 14 871 bytes against 14 423; a 256² mosaic tile: the same).
+        for (effort, level, filter, row_filter, slack) in [
+            (Effort::Tight, 4, FilterType::NoFilter, RowFilter::None, 1),
+            (Effort::Quick, 1, FilterType::Paeth, RowFilter::Paeth, 4),
+        ] {
+            for (w, h) in [(1, 1), (5, 63), (256, 64), (300, 131), (256, 256)] {
+                let rgb: Vec<u8> = (0..w * h * 3)
+                    .map(|i| exemplar[(i as usize * 5 / 3 + i as usize / 700) % exemplar.len()])
+                    .collect();
+                let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+                let one = pool(1).install(|| encode(&rgb, w, h, Format::Png, effort).unwrap());
+                let four = pool(4).install(|| encode(&rgb, w, h, Format::Png, effort).unwrap());
+                assert_eq!(one, four, "{effort:?} {w}×{h}: the same bytes on 1 and 4 threads");
+                let img = image::load_from_memory(&one).unwrap().to_rgb8();
+                assert_eq!((img.dimensions(), img.into_raw()), ((w, h), rgb.clone()), "{effort:?} {w}×{h}");
+                // The image data as zlib itself reads it (the png decoder skips the Adler-32).
+                let (mut at, mut idat) = (8, Vec::new());
+                while at + 12 <= one.len() {
+                    let n = u32::from_be_bytes(one[at..at + 4].try_into().unwrap()) as usize;
+                    if &one[at + 4..at + 8] == b"IDAT" {
+                        idat.extend_from_slice(&one[at + 8..at + 8 + n]);
+                    }
+                    at += 12 + n;
                 }
-                at += 12 + n;
+                let mut raw = Vec::new();
+                std::io::Read::read_to_end(&mut flate2::read::ZlibDecoder::new(&idat[..]), &mut raw).unwrap();
+                let mut rows = Vec::new();
+                let mut prev = None;
+                for row in rgb.chunks_exact(3 * w as usize) {
+                    row_filter.push(prev, row, &mut rows);
+                    prev = Some(row);
+                }
+                assert_eq!(raw, rows, "{effort:?} {w}×{h}: one zlib stream, checksum and all");
+                // Priming each part with the window before it keeps the size of one stream, and
+                // the filter is the png crate's (same size within the parts' flushes).
+                let mut single = Cursor::new(Vec::new());
+                PngEncoder::new_with_quality(&mut single, CompressionType::Level(level), filter)
+                    .write_image(&rgb, w, h, ExtendedColorType::Rgb8)
+                    .unwrap();
+                let single = single.into_inner().len();
+                assert!(
+                    one.len() * 100 <= single * (100 + slack) + 100,
+                    "{effort:?} {w}×{h}: {} bytes against {single} in one stream",
+                    one.len()
+                );
             }
-            let mut raw = Vec::new();
-            std::io::Read::read_to_end(&mut flate2::read::ZlibDecoder::new(&idat[..]), &mut raw).unwrap();
-            let rows: Vec<u8> =
-                rgb.chunks_exact(3 * w as usize).flat_map(|r| std::iter::once(0).chain(r.iter().copied())).collect();
-            assert_eq!(raw, rows, "{w}×{h}: one zlib stream, checksum and all");
-            // Priming each part with the window before it keeps the size of one stream.
-            let mut single = Cursor::new(Vec::new());
-            PngEncoder::new_with_quality(&mut single, CompressionType::Level(4), FilterType::NoFilter)
-                .write_image(&rgb, w, h, ExtendedColorType::Rgb8)
-                .unwrap();
-            let single = single.into_inner().len();
-            assert!(
-                one.len() * 100 <= single * 101 + 100,
-                "{w}×{h}: {} bytes against {single} in one stream",
-                one.len()
-            );
+        }
+    }
+
+    #[test]
+    fn paeth_rows_match_the_png_crate_filter() {
+        // A Quick PNG's rows, unfiltered by the png crate's decoder, are the pixels (checked
+        // above); here the filter bytes themselves on edge cases: zeros, saturation, ties.
+        for (a, b, c, want) in
+            [(0, 0, 0, 0), (10, 20, 10, 20), (20, 10, 10, 20), (255, 0, 255, 0), (5, 5, 5, 5), (0, 255, 128, 128)]
+        {
+            let p = i16::from(a) + i16::from(b) - i16::from(c);
+            let best = [a, b, c].into_iter().min_by_key(|&v| (p - i16::from(v)).abs()).unwrap();
+            assert_eq!(paeth(a, b, c), best, "{a} {b} {c}");
+            assert_eq!(paeth(a, b, c), want, "{a} {b} {c}");
         }
     }
 }
