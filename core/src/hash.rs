@@ -33,8 +33,21 @@ pub fn key(tag: u64, seed: u64) -> u64 {
 /// [`hash`] under a precomputed [`key`].
 #[inline]
 pub fn hash_keyed(key: u64, a: i64, b: i64, c: i64) -> u64 {
-    let h = mix(key ^ a as u64);
-    let h = mix(h ^ (b as u64).rotate_left(21));
+    hash_tail(head(key, a), b, c)
+}
+
+/// The part of [`hash_keyed`] that depends on the key and the first integer alone, for callers
+/// hashing many `(b, c)` under one `a` (a level, say):
+/// `hash_keyed(key, a, b, c) = hash_tail(head(key, a), b, c)`.
+#[inline]
+pub fn head(key: u64, a: i64) -> u64 {
+    mix(key ^ a as u64)
+}
+
+/// The rest of [`hash_keyed`] after [`head`].
+#[inline]
+pub fn hash_tail(head: u64, b: i64, c: i64) -> u64 {
+    let h = mix(head ^ (b as u64).rotate_left(21));
     mix(h ^ (c as u64).rotate_left(42))
 }
 

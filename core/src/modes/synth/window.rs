@@ -14,7 +14,7 @@ use crate::error::{CoreError, Result};
 use crate::analysis::features::TAPS5;
 use super::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
-use crate::hash::{hash, TAG_JITTER};
+use crate::hash::{hash_tail, head, key, TAG_JITTER};
 use crate::lattice::round_to;
 use crate::mask::RandomnessMask;
 use crate::modes::params::ONE_Q16;
@@ -331,6 +331,7 @@ impl<'a> Ctx<'a> {
             mask: self.m - 1,
             rq: self.r[l as usize] as i64,
             period: self.period.map(|n| n >> (self.levels - l)),
+            jitter_head: head(key(TAG_JITTER, self.seed), l as i64),
             cells: self.an.header.lattice.map_or((1, 1), |lat| {
                 let (qx, qy) = lat.moduli(self.m as u32, 1 << (self.levels - l));
                 (qx as i64, qy as i64)
@@ -369,7 +370,7 @@ impl<'a> Ctx<'a> {
                 Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
                 None => (x, y),
             };
-            let z = hash(TAG_JITTER, self.seed, c.l as i64, hx_, hy_);
+            let z = hash_tail(c.jitter_head, hx_, hy_);
             let hx = ((z >> 40) as i64) - (1 << 23);
             let hy = (((z >> 16) & 0xFF_FFFF) as i64) - (1 << 23);
             // A lattice's coarse levels move content by whole cells (§1.9).
@@ -512,6 +513,8 @@ struct LevelConsts {
     mask: i64,
     rq: i64,
     period: Option<i64>,
+    /// The jitter hash with its tag, seed and level applied ([`crate::hash::head`]).
+    jitter_head: u64,
     /// Lattice cell sizes jitter is rounded to at this level (1: not rounded).
     cells: (i64, i64),
 }
