@@ -55,7 +55,7 @@ pub fn render_map(
                 (&mp.texels[..], &map_low[..])
             }
         };
-        seams::blend(&sw.window.coords, w, h, texels, low, m, toroidal, style.fade, &mut pixels);
+        seams::blend(&sw.window.coords, (w, h), &seams::Texels { texels, low, m, toroidal }, style.fade, &mut pixels);
     } else if zoom_out <= levels {
         // Level `L − k`, one pixel per pixel: coherent upsampling would give each of them the
         // `2^k × 2^k` exemplar block centred on its coordinate at the finest level, so it shows

@@ -54,22 +54,24 @@ impl Style {
     }
 }
 
+/// What native pixels show: the texels at exemplar coordinates and their low-pass.
+pub(crate) struct Texels<'a> {
+    /// The `m × m` texels (the exemplar's colours or a material map's).
+    pub texels: &'a [[u8; 3]],
+    /// Their low-pass `Ē`, same layout.
+    pub low: &'a [[u8; 3]],
+    /// The side `m`.
+    pub m: usize,
+    /// Whether the exemplar wraps (else its edge repeats).
+    pub toroidal: bool,
+}
+
 /// Appends to `out` (RGB8) the blended colours of the `w × h` pixels at the centre of
 /// `coords`, a `(w + 2·RADIUS) × (h + 2·RADIUS)` window of packed exemplar coordinates
-/// `x | y << 16`, from the `m × m` exemplar `texels` and their low-pass `low`. Rows run in
-/// parallel; each pixel depends on its neighbourhood only.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn blend(
-    coords: &[u32],
-    w: usize,
-    h: usize,
-    texels: &[[u8; 3]],
-    low: &[[u8; 3]],
-    m: usize,
-    toroidal: bool,
-    fade: i32,
-    out: &mut Vec<u8>,
-) {
+/// `x | y << 16`, from `src`, with the texture's `fade`. Rows run in parallel; each pixel
+/// depends on its neighbourhood only.
+pub(crate) fn blend(coords: &[u32], (w, h): (usize, usize), src: &Texels, fade: i32, out: &mut Vec<u8>) {
+    let Texels { texels, low, m, toroidal } = *src;
     const R: usize = RADIUS;
     const SIDE: usize = 2 * R + 1;
     let (bw, bh) = (w + 2 * R, h + 2 * R);
@@ -216,7 +218,7 @@ mod tests {
         // A coherent window that wraps around the torus.
         let coords: Vec<u32> = (0..bw * bh).map(|i| ((i % bw + 25) % m) as u32 | ((((i / bw) + 7) % m) as u32) << 16).collect();
         let mut out = Vec::new();
-        blend(&coords, w, h, &ex, &low, m, true, MAX_FADE, &mut out);
+        blend(&coords, (w, h), &Texels { texels: &ex, low: &low, m, toroidal: true }, MAX_FADE, &mut out);
         let want: Vec<u8> = (0..w * h)
             .flat_map(|i| ex[((i / w + RADIUS + 7) % m) * m + (i % w + RADIUS + 25) % m])
             .collect();
@@ -240,7 +242,7 @@ mod tests {
             })
             .collect();
         let mut out = Vec::new();
-        blend(&coords, w, h, &ex, &low, m, false, 2, &mut out);
+        blend(&coords, (w, h), &Texels { texels: &ex, low: &low, m, toroidal: false }, 2, &mut out);
         let row: Vec<i32> = out.chunks(3).map(|c| c[0] as i32).collect();
         let steps: Vec<i32> = row.windows(2).map(|p| p[1] - p[0]).collect();
         assert!(steps.iter().all(|&s| s >= 0), "monotone: {row:?}");
