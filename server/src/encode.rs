@@ -144,16 +144,17 @@ enum RowFilter {
 }
 
 impl RowFilter {
-    /// Append `row`'s filter type byte and its filtered bytes to `out`; `prev` is the row above
-    /// (`None` for the first, whose upper bytes count as 0).
-    fn push(self, prev: Option<&[u8]>, row: &[u8], out: &mut Vec<u8>) {
+    /// Write `row`'s filter type byte and its filtered bytes to `out` (one byte longer than
+    /// `row`); `prev` is the row above (`None` for the first, whose upper bytes count as 0).
+    fn write(self, prev: Option<&[u8]>, row: &[u8], out: &mut [u8]) {
+        let (kind, out) = out.split_at_mut(1);
         match self {
             RowFilter::None => {
-                out.push(0);
-                out.extend_from_slice(row);
+                kind[0] = 0;
+                out.copy_from_slice(row);
             }
             RowFilter::Paeth => {
-                out.push(4);
+                kind[0] = 4;
                 let zeros;
                 let up = match prev {
                     Some(p) => p,
@@ -164,12 +165,16 @@ impl RowFilter {
                 };
                 // The first pixel has no left neighbours: its predictor is the byte above.
                 let first = row.len().min(3);
-                out.extend(row[..first].iter().zip(up).map(|(&x, &b)| x.wrapping_sub(b)));
+                for ((o, &x), &b) in out.iter_mut().zip(&row[..first]).zip(up) {
+                    *o = x.wrapping_sub(b);
+                }
                 // The others: x, a (left), b (above), c (upper left), as four aligned slices.
                 let (x, a) = (&row[first..], &row[..row.len() - first]);
                 let (b, c) = (&up[first..], &up[..row.len() - first]);
                 let predicted = a.iter().zip(b).zip(c).map(|((&a, &b), &c)| paeth(a, b, c));
-                out.extend(x.iter().zip(predicted).map(|(&x, p)| x.wrapping_sub(p)));
+                for ((o, &x), p) in out[first..].iter_mut().zip(x).zip(predicted) {
+                    *o = x.wrapping_sub(p);
+                }
             }
         }
     }
@@ -209,22 +214,17 @@ fn png_parts(rgb: &[u8], w: u32, h: u32, level: u32, filter: RowFilter) -> Resul
             image::error::ParameterErrorKind::DimensionMismatch,
         )));
     }
-    // The image data: each row's filter type, then the filtered row (bands filtered in parallel).
-    let band = stride * PART_ROWS as usize;
-    let bands: Vec<Vec<u8>> = rgb
-        .par_chunks(band)
-        .enumerate()
-        .map(|(i, rows)| {
-            let mut out = Vec::with_capacity(rows.len() + rows.len() / stride);
-            let mut prev = (i > 0).then(|| &rgb[i * band - stride..i * band]);
-            for row in rows.chunks_exact(stride) {
-                filter.push(prev, row, &mut out);
-                prev = Some(row);
-            }
-            out
-        })
-        .collect();
-    let raw = bands.concat();
+    // The image data: each row's filter type, then the filtered row (bands filtered in
+    // parallel, each in its place).
+    let (band, line) = (stride * PART_ROWS as usize, stride + 1);
+    let mut raw = vec![0u8; line * h as usize];
+    raw.par_chunks_mut(line * PART_ROWS as usize).zip(rgb.par_chunks(band)).enumerate().for_each(|(i, (out, rows))| {
+        let mut prev = (i > 0).then(|| &rgb[i * band - stride..i * band]);
+        for (o, row) in out.chunks_exact_mut(line).zip(rows.chunks_exact(stride)) {
+            filter.write(prev, row, o);
+            prev = Some(row);
+        }
+    });
     let part = (stride + 1) * PART_ROWS as usize;
     let starts: Vec<usize> = (0..raw.len()).step_by(part).collect();
     let parts: Vec<Result<Vec<u8>, flate2::CompressError>> = starts
@@ -355,10 +355,11 @@ mod tests {
                 }
                 let mut raw = Vec::new();
                 std::io::Read::read_to_end(&mut flate2::read::ZlibDecoder::new(&idat[..]), &mut raw).unwrap();
-                let mut rows = Vec::new();
+                let stride = 3 * w as usize;
+                let mut rows = vec![0u8; (stride + 1) * h as usize];
                 let mut prev = None;
-                for row in rgb.chunks_exact(3 * w as usize) {
-                    row_filter.push(prev, row, &mut rows);
+                for (o, row) in rows.chunks_exact_mut(stride + 1).zip(rgb.chunks_exact(stride)) {
+                    row_filter.write(prev, row, o);
                     prev = Some(row);
                 }
                 assert_eq!(raw, rows, "{effort:?} {w}×{h}: one zlib stream, checksum and all");
