@@ -9,8 +9,9 @@
 //! ([`Cells`]), so an umbrella that reaches several cells is filled once.
 //!
 //! Positions are relative to the origin of a fixed frame of cells, sample centres at
-//! `(r + ½)·sp` for a sample spacing `sp` that is a power of two, so a sample's coverage depends
-//! on its absolute position only: windows are the same samples cut from larger ones.
+//! `(r + ½)·sp` for a sample spacing `sp` (a pixel's width over its sub-samples per side), so a
+//! sample's coverage depends on its absolute position only: windows are the same samples cut
+//! from larger ones.
 
 use std::cell::Cell;
 
@@ -63,8 +64,14 @@ pub fn fill(
             ymax = ymax.max(hi);
         }
     }
-    // `sp` is a power of two: multiplying by its inverse is dividing by it, exactly.
-    debug_assert_eq!(sp.to_bits() & 0x7F_FFFF, 0, "the sample spacing is a power of two");
+    // No edge reaches the rows: no crossing (and `ymin`, `ymax` are still their sentinels).
+    if ne == 0 {
+        return;
+    }
+    // Multiplying by the inverse: exactly dividing when `sp` is a power of two (2 or 4
+    // sub-samples per pixel side), rounded when it is not (3), but the same f32 operations on
+    // the same frame-relative values whichever window asks.
+    debug_assert!(sp > 0.0 && sp.is_finite(), "a sample spacing");
     let inv = 1.0 / sp;
     let first = ceil(ymin * inv - 0.5).max(rows.0);
     let last = ceil(ymax * inv - 0.5).min(rows.1);
@@ -317,5 +324,22 @@ mod tests {
         seen.clear();
         fill(&sq, 0.5, (3, 4), (0, 3), &mut Crossings::default(), |_| false, |r, c0, c1| seen.extend((c0..c1).map(|c| (r, c))));
         assert_eq!(seen, vec![(3, 2)], "clipped to the rows and columns asked for");
+    }
+
+    #[test]
+    fn a_polygon_beside_the_rows_asked_for_fills_nothing() {
+        // No edge reaches the rows (a shape listed for a band it misses, or a flat one): the
+        // row range is never computed from the empty extent (whose `⌈·⌉` overflowed in debug
+        // builds, serving an umbrella tile zoomed out), and nothing is filled, at a spacing
+        // that is a power of two or not (3 sub-samples per pixel side).
+        let square = [[1.0f32, 1.0], [3.0, 1.0], [3.0, 3.0], [1.0, 3.0]];
+        let flat = [[1.0f32, 2.0], [3.0, 2.0], [2.0, 2.0]];
+        for sp in [0.5, 4.0 / 3.0] {
+            for (poly, rows) in [(&square[..], (40, 60)), (&square[..], (-9, -4)), (&flat[..], (0, 10))] {
+                let mut seen = 0;
+                fill(poly, sp, rows, (0, 100), &mut Crossings::default(), |_| false, |_, c0, c1| seen += c1 - c0);
+                assert_eq!(seen, 0, "spacing {sp}, rows {rows:?}");
+            }
+        }
     }
 }
