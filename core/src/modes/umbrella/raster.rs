@@ -330,7 +330,7 @@ mod tests {
     fn a_polygon_beside_the_rows_asked_for_fills_nothing() {
         // No edge reaches the rows (a shape listed for a band it misses, or a flat one): the
         // row range is never computed from the empty extent (whose `⌈·⌉` overflowed in debug
-        // builds, serving an umbrella tile zoomed out), and nothing is filled, at a spacing
+        // builds on the first umbrella tile served), and nothing is filled, at a spacing
         // that is a power of two or not (3 sub-samples per pixel side).
         let square = [[1.0f32, 1.0], [3.0, 1.0], [3.0, 3.0], [1.0, 3.0]];
         let flat = [[1.0f32, 2.0], [3.0, 2.0], [2.0, 2.0]];
