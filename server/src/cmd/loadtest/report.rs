@@ -59,13 +59,17 @@ pub fn statuses(samples: &[Sample]) -> BTreeMap<String, u64> {
     m
 }
 
-/// Per second of the run (by when requests ended): requests, errors, and p50 / p99 of the
-/// latency the report leads with (`corrected` for the open model).
+/// Per second of the run, by when requests were meant to be sent (the closed loop: when they
+/// were sent): requests, errors, and p50 / p99 of the latency the report leads with
+/// (`corrected` for the open model) — what became of the load offered that second, as
+/// open-model tools chart it. Answers still arriving after the last send (the drain) count
+/// with their requests' seconds, so a run of `D` seconds has `D` rows; `seconds` (the run's
+/// length) sizes the timeline of a run that sent nothing.
 pub fn timeline(samples: &[Sample], seconds: f64, corrected: bool) -> Vec<Value> {
-    let n = seconds.ceil().max(1.0) as usize;
+    let n = samples.iter().map(|s| s.intended.as_secs() as usize + 1).max().unwrap_or(seconds.ceil().max(1.0) as usize);
     let mut by: Vec<Vec<&Sample>> = vec![Vec::new(); n];
     for s in samples {
-        by[(s.done.as_secs() as usize).min(n - 1)].push(s);
+        by[s.intended.as_secs() as usize].push(s);
     }
     by.iter()
         .enumerate()
