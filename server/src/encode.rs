@@ -217,15 +217,15 @@ fn png_parts(rgb: &[u8], w: u32, h: u32, level: u32, filter: RowFilter) -> Resul
     // The image data: each row's filter type, then the filtered row (bands filtered in
     // parallel, each in its place).
     let (band, line) = (stride * PART_ROWS as usize, stride + 1);
+    let part = line * PART_ROWS as usize;
     let mut raw = vec![0u8; line * h as usize];
-    raw.par_chunks_mut(line * PART_ROWS as usize).zip(rgb.par_chunks(band)).enumerate().for_each(|(i, (out, rows))| {
+    raw.par_chunks_mut(part).zip(rgb.par_chunks(band)).enumerate().for_each(|(i, (out, rows))| {
         let mut prev = (i > 0).then(|| &rgb[i * band - stride..i * band]);
         for (o, row) in out.chunks_exact_mut(line).zip(rows.chunks_exact(stride)) {
             filter.write(prev, row, o);
             prev = Some(row);
         }
     });
-    let part = (stride + 1) * PART_ROWS as usize;
     let starts: Vec<usize> = (0..raw.len()).step_by(part).collect();
     let parts: Vec<Result<Vec<u8>, flate2::CompressError>> = starts
         .par_iter()

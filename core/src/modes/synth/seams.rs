@@ -102,12 +102,11 @@ pub(crate) fn blend(coords: &[u32], (w, h): (usize, usize), src: &Texels, fade: 
     // masked all the same, so that every such index, `(S_y(q) + R − dy)·pm + S_x(q) + R − dx`
     // with `|dx|, |dy| ≤ R`, provably lies in `padded`: the sum below reads it unchecked.
     let lin = |x: usize, y: usize| (y * pm + x) as isize;
-    let low_mask = m - 1;
     let mut trans = vec![0isize; bw * bh];
     trans.par_chunks_exact_mut(bw).zip(coords.par_chunks_exact(bw)).enumerate().for_each(|(y, (row_t, row_c))| {
         for (x, (t, &v)) in row_t.iter_mut().zip(row_c).enumerate() {
-            let (sx, sy) = ((v & 0xFFFF) as usize & low_mask, (v >> 16) as usize & low_mask);
-            *t = ((sy + R) * pm + sx + R) as isize - lin(x, y);
+            let (sx, sy) = ((v & 0xFFFF) as i64 & mask, (v >> 16) as i64 & mask);
+            *t = ((sy as usize + R) * pm + sx as usize + R) as isize - lin(x, y);
         }
     });
     let index = |v: u32| (v >> 16) as usize * m + (v & 0xFFFF) as usize;
