@@ -45,7 +45,7 @@ pub struct Merged {
     pub rim: Vec<[f64; 2]>,
     /// Colour at each rim vertex, RGB in `[0, 1]` (none for a cluster of one).
     pub colour: Vec<[f32; 3]>,
-    /// Colour at the centre.
+    /// Colour at the centre (a cluster of one: the background, unused).
     pub centre: [f32; 3],
     /// Largest centre–vertex distance.
     pub reach: f64,
@@ -303,9 +303,9 @@ fn merge(members: &[&Member], palette: &Palette, background: [f32; 3]) -> Option
         let (depth, id) = one.key();
         let rim: Vec<[f64; 2]> = palette.arr.rim(&one.u, one.x, one.y).iter().map(|&(a, b)| [a, b]).collect();
         let o = one.centre();
-        let centre = palette.colour(one, o).unwrap_or(background);
+        // (Its `centre` colour is never read: [`colour_at`] colours a single from its texture.)
         let single = Some(one.u);
-        return Some(Merged { reach: reach_of(o, &rim), o, rim, colour: Vec::new(), centre, depth, id, single });
+        return Some(Merged { reach: reach_of(o, &rim), o, rim, colour: Vec::new(), centre: background, depth, id, single });
     }
     let n = members.len() as f64;
     let mut o = [0f64; 2];
