@@ -336,7 +336,6 @@ impl<'a> Ctx<'a> {
                 let (qx, qy) = lat.moduli(self.m as u32, 1 << (self.levels - l));
                 (qx as i64, qy as i64)
             }),
-            still: (self.r[l as usize] as i64) << (self.levels - l) <= ONE_Q16 as i64 / 2,
         }
     }
 
@@ -358,7 +357,7 @@ impl<'a> Ctx<'a> {
         };
         let mut sx = (v & 0xFFFF) as i64 + off(par(x));
         let mut sy = (v >> 16) as i64 + off(par(y));
-        if c.still {
+        if c.still() {
             // Every jitter below rounds to 0 (`|hx| ≤ 2²³`, effective `r ≤ c.rq`).
             return ((sx & c.mask) | ((sy & c.mask) << 16)) as u32;
         }
@@ -522,8 +521,13 @@ struct LevelConsts {
     jitter_head: u64,
     /// Lattice cell sizes jitter is rounded to at this level (1: not rounded).
     cells: (i64, i64),
+}
+
+impl LevelConsts {
     /// Whether no pixel of this level can move: the largest jitter, `h·r` texels, rounds to 0
     /// (`h·r ≤ ½`; the mask and `R_S` only scale `r` down). The finest levels of the default
     /// schedule, which then skip the hash.
-    still: bool,
+    fn still(&self) -> bool {
+        self.h * self.rq <= ONE_Q16 as i64 / 2
+    }
 }
