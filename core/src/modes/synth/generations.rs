@@ -78,7 +78,7 @@ pub(crate) fn needed_generations(
         let (mut x0, mut x1) = (usize::MAX, 0);
         let mut row = vec![0u64; ww];
         for j in (j0..h).step_by(step) {
-            // This class's pixels that need generation `k` and whose cached ones stop below it.
+            // This class's pixels that need generation `k` and whose cached generations stop below it.
             let mut any = false;
             for (i, out) in row.iter_mut().enumerate() {
                 let mut bits = needs[j * ww + i] & columns;
