@@ -67,6 +67,8 @@ pub(crate) fn needed_generations(
     // Per row, the computed pixels dilated along the row (valid where `computed_rows` says so).
     let mut along = vec![0u64; ww * h];
     let mut computed_rows = vec![false; h];
+    // One class row's computed pixels.
+    let mut row = vec![0u64; ww];
     for (k, &class) in gens.iter().enumerate().rev().map(|(i, c)| (i as i8 + 1, c)) {
         let (j0, c0, step) = class_origin(class, ext);
         let columns = match (step, c0 % 2) {
@@ -76,18 +78,13 @@ pub(crate) fn needed_generations(
         };
         computed_rows.fill(false);
         let (mut x0, mut x1) = (usize::MAX, 0);
-        let mut row = vec![0u64; ww];
         for j in (j0..h).step_by(step) {
             // This class's pixels that need generation `k` and whose cached generations stop below it.
             let mut any = false;
             for (i, out) in row.iter_mut().enumerate() {
-                let mut bits = needs[j * ww + i] & columns;
-                let mut keep = 0u64;
-                while bits != 0 {
-                    let b = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    keep |= ((lo[j * w + 64 * i + b] < k) as u64) << b;
-                }
+                let keep = set_bits(needs[j * ww + i] & columns)
+                    .filter(|&b| lo[j * w + 64 * i + b] < k)
+                    .fold(0u64, |acc, b| acc | 1 << b);
                 *out = keep;
                 any |= keep != 0;
             }
@@ -123,17 +120,25 @@ pub(crate) fn needed_generations(
             let rows = j.saturating_sub(2)..=(j + 2).min(h - 1);
             for i in 0..ww {
                 let d = rows.clone().filter(|&jj| computed_rows[jj]).fold(0, |a, jj| a | along[jj * ww + i]);
-                let mut new = d & !needs[j * ww + i];
-                needs[j * ww + i] |= d;
-                while new != 0 {
-                    let b = new.trailing_zeros() as usize;
-                    new &= new - 1;
+                for b in set_bits(d & !needs[j * ww + i]) {
                     top[j * w + 64 * i + b] = k - 1;
                 }
+                needs[j * ww + i] |= d;
             }
         }
     }
     (top, boxes)
+}
+
+/// The positions of the set bits of `word`, lowest first.
+fn set_bits(mut word: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (word != 0).then(|| {
+            let b = word.trailing_zeros() as usize;
+            word &= word - 1;
+            b
+        })
+    })
 }
 
 /// [`needed_generations`] with nothing cached: the plan's cone, written row by row (each pixel
