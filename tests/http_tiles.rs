@@ -438,3 +438,68 @@ async fn modes_that_need_only_the_exemplar_serve_while_the_analysis_is_computed(
     assert_eq!(body["error"], "not_ready", "{body}");
     assert!(body["message"].as_str().unwrap().contains("mode=synth"), "{body}");
 }
+
+/// A value of the described parameter `d` other than its default `default`, from its type and
+/// range as `GET /textures/{id}` describes them.
+fn another_value(d: &serde_json::Value, default: &serde_json::Value) -> String {
+    let num = |k: &str| d[k].as_f64().unwrap_or_else(|| panic!("{d} has no {k}"));
+    let pick = |a: String, b: String, a_is_default: bool| if a_is_default { b } else { a };
+    match d["type"].as_str().expect("type") {
+        "choice" => {
+            let values: Vec<&str> = d["values"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+            values.iter().find(|v| default.as_str() != Some(**v)).unwrap().to_string()
+        }
+        "integer" | "power_of_two" => {
+            let (min, max) = (d["min"].as_u64().unwrap(), d["max"].as_u64().unwrap());
+            pick(min.to_string(), max.min(min * 4).max(min + 1).to_string(), default.as_u64() == Some(min))
+        }
+        "number" => pick(num("min").to_string(), num("max").to_string(), default.as_f64() == Some(num("min"))),
+        "levels" => {
+            let all = |v: f64| default.as_array().is_some_and(|a| a.iter().all(|x| x.as_f64() == Some(v)));
+            pick("0".into(), "1".into(), all(0.0))
+        }
+        "interval" => {
+            let (lo, hi) = (num("min"), num("max"));
+            let is = |a: f64, b: f64| {
+                default.as_array().is_some_and(|x| x[0].as_f64() == Some(a) && x[1].as_f64() == Some(b))
+            };
+            pick(format!("{lo},{lo}"), format!("{hi},{hi}"), is(lo, lo))
+        }
+        // {"strokes":[{"at":[3,4],"radius":8,"value":0}]}
+        "text" => "eyJzdHJva2VzIjpbeyJhdCI6WzMsNF0sInJhZGl1cyI6OCwidmFsdWUiOjB9XX0".into(),
+        other => panic!("no value to try for a parameter of type {other}"),
+    }
+}
+
+#[tokio::test]
+async fn every_request_parameter_of_every_mode_changes_the_etag() {
+    let s = Server::builder().start();
+    let meta = s.json("/textures/gravel").await;
+    let params = meta["parameters"].as_object().expect("parameters");
+    let etag = |query: String| {
+        let s = &s;
+        async move {
+            let r = s.get(&format!("/tiles/gravel/3/1/-1.png?{query}")).await;
+            assert_eq!(r.status(), 200, "{query}");
+            r.headers()["etag"].to_str().unwrap().to_string()
+        }
+    };
+    let mut tried = 0;
+    for (name, d) in params {
+        let modes: Vec<String> = match d["modes"].as_array() {
+            Some(m) => m.iter().map(|m| m.as_str().unwrap().to_string()).collect(),
+            // The common keys: every mode whose pixels they change (the tiling's depend on neither).
+            None if name == "mode" => continue,
+            None => ["synth", "mosaic", "umbrella"].map(String::from).to_vec(),
+        };
+        for mode in modes {
+            let default = d["default"].clone();
+            let value = another_value(d, &default);
+            let (base, changed) =
+                (etag(format!("mode={mode}")).await, etag(format!("mode={mode}&{name}={value}")).await);
+            assert_ne!(base, changed, "mode={mode}: {name}={value} (default {default}) keeps the ETag");
+            tried += 1;
+        }
+    }
+    assert!(tried >= 12, "only {tried} parameters tried");
+}

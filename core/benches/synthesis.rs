@@ -117,7 +117,8 @@ fn windows(c: &mut Criterion) {
     g.bench_function("cold_256_magnified_1", |b| {
         b.iter(|| {
             i += 1;
-            Synth::magnify(&p, &Source::new(&ex, &an), &Pyramid::off(), 1, Rect::new(256 * i, 512, 256, 256)).unwrap()
+            Synth::magnify(&p, &(), &Source::new(&ex, &an), &Pyramid::off(), 1, Rect::new(256 * i, 512, 256, 256))
+                .unwrap()
         })
     });
     g.sample_size(10);
@@ -153,8 +154,9 @@ fn umbrella(c: &mut Criterion) {
     let ex = exemplar(128);
     let an = Analysis::build(&ex, &NoProgress);
     // The texture's prepared state, as the server keeps it: the extraction and its caches.
-    let prepared = textile_core::prepare::Prepared::new();
-    prepared.set(<Umbrella as Mode>::NAME, std::sync::Arc::new(Extraction::extract(&ex)));
+    let prepared = textile_core::modes::Prepared::new();
+    prepared.keep::<Umbrella>(Extraction::extract(&ex));
+    let state = prepared.get::<Umbrella>().expect("kept");
     let src = Source::new(&ex, &an).with_prepared(&prepared);
     let p = UmbrellaParams::default();
     let mut g = c.benchmark_group("umbrella");
@@ -167,7 +169,7 @@ fn umbrella(c: &mut Criterion) {
             b.iter(|| {
                 i += 1;
                 let rect = Rect::new(256 * i, -256 * i, 256, 256);
-                <Umbrella as Mode>::render(&p, &src, &Pyramid::off(), View::out(k, rect)).unwrap()
+                <Umbrella as Mode>::render(&p, &state, &src, &Pyramid::off(), View::out(k, rect)).unwrap()
             })
         });
     }

@@ -10,10 +10,9 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use textile_core::modes::umbrella::{Extraction, Umbrella};
-use textile_core::prepare::Prepared;
+use textile_core::modes::Prepared;
 use textile_core::{
-    Analysis, Defaults, Exemplar, ExemplarOptions, Mode, NoProgress, ParamReader, Pyramid, Rect, Source, View,
-    MODE_NAMES,
+    Analysis, Defaults, Exemplar, ExemplarOptions, NoProgress, ParamReader, Pyramid, Rect, Source, View, MODE_NAMES,
 };
 
 fn zoom(c: &mut Criterion) {
@@ -23,7 +22,7 @@ fn zoom(c: &mut Criterion) {
     let an = Analysis::build(&ex, &NoProgress);
     // What the server prepares per texture, as it keeps it.
     let prepared = Prepared::new();
-    prepared.set(<Umbrella as Mode>::NAME, std::sync::Arc::new(Extraction::extract(&ex)));
+    prepared.keep::<Umbrella>(Extraction::extract(&ex));
     let src = Source::new(&ex, &an).with_prepared(&prepared);
     let defaults = Defaults::builtin(&src);
     let mut g = c.benchmark_group("zoom");

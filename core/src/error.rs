@@ -80,6 +80,12 @@ pub enum CoreError {
         /// The mode asked for.
         mode: &'static str,
     },
+    /// The mode renders from a state it prepares per texture, which is not prepared (yet).
+    #[error("mode={mode} needs what it prepares from the texture, which is not ready")]
+    NotPrepared {
+        /// The mode asked for.
+        mode: &'static str,
+    },
     /// A requested window is empty or too large.
     #[error("window {width}x{height} is not allowed: {message}")]
     Window {

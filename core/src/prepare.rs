@@ -3,14 +3,12 @@
 //! [`Preparation`]: made from an [`Input`] (the exemplar and the texture's settings), stored in
 //! the data directory beside the texture (`<texture>.<extension>`: versioned, checksummed,
 //! written whole or not at all), loaded back when its id still matches, and described for the
-//! API, the CLI and the logs. [`load_or_compute`] is the one path that drives every one of them;
-//! [`Step`] is the same path without naming the type, for lists of them ([`Prepared`] holds the
-//! results of one texture). Nothing here knows a mode.
+//! API, the CLI and the logs. [`load_or_compute`] is the one path that drives every one of them.
+//! Nothing here knows a mode: what each mode prepares, typed, is `modes::prepared`.
 
 use std::any::Any;
-use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::{Arc, RwLock};
+use std::sync::Arc;
 
 use serde_json::{Map, Value};
 
@@ -199,115 +197,6 @@ impl<P: Preparation> State for P {
     }
     fn into_any(self: Arc<Self>) -> Arc<dyn Any + Send + Sync> {
         self
-    }
-}
-
-/// A preparation without its type: its constants and [`load_or_compute`].
-pub trait Step: Send + Sync {
-    /// See [`Preparation::WHAT`].
-    fn what(&self) -> &'static str;
-    /// See [`Preparation::EXTENSION`].
-    fn extension(&self) -> &'static str;
-    /// See [`Preparation::SETTINGS`].
-    fn settings(&self) -> &'static [Setting];
-    /// See [`Preparation::id`].
-    fn id(&self, input: &Input) -> String;
-    /// See [`load_or_compute`].
-    fn run(
-        &self,
-        input: &Input,
-        path: Option<&Path>,
-        store: bool,
-        keep: &dyn Fn() -> bool,
-        progress: &dyn Progress,
-        cancel: &Cancel,
-    ) -> Result<(Arc<dyn State>, Origin)>;
-    /// Read a stored state (for inspection: `textile info`).
-    fn load(&self, path: &Path) -> Result<Arc<dyn State>>;
-}
-
-/// The [`Step`] of preparation `P`.
-pub struct StepOf<P>(std::marker::PhantomData<fn() -> P>);
-
-impl<P> StepOf<P> {
-    /// The step.
-    pub const NEW: StepOf<P> = StepOf(std::marker::PhantomData);
-}
-
-impl<P: Preparation> Step for StepOf<P> {
-    fn what(&self) -> &'static str {
-        P::WHAT
-    }
-    fn extension(&self) -> &'static str {
-        P::EXTENSION
-    }
-    fn settings(&self) -> &'static [Setting] {
-        P::SETTINGS
-    }
-    fn id(&self, input: &Input) -> String {
-        P::id(input)
-    }
-    fn run(
-        &self,
-        input: &Input,
-        path: Option<&Path>,
-        store: bool,
-        keep: &dyn Fn() -> bool,
-        progress: &dyn Progress,
-        cancel: &Cancel,
-    ) -> Result<(Arc<dyn State>, Origin)> {
-        let (state, origin) = load_or_compute::<P>(input, path, store, keep, progress, cancel)?;
-        Ok((Arc::new(state), origin))
-    }
-    fn load(&self, path: &Path) -> Result<Arc<dyn State>> {
-        Ok(Arc::new(load::<P>(path)?))
-    }
-}
-
-/// The states one texture's modes have prepared, by mode name; a mode whose state is missing
-/// computes it for the request (and a caller that keeps none, such as a test, pays each time).
-#[derive(Default)]
-pub struct Prepared {
-    states: RwLock<BTreeMap<&'static str, Arc<dyn State>>>,
-}
-
-impl Prepared {
-    /// None yet.
-    pub fn new() -> Prepared {
-        Prepared::default()
-    }
-
-    /// Keep `state` as mode `mode`'s.
-    pub fn set(&self, mode: &'static str, state: Arc<dyn State>) {
-        if let Ok(mut s) = self.states.write() {
-            s.insert(mode, state);
-        }
-    }
-
-    /// Mode `mode`'s state, as type `P`.
-    pub fn get<P: Preparation>(&self, mode: &str) -> Option<Arc<P>> {
-        let s = self.states.read().ok()?.get(mode).cloned()?;
-        s.into_any().downcast::<P>().ok()
-    }
-
-    /// Whether mode `mode` has its state.
-    pub fn has(&self, mode: &str) -> bool {
-        self.states.read().is_ok_and(|s| s.contains_key(mode))
-    }
-
-    /// Every state, by mode name.
-    pub fn all(&self) -> Vec<(&'static str, Arc<dyn State>)> {
-        self.states.read().map(|s| s.iter().map(|(k, v)| (*k, v.clone())).collect()).unwrap_or_default()
-    }
-
-    /// What the states add to the ETags of mode `mode`.
-    pub fn etag(&self, mode: &str) -> String {
-        self.states.read().ok().and_then(|s| s.get(mode).map(|st| st.etag())).unwrap_or_default()
-    }
-
-    /// Bytes held by all states.
-    pub fn memory_bytes(&self) -> u64 {
-        self.all().iter().map(|(_, s)| s.memory_bytes()).sum()
     }
 }
 

@@ -23,7 +23,9 @@ fn golden_source(name: &str) -> (Exemplar, Analysis) {
 
 /// Render through the same path as a request: the query read over the built-in defaults.
 fn render_mode((ex, an): &(Exemplar, Analysis), query: &str, zoom_out: u32, rect: Rect) -> RgbWindow {
-    let src = Source::new(ex, an);
+    // What a texture prepares, as the server keeps it (umbrella: its extraction).
+    let prepared = textile_core::modes::Prepared::compute(ex).unwrap();
+    let src = Source::new(ex, an).with_prepared(&prepared);
     let pairs = query.split('&').filter_map(|kv| kv.split_once('='));
     let params = Defaults::builtin(&src).request(&src, ParamReader::request(pairs).unwrap()).unwrap();
     params.render(&src, &Pyramid::off(), View::out(zoom_out, rect)).unwrap().image

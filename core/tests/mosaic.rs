@@ -115,8 +115,8 @@ fn invalid_parameters_are_refused() {
     for p in [
         MosaicParams { iterations: 65, ..MosaicParams::default() },
         MosaicParams { smoothing: 4, ..MosaicParams::default() },
-        MosaicParams { area_min: 800, area_max: 700, ..MosaicParams::default() },
-        MosaicParams { area_min: 10, ..MosaicParams::default() },
+        MosaicParams { block_area: (800, 700), ..MosaicParams::default() },
+        MosaicParams { block_area: (10, 750), ..MosaicParams::default() },
         MosaicParams { period: Some(48), ..MosaicParams::default() },
         MosaicParams { period: Some(32), ..MosaicParams::default() },
     ] {

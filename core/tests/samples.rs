@@ -33,7 +33,8 @@ fn texels(seed: u64, n: usize, spread: i64) -> Vec<Texel> {
 #[test]
 fn samples_equal_window_pixels_for_every_mode() {
     let (ex, an) = (common::small_exemplar(), common::small());
-    let src = Source::new(ex, an);
+    let prepared = textile_core::modes::Prepared::compute(ex).unwrap();
+    let src = Source::new(ex, an).with_prepared(&prepared);
     let pts = texels(1, 40, 300);
     for mode in MODE_NAMES {
         let p = params(&src, mode);
@@ -47,7 +48,8 @@ fn samples_equal_window_pixels_for_every_mode() {
 #[test]
 fn order_batching_and_cache_do_not_change_samples() {
     let (ex, an) = (common::small_exemplar(), common::small());
-    let src = Source::new(ex, an);
+    let prepared = textile_core::modes::Prepared::compute(ex).unwrap();
+    let src = Source::new(ex, an).with_prepared(&prepared);
     let p = params(&src, "synth");
     let pts = texels(2, 300, 200);
     let whole = samples::texels(&p, &src, &Pyramid::off(), &pts).unwrap().colors;
@@ -66,7 +68,8 @@ fn order_batching_and_cache_do_not_change_samples() {
 #[test]
 fn a_batch_computes_shared_cones_once() {
     let (ex, an) = (common::small_exemplar(), common::small());
-    let src = Source::new(ex, an);
+    let prepared = textile_core::modes::Prepared::compute(ex).unwrap();
+    let src = Source::new(ex, an).with_prepared(&prepared);
     let p = params(&src, "synth");
     // 64 texels spread over a 64×64 native area.
     let pts: Vec<Texel> = (0..64).map(|i| Texel { x: (i % 8) * 8 + 3, y: (i / 8) * 8 + 5, zoom_out: 0 }).collect();
@@ -82,7 +85,8 @@ fn a_batch_computes_shared_cones_once() {
 #[test]
 fn filtered_samples_at_centres_equal_texels_and_blend_between_levels() {
     let (ex, an) = (common::small_exemplar(), common::small());
-    let src = Source::new(ex, an);
+    let prepared = textile_core::modes::Prepared::compute(ex).unwrap();
+    let src = Source::new(ex, an).with_prepared(&prepared);
     for mode in MODE_NAMES {
         let p = params(&src, mode);
         let pts = texels(3, 30, 500);
@@ -120,7 +124,8 @@ proptest! {
     #[test]
     fn split_batches_agree(seed in 0u64..1000, cut in 1usize..59) {
         let (ex, an) = (common::small_exemplar(), common::small());
-        let src = Source::new(ex, an);
+        let prepared = textile_core::modes::Prepared::compute(ex).unwrap();
+        let src = Source::new(ex, an).with_prepared(&prepared);
         let p = params(&src, "synth");
         let pts = texels(seed, 60, 150);
         let whole = samples::texels(&p, &src, &Pyramid::off(), &pts).unwrap().colors;
@@ -135,7 +140,8 @@ fn batches_bigger_than_a_chunk_equal_the_window_they_cover() {
     // 70 000 texels (over one chunk of 65 536) in a shuffled 256² area, with duplicates; and as
     // many footprints at texel centres, lod 0 (over one footprint chunk).
     let (ex, an) = (common::small_exemplar(), common::small());
-    let src = Source::new(ex, an);
+    let prepared = textile_core::modes::Prepared::compute(ex).unwrap();
+    let src = Source::new(ex, an).with_prepared(&prepared);
     let p = params(&src, "synth");
     let rect = Rect::new(-100, 40, 256, 256);
     let window = p.render(&src, &Pyramid::off(), View::native(rect)).unwrap();

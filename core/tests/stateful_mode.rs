@@ -1,19 +1,15 @@
 //! A mode that prepares something per texture, written outside the core: the `Mode` and
-//! `Preparation` traits are all it needs. The mode ("means") prepares the exemplar's mean colour
-//! per 8×8 block, stores it as its own file through the one preparation path (written, read
-//! back, a stale or damaged file replaced), finds it in `Source::prepared`, and renders from
-//! it deterministically. Adding such a mode to the product is its folder in
-//! `core/src/modes/` plus its line of `modes!`: nothing else in the core or the server names a
-//! mode's state.
-
-use std::sync::Arc;
+//! `Preparation` traits and one `declare_params!` block are all it needs. The mode ("means")
+//! prepares the exemplar's mean colour per 8×8 block, stores it as its own file through the one
+//! preparation path (written, read back, a stale or damaged file replaced), and renders from
+//! the state it is handed (`Mode::State`, typed: no cast) deterministically. Adding such a mode
+//! to the product is its folder in `core/src/modes/` plus its line of `modes!`: nothing else
+//! in the core or the server names a mode's state.
 
 use serde_json::{json, Map, Value};
-use textile_core::modes::params::{Common, ParamReader, ParamSpec};
+use textile_core::modes::declared::Declared;
 use textile_core::modes::{Cost, Mode, Needs, Source, View};
-use textile_core::prepare::{
-    envelope, load_or_compute, open_envelope, Input, Origin, Preparation, Prepared, Step, StepOf,
-};
+use textile_core::prepare::{envelope, load_or_compute, open_envelope, Input, Origin, Preparation};
 use textile_core::{
     AnalysisFileProblem, Cancel, CoreError, Exemplar, ExemplarOptions, NoProgress, Progress, Pyramid, Rect, Rendered,
     RgbWindow,
@@ -96,6 +92,14 @@ impl Preparation for Means {
     }
 }
 
+textile_core::declare_params! {
+    /// The mode's parameters: the seed alone.
+    struct MeansParams {
+        seed: u64 { default: 0, canonical: "seed=", seed }
+    }
+    check(_p, _src) { Ok(()) }
+}
+
 /// The mode: each pixel the mean of a block drawn by a hash of its 8×8 cell and the seed.
 struct BlockMeans;
 
@@ -103,40 +107,17 @@ impl Mode for BlockMeans {
     const NAME: &'static str = "means";
     const VERSION: u32 = 1;
     const SUMMARY: &'static str = "block means of the exemplar, shuffled";
-    const NEEDS: Needs = Needs::Exemplar;
+    const NEEDS: Needs = Needs::Prepared;
     const COST: Cost = Cost::Light;
-    type Params = u64;
+    type Params = MeansParams;
+    type State = Means;
 
-    fn specs() -> &'static [ParamSpec] {
-        &[]
-    }
-    fn defaults() -> u64 {
-        0
-    }
-    fn parse(base: &u64, common: &Common, _: &mut ParamReader, _: &Source) -> textile_core::Result<u64> {
-        Ok(common.seed.unwrap_or(*base))
-    }
-    fn values(p: &u64, _: &Source) -> Map<String, Value> {
-        let mut m = Map::new();
-        m.insert("seed".into(), json!(p));
-        m
-    }
-    fn canonical(p: &u64) -> String {
-        format!("seed={p}")
-    }
-    fn preparation() -> Option<&'static dyn Step> {
-        Some(&StepOf::<Means>::NEW)
-    }
-    fn render(p: &u64, src: &Source, _: &Pyramid, view: View) -> textile_core::Result<Rendered> {
-        let state = src
-            .prepared
-            .and_then(|pr| pr.get::<Means>(Self::NAME))
-            .ok_or(CoreError::NotAnalysed { mode: Self::NAME })?;
+    fn render(p: &MeansParams, state: &Means, _: &Source, _: &Pyramid, view: View) -> textile_core::Result<Rendered> {
         let r = view.rect;
         let mut pixels = Vec::with_capacity(r.area() as usize * 3);
         for y in r.y0..r.y1 {
             for x in r.x0..r.x1 {
-                let h = textile_core::hash::hash(7, *p, x.div_euclid(8), y.div_euclid(8), 0);
+                let h = textile_core::hash::hash(7, p.seed, x.div_euclid(8), y.div_euclid(8), 0);
                 pixels.extend_from_slice(&state.means[(h % state.means.len() as u64) as usize]);
             }
         }
@@ -156,16 +137,15 @@ fn gravel() -> Exemplar {
 fn a_stateful_mode_prepares_stores_reloads_and_renders_through_the_one_path() {
     let ex = gravel();
     let dir = tempfile::tempdir().unwrap();
-    let step = BlockMeans::preparation().unwrap();
-    let path = dir.path().join(format!("gravel.{}", step.extension()));
+    let path = dir.path().join(format!("gravel.{}", Means::EXTENSION));
     let input = Input::exemplar(&ex);
-    let run = || step.run(&input, Some(&path), true, &|| true, &NoProgress, &Cancel::new()).unwrap();
+    let run = || load_or_compute::<Means>(&input, Some(&path), true, &|| true, &NoProgress, &Cancel::new()).unwrap();
     // Computed and stored, then read back.
     let (first, origin) = run();
     assert!(matches!(origin, Origin::Stored { .. }), "{origin:?}");
     let (second, origin) = run();
     assert_eq!(origin, Origin::Loaded);
-    assert_eq!((first.id(), first.summary()), (second.id(), second.summary()));
+    assert_eq!((&first.id, first.summary()), (&second.id, second.summary()));
     // A damaged file is named and replaced, never a panic.
     let mut bytes = std::fs::read(&path).unwrap();
     let n = bytes.len();
@@ -183,22 +163,26 @@ fn a_stateful_mode_prepares_stores_reloads_and_renders_through_the_one_path() {
     assert!(!other.exists());
     // Rendered from the state the texture keeps, the same pixels whether it was computed or
     // loaded, and windows are cut from larger ones.
-    let render = |state: Arc<dyn textile_core::prepare::State>, rect: Rect| {
-        let prepared = Prepared::new();
-        prepared.set(BlockMeans::NAME, state);
-        let src = Source::exemplar(&ex).with_prepared(&prepared);
-        BlockMeans::render(&5, &src, &Pyramid::off(), View::native(rect)).unwrap().image
+    let p = MeansParams { seed: 5 };
+    let render = |state: &Means, rect: Rect| {
+        BlockMeans::render(&p, state, &Source::exemplar(&ex), &Pyramid::off(), View::native(rect)).unwrap().image
     };
-    let big = render(first.clone(), Rect::new(-40, 30, 64, 48));
-    assert_eq!(big, render(second.clone(), Rect::new(-40, 30, 64, 48)));
-    let part = render(second, Rect::new(-24, 38, 16, 16));
+    let big = render(&first, Rect::new(-40, 30, 64, 48));
+    assert_eq!(big, render(&second, Rect::new(-40, 30, 64, 48)));
+    let part = render(&second, Rect::new(-24, 38, 16, 16));
     for y in 0..16 {
         let row = |img: &RgbWindow, x0: usize, y0: usize| {
             img.pixels[((y0 + y) * img.width as usize + x0) * 3..][..48].to_vec()
         };
         assert_eq!(row(&part, 0, 0), row(&big, 16, 8));
     }
-    // Without its state the mode says so.
-    let src = Source::exemplar(&ex);
-    assert!(BlockMeans::render(&5, &src, &Pyramid::off(), View::native(Rect::new(0, 0, 8, 8))).is_err());
+    // Its parameters come from its one declaration: read, described and keyed.
+    let read = MeansParams::default()
+        .parse(
+            &textile_core::modes::params::Common { seed: Some(9), period: None },
+            &mut textile_core::ParamReader::request([("seed", "9")]).unwrap(),
+            &Source::exemplar(&ex),
+        )
+        .unwrap();
+    assert_eq!((read.canonical(), read.values(&Source::exemplar(&ex))["seed"].clone()), ("seed=9".into(), json!(9)));
 }

@@ -14,7 +14,7 @@ use textile_core::modes::umbrella::shape::fold_free;
 use textile_core::modes::umbrella::{
     arrange::Arrangement, elements, extraction_id, umbrella_zooms, Extraction, Umbrella, UmbrellaParams,
 };
-use textile_core::prepare::Prepared;
+use textile_core::modes::Prepared;
 use textile_core::{Exemplar, ExemplarOptions, Mode, Pyramid, Rect, RgbWindow, View};
 
 fn fixture(name: &str) -> Exemplar {
@@ -36,14 +36,15 @@ fn prepared(ex: &Exemplar) -> std::sync::Arc<Prepared> {
         return p.clone();
     }
     let p = std::sync::Arc::new(Prepared::new());
-    p.set(Umbrella::NAME, std::sync::Arc::new(Extraction::extract(ex)));
+    p.keep::<Umbrella>(Extraction::extract(ex));
     kept.push((id, p.clone()));
     p
 }
 
 fn render_with(ex: &Exemplar, prepared: &Prepared, p: &UmbrellaParams, view: View) -> RgbWindow {
     let src = textile_core::Source::exemplar(ex).with_prepared(prepared);
-    <Umbrella as Mode>::render(p, &src, &Pyramid::off(), view).unwrap().image
+    let state = prepared.get::<Umbrella>().expect("prepared");
+    <Umbrella as Mode>::render(p, &state, &src, &Pyramid::off(), view).unwrap().image
 }
 
 fn render(ex: &Exemplar, p: &UmbrellaParams, view: View) -> RgbWindow {
@@ -405,7 +406,7 @@ fn the_stored_extraction_reads_back_as_extracted_and_damage_is_named() {
     let view = View::native(Rect::new(-40, 17, 96, 64));
     let before = render(&ex, &UmbrellaParams::default(), view);
     let loaded = Prepared::new();
-    loaded.set(Umbrella::NAME, std::sync::Arc::new(b));
+    loaded.keep::<Umbrella>(b);
     assert_eq!(render_with(&ex, &loaded, &UmbrellaParams::default(), view), before);
 }
 
@@ -475,7 +476,7 @@ fn a_hand_made_set_gives_its_bases_and_variants_and_bad_sets_are_named() {
     // An exemplar with the set renders its elements (deterministically), not gravel's.
     let ex = gravel();
     let set = Prepared::new();
-    set.set(Umbrella::NAME, std::sync::Arc::new(Extraction::hand_made(&ex, el.clone())));
+    set.keep::<Umbrella>(Extraction::hand_made(&ex, el.clone()));
     let view = View::native(Rect::new(-64, 100, 128, 96));
     let img = render_with(&ex, &set, &UmbrellaParams::default(), view);
     assert_eq!(img, render_with(&ex, &set, &UmbrellaParams::default(), view));

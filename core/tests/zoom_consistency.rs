@@ -78,7 +78,7 @@ fn zoomed_out_tiles_are_close_to_their_children_box_filtered() {
     let mut failures = Vec::new();
     for name in ["gravel.png", "brick.png"] {
         let (ex, an) = source(name);
-        let prepared = textile_core::prepare::Prepared::new();
+        let prepared = textile_core::modes::Prepared::compute(&ex).unwrap();
         let src = Source::new(&ex, &an).with_prepared(&prepared);
         for mode in MODE_NAMES {
             let p = params(&src, mode);

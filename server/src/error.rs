@@ -105,7 +105,7 @@ impl From<CoreError> for ApiError {
             CoreError::ExemplarSize { .. } => Self::new(Kind::Unprocessable, "image_size", msg),
             CoreError::FlatExemplar { .. } => Self::bad_request("flat_image", msg),
             CoreError::AnalysisWork { .. } => Self::new(Kind::Unprocessable, "analysis_work", msg),
-            CoreError::NotAnalysed { .. } => {
+            CoreError::NotAnalysed { .. } | CoreError::NotPrepared { .. } => {
                 ApiError { retry_after: Some(2), ..Self::new(Kind::Unavailable, "not_ready", msg) }
             }
             CoreError::Io { .. } | CoreError::AnalysisFile { .. } => Self::internal(msg),

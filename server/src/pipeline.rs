@@ -36,7 +36,7 @@ pub fn etag_for(key: &str) -> String {
 pub fn cache_key(tex: &Texture, p: &ModeParams, what: std::fmt::Arguments) -> String {
     let source = match p.info().needs {
         Needs::Analysis => tex.file_hash().unwrap_or("analysing"),
-        Needs::Exemplar => &tex.exemplar_hash,
+        Needs::Exemplar | Needs::Prepared => &tex.exemplar_hash,
     };
     // Empty unless the state says otherwise, so that the keys of every other texture and mode
     // stay as they were.

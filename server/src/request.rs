@@ -49,17 +49,19 @@ pub fn query_reader(raw: Option<&str>) -> Result<ParamReader, ApiError> {
 
 /// Resolve a request's parameters against a texture's defaults: takes `v` (checked, not part
 /// of the content), then the texture reads the rest and refuses leftovers. A mode that needs
-/// the texture's analysis answers 503 `not_ready` (with `Retry-After`) while it is computed.
+/// the texture's analysis, or what it prepares from the texture, answers 503 `not_ready` (with
+/// `Retry-After`) while that is computed.
 pub fn params(tex: &Texture, mut r: ParamReader) -> Result<ModeParams, ApiError> {
     if r.take("v").is_some_and(|v| v.len() > MAX_V) {
         return Err(ApiError::bad_request("invalid_parameter", format!("parameter 'v': at most {MAX_V} characters")));
     }
     let p = tex.defaults.request(&tex.source(), r)?;
-    if p.info().needs == Needs::Analysis && tex.analysis().is_none() {
-        let mode = p.name();
-        return Err(textile_core::CoreError::NotAnalysed { mode }.into());
+    let mode = p.name();
+    match p.info().needs {
+        Needs::Analysis if tex.analysis().is_none() => Err(textile_core::CoreError::NotAnalysed { mode }.into()),
+        Needs::Prepared if !tex.prepared.has(mode) => Err(textile_core::CoreError::NotPrepared { mode }.into()),
+        _ => Ok(p),
     }
-    Ok(p)
 }
 
 /// Read `map=` (default `albedo`): the colour, one of the texture's maps, or `uv` (PNG only).

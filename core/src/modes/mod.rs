@@ -7,12 +7,14 @@
 //! part of every ETag and cache key of its tiles, bumped whenever its pixels change (the golden
 //! test in `core/tests/golden.rs` says when).
 
+pub mod declared;
 pub mod magnify;
 pub mod params;
+pub mod prepared;
 
 use std::collections::BTreeMap;
 use std::fmt::Debug;
-use std::hash::Hash;
+use std::sync::{Arc, OnceLock};
 
 use serde_json::{Map, Value};
 
@@ -23,8 +25,10 @@ use crate::exemplar::Exemplar;
 use crate::geom::Rect;
 use crate::image::{Rendered, RgbWindow};
 use crate::maps::{MaterialMap, UvWindow};
-use crate::prepare::{Prepared, Step};
+use crate::prepare::State;
+pub use declared::Declared;
 use params::{Common, ParamReader, ParamSpec};
+use prepared::{ModeState, Slot, Step};
 
 /// What a mode needs from a texture.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +37,9 @@ pub enum Needs {
     Exemplar,
     /// The exemplar analysis (Gaussian stack, PCA, candidates).
     Analysis,
+    /// The exemplar and what the mode prepares from it ([`Mode::State`]): servable once that
+    /// is prepared.
+    Prepared,
 }
 
 /// How expensive a mode's pixels are, so front ends can spend encoder effort accordingly.
@@ -53,7 +60,7 @@ pub struct Source<'a> {
     /// The analysis, when available.
     pub analysis: Option<&'a Analysis>,
     /// The modes' prepared states, when the caller keeps them (a mode whose state is missing
-    /// prepares it for the request).
+    /// does not render: [`CoreError::NotPrepared`]).
     pub prepared: Option<&'a Prepared>,
     /// The material map to show instead of the colour ([`Source::with_map`]).
     pub map: Option<&'a MaterialMap>,
@@ -172,6 +179,14 @@ pub(crate) fn check_window(rect: Rect, max: i64) -> Result<()> {
     Ok(())
 }
 
+/// The error of `map=uv` in a mode whose pixels are not texels looked up by coordinate.
+fn no_uv(mode: &str) -> CoreError {
+    CoreError::Map {
+        name: "uv".into(),
+        message: format!("is not available in mode={mode}: its pixels are not texels looked up by coordinate"),
+    }
+}
+
 /// An engine: its name, version, parameters and rendering of any window.
 pub trait Mode {
     /// Name as the API spells it (`mode=NAME`).
@@ -185,28 +200,18 @@ pub trait Mode {
     const NEEDS: Needs;
     /// How expensive its pixels are.
     const COST: Cost;
-    /// Validated parameters: everything besides the texture that determines the pixels.
-    type Params: Clone + Debug + PartialEq + Eq + Hash + Send + Sync + 'static;
+    /// Validated parameters: everything besides the texture that determines the pixels,
+    /// declared once with [`crate::declare_params!`] (specs, defaults, reading, values and the
+    /// canonical text all come from that declaration).
+    type Params: Declared;
 
-    /// The mode's own parameters (the common ones are [`params::COMMON`]).
-    fn specs() -> &'static [ParamSpec];
-    /// Built-in defaults, before a texture's configuration.
-    fn defaults() -> Self::Params;
-    /// Read this mode's keys from `r` over `base`, apply `common`, and validate for `src`.
-    fn parse(base: &Self::Params, common: &Common, r: &mut ParamReader, src: &Source) -> Result<Self::Params>;
-    /// The current value of each of [`Mode::specs`] (and `seed`) as JSON, for descriptions.
-    fn values(p: &Self::Params, src: &Source) -> Map<String, Value>;
-    /// Canonical text of every field, for cache keys and ETags.
-    fn canonical(p: &Self::Params) -> String;
-    /// What the mode prepares per texture and keeps (see [`crate::prepare`]): none by default.
-    /// A mode that prepares something reads it back from [`Source::prepared`] under its name.
-    fn preparation() -> Option<&'static dyn Step> {
-        None
-    }
+    /// What the mode prepares per texture and renders from: `()` for nothing, or a
+    /// [`crate::prepare::Preparation`] (see [`prepared`]). Its render receives it.
+    type State: ModeState;
 
     /// A picture of what the mode prepared for the texture, as parameters `p` use it
     /// (`textile render --sheet`): none by default.
-    fn sheet(_p: &Self::Params, _src: &Source) -> Option<Result<RgbWindow>> {
+    fn sheet(_p: &Self::Params, _state: &Self::State, _src: &Source) -> Option<Result<RgbWindow>> {
         None
     }
 
@@ -216,25 +221,32 @@ pub trait Mode {
 
     /// The exemplar coordinates each pixel of `view` shows (`map=uv`), for modes whose pixels
     /// are exemplar texels looked up by coordinate; others answer [`CoreError::Map`] saying why.
-    fn coordinates(_p: &Self::Params, _src: &Source, _cache: &Pyramid, _view: View) -> Result<UvWindow> {
-        Err(CoreError::Map {
-            name: "uv".into(),
-            message: format!(
-                "is not available in mode={}: its pixels are not texels looked up by coordinate",
-                Self::NAME
-            ),
-        })
+    fn coordinates(
+        _p: &Self::Params,
+        _state: &Self::State,
+        _src: &Source,
+        _cache: &Pyramid,
+        _view: View,
+    ) -> Result<UvWindow> {
+        Err(no_uv(Self::NAME))
     }
 
     /// Render a view that is not magnified (`view.zoom_in = 0`); `cache` is the shared
     /// pyramidal cache (modes that keep nothing ignore it).
-    fn render(p: &Self::Params, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered>;
+    fn render(p: &Self::Params, state: &Self::State, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered>;
 
     /// Render `rect` magnified `k` steps beyond native (design note §1.8). By default the
     /// native pixels are magnified bilinearly; modes that synthesize exemplar coordinates
     /// extrapolate each texel's patch instead ([`magnify::patches`]).
-    fn magnify(p: &Self::Params, src: &Source, cache: &Pyramid, k: u32, rect: Rect) -> Result<Rendered> {
-        let native = Self::render(p, src, cache, View::native(magnify::source_rect(rect, k)))?;
+    fn magnify(
+        p: &Self::Params,
+        state: &Self::State,
+        src: &Source,
+        cache: &Pyramid,
+        k: u32,
+        rect: Rect,
+    ) -> Result<Rendered> {
+        let native = Self::render(p, state, src, cache, View::native(magnify::source_rect(rect, k)))?;
         Ok(Rendered { image: magnify::bilinear(&native.image, k, rect), synthesized: native.synthesized })
     }
 }
@@ -271,15 +283,15 @@ impl std::fmt::Debug for ModeInfo {
 }
 
 impl ModeInfo {
-    fn of<M: Mode>(specs: &'static [ParamSpec]) -> ModeInfo {
+    fn of<M: Slot>() -> ModeInfo {
         ModeInfo {
             name: M::NAME,
             version: M::VERSION,
             summary: M::SUMMARY,
             needs: M::NEEDS,
             cost: M::COST,
-            specs,
-            preparation: M::preparation(),
+            specs: <M::Params as Declared>::SPECS,
+            preparation: <M::State as ModeState>::step::<M>(),
             has_uv: M::HAS_UV,
         }
     }
@@ -300,12 +312,47 @@ macro_rules! modes {
     ($($variant:ident => $module:ident :: $ty:ident),+ $(,)?) => {
         $(pub mod $module;)+
 
+        /// The states one texture's modes have prepared: a slot per mode, each of that mode's
+        /// own [`Mode::State`] (filled from the start for a mode that prepares nothing).
+        pub struct Prepared {
+            $($module: OnceLock<Arc<<$module::$ty as Mode>::State>>,)+
+        }
+
+        impl Default for Prepared {
+            fn default() -> Self {
+                Prepared { $($module: prepared::empty_slot(),)+ }
+            }
+        }
+
+        $(impl Slot for $module::$ty {
+            fn slot(p: &Prepared) -> &OnceLock<Arc<Self::State>> {
+                &p.$module
+            }
+        })+
+
+        impl Prepared {
+            /// Every state prepared so far, by mode name, without its type (modes that prepare
+            /// nothing have none).
+            pub fn all(&self) -> Vec<(&'static str, Arc<dyn State>)> {
+                let mut all = Vec::new();
+                $(if let Some(s) = self.$module.get().and_then(ModeState::erased) {
+                    all.push((<$module::$ty as Mode>::NAME, s));
+                })+
+                all
+            }
+
+            /// Whether each mode has its state, by mode name.
+            fn ready(&self) -> Vec<(&'static str, bool)> {
+                vec![$((<$module::$ty as Mode>::NAME, self.$module.get().is_some())),+]
+            }
+        }
+
         /// Names of all modes, in the order they are listed.
         pub const MODE_NAMES: &[&str] = &[$(<$module::$ty as Mode>::NAME),+];
 
         /// Every mode, described.
         pub fn all() -> Vec<ModeInfo> {
-            vec![$(ModeInfo::of::<$module::$ty>(<$module::$ty as Mode>::specs())),+]
+            vec![$(ModeInfo::of::<$module::$ty>()),+]
         }
 
         /// A mode with its validated parameters: everything besides the texture that
@@ -322,7 +369,7 @@ macro_rules! modes {
             /// The built-in defaults of the mode called `name`.
             pub fn defaults(name: &str) -> Option<ModeParams> {
                 match name {
-                    $(n if n == <$module::$ty as Mode>::NAME => Some(ModeParams::$variant(<$module::$ty as Mode>::defaults())),)+
+                    $(n if n == <$module::$ty as Mode>::NAME => Some(ModeParams::$variant(Default::default())),)+
                     _ => None,
                 }
             }
@@ -330,21 +377,28 @@ macro_rules! modes {
             /// The mode's description.
             pub fn info(&self) -> ModeInfo {
                 match self {
-                    $(ModeParams::$variant(_) => ModeInfo::of::<$module::$ty>(<$module::$ty as Mode>::specs()),)+
+                    $(ModeParams::$variant(_) => ModeInfo::of::<$module::$ty>(),)+
                 }
             }
 
             /// Read the mode's keys over these parameters (see [`Mode::parse`]).
             pub fn parse(&self, common: &Common, r: &mut ParamReader, src: &Source) -> Result<ModeParams> {
                 match self {
-                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::parse(p, common, r, src).map(ModeParams::$variant),)+
+                    $(ModeParams::$variant(p) => Declared::parse(p, common, r, src).map(ModeParams::$variant),)+
                 }
             }
 
             /// Current values as JSON (see [`Mode::values`]).
             pub fn values(&self, src: &Source) -> Map<String, Value> {
                 match self {
-                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::values(p, src),)+
+                    $(ModeParams::$variant(p) => Declared::values(p, src),)+
+                }
+            }
+
+            /// Each parameter as text that reads back to its value (see [`Declared::texts`]).
+            pub fn texts(&self) -> Vec<(&'static str, String)> {
+                match self {
+                    $(ModeParams::$variant(p) => Declared::texts(p),)+
                 }
             }
 
@@ -356,7 +410,7 @@ macro_rules! modes {
                         "mode={};v{};{}",
                         <$module::$ty as Mode>::NAME,
                         <$module::$ty as Mode>::VERSION,
-                        <$module::$ty as Mode>::canonical(p)
+                        Declared::canonical(p)
                     ),)+
                 }
             }
@@ -364,7 +418,7 @@ macro_rules! modes {
             /// A picture of what the mode prepared (see [`Mode::sheet`]).
             pub fn sheet(&self, src: &Source) -> Option<Result<RgbWindow>> {
                 match self {
-                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::sheet(p, src),)+
+                    $(ModeParams::$variant(p) => prepared::with_state::<$module::$ty, _>(src.prepared, |st| Ok(<$module::$ty as Mode>::sheet(p, st, src))).unwrap_or_else(|e| Some(Err(e))),)+
                 }
             }
 
@@ -374,7 +428,8 @@ macro_rules! modes {
                     magnify::check_steps(view.zoom_in)?;
                 }
                 match self {
-                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::coordinates(p, src, cache, view),)+
+                    $(ModeParams::$variant(_) if !<$module::$ty as Mode>::HAS_UV => Err(no_uv(<$module::$ty as Mode>::NAME)),)+
+                    $(ModeParams::$variant(p) => prepared::with_state::<$module::$ty, _>(src.prepared, |st| <$module::$ty as Mode>::coordinates(p, st, src, cache, view)),)+
                 }
             }
 
@@ -393,11 +448,11 @@ macro_rules! modes {
                 if view.zoom_in > 0 {
                     magnify::check_steps(view.zoom_in)?;
                     return match self {
-                        $(ModeParams::$variant(p) => <$module::$ty as Mode>::magnify(p, src, cache, view.zoom_in, view.rect),)+
+                        $(ModeParams::$variant(p) => prepared::with_state::<$module::$ty, _>(src.prepared, |st| <$module::$ty as Mode>::magnify(p, st, src, cache, view.zoom_in, view.rect)),)+
                     };
                 }
                 match self {
-                    $(ModeParams::$variant(p) => <$module::$ty as Mode>::render(p, src, cache, view),)+
+                    $(ModeParams::$variant(p) => prepared::with_state::<$module::$ty, _>(src.prepared, |st| <$module::$ty as Mode>::render(p, st, src, cache, view)),)+
                 }
             }
         }
@@ -417,6 +472,10 @@ impl ModeParams {
         self.info().name
     }
 }
+
+/// The mode of requests that name none, unless a texture's configuration says otherwise: the
+/// first of the `modes!` list. Named here only.
+pub const DEFAULT_MODE: &str = MODE_NAMES[0];
 
 /// Every mode's parameters, for naming the mode a stray key belongs to.
 fn all_specs() -> Vec<(&'static str, &'static [ParamSpec])> {
@@ -488,9 +547,9 @@ impl Defaults {
         Ok(Defaults { mode: mode_name, params: out })
     }
 
-    /// Built-in defaults for every mode, default mode `synth`.
+    /// Built-in defaults for every mode, default mode [`DEFAULT_MODE`].
     pub fn builtin(src: &Source) -> Defaults {
-        Defaults::configure(src, MODE_NAMES[0], 0, &BTreeMap::new())
+        Defaults::configure(src, DEFAULT_MODE, 0, &BTreeMap::new())
             .unwrap_or_else(|e| unreachable!("built-in defaults are valid: {e}"))
     }
 

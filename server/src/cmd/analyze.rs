@@ -21,9 +21,15 @@ pub fn run(a: AnalyzeArgs) -> CliResult {
     for (_, step) in textile_core::modes::preparations() {
         let beside = a.output.with_extension(step.extension());
         let input = Input::exemplar(&ex);
-        if let (_, Origin::Computed { not_stored: Some(e), .. }) =
-            step.run(&input, Some(&beside), true, &|| true, &textile_core::NoProgress, &Cancel::new())?
-        {
+        if let (_, Origin::Computed { not_stored: Some(e), .. }) = step.run(
+            &textile_core::modes::Prepared::new(),
+            &input,
+            Some(&beside),
+            true,
+            &|| true,
+            &textile_core::NoProgress,
+            &Cancel::new(),
+        )? {
             return Err(format!("{}: {e}", beside.display()).into());
         }
     }

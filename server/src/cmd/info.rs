@@ -37,7 +37,17 @@ pub fn run(a: InfoArgs) -> CliResult {
             Err(e) => (None, format!("computed ({e})")),
         };
         let input = Input::exemplar(&ex);
-        let current = || step.run(&input, None, false, &|| true, &textile_core::NoProgress, &Cancel::new());
+        let current = || {
+            step.run(
+                &textile_core::modes::Prepared::new(),
+                &input,
+                None,
+                false,
+                &|| true,
+                &textile_core::NoProgress,
+                &Cancel::new(),
+            )
+        };
         let (state, from) = match stored {
             // Of this exemplar and version (its id), else computed.
             Some(state) if state.id() == step.id(&input) => (state, from),

@@ -103,8 +103,7 @@ pub fn run(a: RenderArgs) -> CliResult {
     // here, in memory, not again by every window the mode renders (a camera view renders many).
     if let (Some(_), Some(step)) = (&a.exemplar, params.info().preparation) {
         let input = textile_core::prepare::Input::exemplar(&tex.exemplar);
-        let (state, _) = step.run(&input, None, false, &|| false, &textile_core::NoProgress, &Cancel::new())?;
-        tex.prepared.set(params.name(), state);
+        step.run(&tex.prepared, &input, None, false, &|| false, &textile_core::NoProgress, &Cancel::new())?;
     }
     let map = crate::request::parse_map(&tex, &a.map, output_format(&output).unwrap_or(crate::encode::Format::Png))?;
     if map != MapChoice::Albedo && (a.sheet || a.camera.is_some()) {

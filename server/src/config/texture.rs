@@ -268,7 +268,7 @@ fn default_toroidal() -> Toroidal {
 }
 
 fn default_mode() -> String {
-    "synth".into()
+    textile_core::modes::DEFAULT_MODE.into()
 }
 
 /// Texture ids: 1–64 characters of `a-z 0-9 _ -`.

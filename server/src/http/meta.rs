@@ -173,6 +173,7 @@ fn mode_info() -> Value {
         let needs = match m.needs {
             Needs::Exemplar => "exemplar",
             Needs::Analysis => "analysis",
+            Needs::Prepared => "prepared",
         };
         let cost = match m.cost {
             Cost::Heavy => "heavy",

@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, OnceLock};
 
-use textile_core::prepare::Prepared;
+use textile_core::modes::Prepared;
 use textile_core::{Analysis, Cancel, Defaults, Exemplar, Source};
 
 use crate::config::TextureConfig;

@@ -135,11 +135,17 @@ impl Preparing<'_> {
             let path = self.path(step.extension());
             let started = std::time::Instant::now();
             let keep = || self.keep();
-            let (state, origin) =
-                step.run(&input, Some(&path), self.storable, &keep, &textile_core::NoProgress, cancel)?;
+            let (state, origin) = step.run(
+                &self.tex.prepared,
+                &input,
+                Some(&path),
+                self.storable,
+                &keep,
+                &textile_core::NoProgress,
+                cancel,
+            )?;
             self.report(step.what(), state.summary(), &origin, &path, started.elapsed());
             state.limit_caches(self.tex.cache_limit.load(Ordering::Relaxed));
-            self.tex.prepared.set(mode, state);
         }
         Ok(())
     }

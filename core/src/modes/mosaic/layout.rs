@@ -79,8 +79,8 @@ impl Layout {
     fn sides(&self, z: u64) -> (i64, i64) {
         let n = self.n;
         // Integers below 2^48 convert to f64 exactly, and from i64 in one instruction.
-        let rho = self.p.area_min as f64
-            + ((((z & 0xFFFF) * (self.p.area_max - self.p.area_min) as u64) >> 16) as i64) as f64;
+        let rho = self.p.block_area.0 as f64
+            + ((((z & 0xFFFF) * (self.p.block_area.1 - self.p.block_area.0) as u64) >> 16) as i64) as f64;
         let rho = rho / 1000.0;
         // Aspect in [2/3, 3/2], symmetric in log scale (α and 1/α equally likely).
         let u = (((z >> 16) & 0xFFFF) as i64) as f64 / 32768.0 - 1.0;

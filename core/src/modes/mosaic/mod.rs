@@ -10,17 +10,15 @@ pub mod params;
 mod smooth;
 
 use rayon::prelude::*;
-use serde_json::{json, Map, Value};
 
 use crate::cache::Pyramid;
 use crate::error::Result;
 use crate::exemplar::Exemplar;
 use crate::geom::Rect;
 use crate::image::{box_mip, Integral, Rendered, RgbWindow};
-use crate::modes::params::{Common, Kind, ParamReader, ParamSpec, Scope};
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
-pub use params::{MosaicParams, MAX_ITERATIONS, MAX_SMOOTHING};
+pub use params::{MosaicParams, BLOCK_AREA, ITERATIONS, MAX_ITERATIONS, MAX_SMOOTHING, SMOOTHING};
 
 use layout::Layout;
 use paint::sources;
@@ -32,26 +30,6 @@ pub const MAX_PIXELS: i64 = 1 << 26;
 /// The mosaic mode.
 pub struct Mosaic;
 
-const ITERATIONS: ParamSpec = ParamSpec {
-    name: "iterations",
-    kind: Kind::Integer { min: 0, max: MAX_ITERATIONS as u64 },
-    scope: Scope::Request,
-    help: "cat-map iterations that move the blocks (0 = blocks stay in place: the plain tiling)",
-};
-const BLOCK_AREA: ParamSpec = ParamSpec {
-    name: "block_area",
-    kind: Kind::Interval { min: 0.05, max: 1.0 },
-    scope: Scope::Request,
-    help: "MIN,MAX block area as fractions of the exemplar area",
-};
-const SMOOTHING: ParamSpec = ParamSpec {
-    name: "smoothing",
-    kind: Kind::Integer { min: 0, max: MAX_SMOOTHING as u64 },
-    scope: Scope::Request,
-    help: "pixel layers smoothed on each side of block and tile edges",
-};
-const SPECS: &[ParamSpec] = &[ITERATIONS, BLOCK_AREA, SMOOTHING];
-
 impl Mode for Mosaic {
     const NAME: &'static str = "mosaic";
     const VERSION: u32 = 2;
@@ -59,45 +37,9 @@ impl Mode for Mosaic {
     const NEEDS: Needs = Needs::Exemplar;
     const COST: Cost = Cost::Light;
     type Params = MosaicParams;
+    type State = ();
 
-    fn specs() -> &'static [ParamSpec] {
-        SPECS
-    }
-
-    fn defaults() -> MosaicParams {
-        MosaicParams::default()
-    }
-
-    fn parse(base: &MosaicParams, common: &Common, r: &mut ParamReader, src: &Source) -> Result<MosaicParams> {
-        let mut p = base.clone();
-        common.apply(&mut p.seed, &mut p.period);
-        if let Some(s) = r.get(&ITERATIONS) {
-            p.iterations = ITERATIONS.integer(&s)? as u32;
-        }
-        if let Some(s) = r.get(&BLOCK_AREA) {
-            (p.area_min, p.area_max) = BLOCK_AREA.interval_milli(&s)?;
-        }
-        if let Some(s) = r.get(&SMOOTHING) {
-            p.smoothing = SMOOTHING.integer(&s)? as u32;
-        }
-        p.validate(src.side())?;
-        Ok(p)
-    }
-
-    fn values(p: &MosaicParams, _: &Source) -> Map<String, Value> {
-        let mut m = Map::new();
-        m.insert("seed".into(), json!(p.seed));
-        m.insert(ITERATIONS.name.into(), json!(p.iterations));
-        m.insert(BLOCK_AREA.name.into(), json!([p.area_min as f64 / 1000.0, p.area_max as f64 / 1000.0]));
-        m.insert(SMOOTHING.name.into(), json!(p.smoothing));
-        m
-    }
-
-    fn canonical(p: &MosaicParams) -> String {
-        p.canonical()
-    }
-
-    fn render(p: &MosaicParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
+    fn render(p: &MosaicParams, _: &(), src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
         Ok(Rendered {
             image: render_texels(src, p, view.zoom_out, view.rect)?,
             synthesized: render_cost(view.zoom_out, view.rect),

@@ -1,50 +1,53 @@
-//! Validated mosaic parameters: cat-map iterations, block area bounds, smoothing, seed, period.
+//! The mosaic's parameters, declared once ([`crate::declare_params!`]): cat-map iterations,
+//! block area bounds, smoothing, seed and period, with their specs and canonical keys.
 
 use crate::error::{CoreError, Result};
-use crate::modes::params::check_period;
+use crate::modes::params::{check_period, Kind};
 
 /// Largest number of cat-map iterations accepted.
 pub const MAX_ITERATIONS: u32 = 64;
 /// Smoothing layers at most (the tent filter is 7×7).
 pub const MAX_SMOOTHING: u32 = 3;
 
-/// Validated mosaic parameters.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct MosaicParams {
-    /// Selects another arrangement of blocks.
-    pub seed: u64,
-    /// Cat-map iterations (0 = blocks stay in place: the plain tiling).
-    pub iterations: u32,
-    /// Smallest block area, per mille of the exemplar area.
-    pub area_min: u32,
-    /// Largest block area, per mille of the exemplar area.
-    pub area_max: u32,
-    /// Pixel layers smoothed on each side of block and tile edges (0–3).
-    pub smoothing: u32,
-    /// Optional period in texels (power of two ≥ the exemplar side): a mosaic on a torus.
-    pub period: Option<i64>,
-}
-
-impl Default for MosaicParams {
-    fn default() -> Self {
-        MosaicParams { seed: 0, iterations: 10, area_min: 500, area_max: 750, smoothing: 3, period: None }
+crate::declare_params! {
+    /// Validated mosaic parameters.
+    pub struct MosaicParams {
+        /// Selects another arrangement of blocks.
+        pub seed: u64 { default: 0, canonical: "seed=", seed }
+        /// Cat-map iterations (0 = blocks stay in place: the plain tiling).
+        pub iterations: u32 { default: 10, canonical: ";it=",
+            spec ITERATIONS = "iterations", Kind::Integer { min: 0, max: MAX_ITERATIONS as u64 }, Request,
+            "cat-map iterations that move the blocks (0 = blocks stay in place: the plain tiling)" }
+        /// Smallest and largest block area, per mille of the exemplar area.
+        pub block_area: (u32, u32) { default: (500, 750), canonical: ";area=",
+            spec BLOCK_AREA = "block_area", Kind::Interval { min: 0.05, max: 1.0 }, Request,
+            "MIN,MAX block area as fractions of the exemplar area" }
+        /// Pixel layers smoothed on each side of block and tile edges (0–3).
+        pub smoothing: u32 { default: 3, canonical: ";smooth=",
+            spec SMOOTHING = "smoothing", Kind::Integer { min: 0, max: MAX_SMOOTHING as u64 }, Request,
+            "pixel layers smoothed on each side of block and tile edges" }
+        /// Optional period in texels (power of two ≥ the exemplar side): a mosaic on a torus.
+        pub period: Option<i64> { default: None, canonical: ";period=", period }
     }
+    check(p, src) { p.validate(src.side()) }
 }
 
 impl MosaicParams {
-    /// Check ranges for an exemplar of side `side`.
+    /// Check ranges for an exemplar of side `side` (parameters made in code are checked here
+    /// too, not only parsed ones).
     pub fn validate(&self, side: u32) -> Result<()> {
         let bad = |name, message: String| Err(CoreError::Param { name, message });
         if self.iterations > MAX_ITERATIONS {
             return bad("iterations", format!("{} is outside 0..={MAX_ITERATIONS}", self.iterations));
         }
-        if !(50..=1000).contains(&self.area_min) || !(self.area_min..=1000).contains(&self.area_max) {
+        let (min, max) = self.block_area;
+        if !(50..=1000).contains(&min) || !(min..=1000).contains(&max) {
             return bad(
                 "block_area",
                 format!(
                     "{},{} must be two fractions of the exemplar area with 0.05 <= min <= max <= 1",
-                    self.area_min as f64 / 1000.0,
-                    self.area_max as f64 / 1000.0
+                    min as f64 / 1000.0,
+                    max as f64 / 1000.0
                 ),
             );
         }
@@ -53,18 +56,5 @@ impl MosaicParams {
         }
         check_period(self.period, side)?;
         Ok(())
-    }
-
-    /// Canonical text form for cache keys and ETags.
-    pub fn canonical(&self) -> String {
-        format!(
-            "seed={};it={};area={},{};smooth={};period={}",
-            self.seed,
-            self.iterations,
-            self.area_min,
-            self.area_max,
-            self.smoothing,
-            self.period.map(|p| p.to_string()).unwrap_or_else(|| "none".into())
-        )
     }
 }

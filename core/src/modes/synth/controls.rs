@@ -357,6 +357,25 @@ impl Controls {
     }
 }
 
+impl crate::modes::declared::Canonical for Controls {
+    fn canonical(&self) -> String {
+        Controls::canonical(self)
+    }
+}
+
+impl crate::modes::declared::ParamValue for Controls {
+    fn parse(_: &crate::modes::params::ParamSpec, s: &str) -> Result<Self> {
+        Controls::parse(s)
+    }
+    fn json(&self, _: &crate::modes::params::ParamSpec, _: u32) -> Value {
+        self.to_json()
+    }
+    fn text(&self, _: &crate::modes::params::ParamSpec) -> String {
+        let json = serde_json::to_vec(&self.to_json()).unwrap_or_default();
+        base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(json)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

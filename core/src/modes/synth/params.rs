@@ -3,7 +3,10 @@
 
 use crate::analysis::FIRST_CORRECTED_LEVEL;
 use crate::error::{CoreError, Result};
-use crate::modes::params::{check_period, parse_unit, ONE_Q16};
+use serde_json::{json, Value};
+
+use crate::modes::declared::{unit_text, unit_value, Canonical, ParamValue};
+use crate::modes::params::{check_period, parse_unit, Kind, ParamSpec, ONE_Q16};
 
 use super::controls::Controls;
 
@@ -46,8 +49,12 @@ pub fn default_randomness(levels: u32) -> Vec<u32> {
 }
 
 impl Randomness {
-    /// Parse `"0.5"` (every level) or `"1,0.8,…"` (one value per level, coarse to fine).
+    /// Parse `"0.5"` (every level), `"1,0.8,…"` (one value per level, coarse to fine) or
+    /// `"default"` (the default schedule).
     pub fn parse(s: &str) -> Result<Randomness> {
+        if s.trim() == "default" {
+            return Ok(Randomness::Default);
+        }
         let parts: Vec<&str> = s.split(',').collect();
         if parts.len() == 1 {
             return Ok(Randomness::Uniform(parse_unit("randomness", parts[0])?));
@@ -74,36 +81,57 @@ impl Randomness {
     }
 }
 
-/// Everything besides the analysis that determines synthesized pixels.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct SynthParams {
-    /// Selects another, equally good texture.
-    pub seed: u64,
-    /// Per-level jitter strength.
-    pub randomness: Randomness,
-    /// Correction passes per corrected level; level `L − 2` gets one more (see
-    /// [`super::plan::Schedules`]). 0 switches correction off.
-    pub passes: u32,
-    /// Subpasses per pass: 4 (parity classes, the paper's order) or 1 (all pixels at once).
-    pub subpasses: u32,
-    /// κ in fixed point (`[0, 65536]`): penalty on jumps to the second candidate.
-    pub kappa: u32,
-    /// Optional period in texels (a power of two ≥ the exemplar side): periodic output.
-    pub period: Option<i64>,
-    /// Spatial modulation of randomness over the output (`R_S`), from the request.
-    pub controls: Controls,
+crate::declare_params! {
+    /// Everything besides the analysis that determines synthesized pixels.
+    pub struct SynthParams {
+        /// Selects another, equally good texture.
+        pub seed: u64 { default: 0, canonical: "seed=", seed }
+        /// Per-level jitter strength.
+        pub randomness: Randomness { default: Randomness::Default, canonical: ";r=",
+            spec RANDOMNESS = "randomness", Kind::Levels, Request,
+            "jitter strength per synthesis level: one value in [0, 1] for every level, or a comma list of one per level, coarse to fine" }
+        /// Correction passes per corrected level; level `L − 2` gets one more (see
+        /// [`super::plan::Schedules`]). 0 switches correction off.
+        pub passes: u32 { default: 2, canonical: ";passes=",
+            spec PASSES = "passes", Kind::Integer { min: 0, max: MAX_PASSES as u64 }, Texture,
+            "correction passes per corrected level, one more at the third-finest (0 switches correction off)" }
+        /// Subpasses per pass: 4 (parity classes, the paper's order) or 1 (all pixels at once).
+        pub subpasses: u32 { default: 4, canonical: ";sub=",
+            spec SUBPASSES = "subpasses", Kind::Integer { min: 1, max: 4 }, Texture,
+            "subpasses per pass: 4 (parity classes, the paper's order) or 1 (all pixels at once)" }
+        /// κ in fixed point (`[0, 65536]`): penalty on jumps to the second candidate.
+        pub kappa: u32 { default: ONE_Q16, canonical: ";kappa=",
+            spec KAPPA = "kappa", Kind::Unit, Texture,
+            "κ, the penalty on jumps to a pixel's second candidate (default 1): higher keeps exemplar patches more coherent and the colour distribution closer to the exemplar's" }
+        /// Optional period in texels (a power of two ≥ the exemplar side): periodic output.
+        pub period: Option<i64> { default: None, canonical: ";period=", period }
+        /// Spatial modulation of randomness over the output (`R_S`), from the request; part of
+        /// the canonical text only when given, so that every other request keeps its identity.
+        pub controls: Controls { default: Controls::default(), canonical: (unless_default ";controls="),
+            spec CONTROLS = "controls", Kind::Text { max_len: super::controls::MAX_CONTROLS_LEN as u64 }, Request,
+            "spatial modulation of randomness over the output (R_S): base64url of JSON {\"noise\": {\"scale\": 64, \"range\": [0.2, 1]}, \"strokes\": [{\"at\": [x, y], \"radius\": 40, \"soft\": 8, \"value\": 0}], \"features\": [{\"at\": [x, y], \"source\": [u, v], \"inner\": 12, \"outer\": 40}]} (native texels; values in [0, 1]: 0 calm, 1 the full randomness; a feature shows the exemplar around its source within its inner radius; at most 64 strokes and 32 features)" }
+    }
+    check(p, src) { p.validate(src.side()) }
 }
 
-impl Default for SynthParams {
-    fn default() -> Self {
-        SynthParams {
-            seed: 0,
-            randomness: Randomness::Default,
-            passes: 2,
-            subpasses: 4,
-            kappa: ONE_Q16,
-            period: None,
-            controls: Controls::default(),
+impl Canonical for Randomness {
+    fn canonical(&self) -> String {
+        Randomness::canonical(self)
+    }
+}
+
+impl ParamValue for Randomness {
+    fn parse(_: &ParamSpec, s: &str) -> Result<Self> {
+        Randomness::parse(s)
+    }
+    fn json(&self, _: &ParamSpec, levels: u32) -> Value {
+        json!(self.resolve(levels).into_iter().map(unit_value).collect::<Vec<f64>>())
+    }
+    fn text(&self, _: &ParamSpec) -> String {
+        match self {
+            Randomness::Default => "default".into(),
+            Randomness::Uniform(r) => unit_text(*r),
+            Randomness::PerLevel(v) => v.iter().map(|r| unit_text(*r)).collect::<Vec<_>>().join(","),
         }
     }
 }
@@ -141,24 +169,6 @@ impl SynthParams {
         self.controls.check_period(self.period)?;
         self.controls.check_side(side)?;
         Ok(())
-    }
-
-    /// Canonical text form of every field, for cache keys and ETags.
-    pub fn canonical(&self) -> String {
-        let base = format!(
-            "seed={};r={};passes={};sub={};kappa={};period={}",
-            self.seed,
-            self.randomness.canonical(),
-            self.passes,
-            self.subpasses,
-            self.kappa,
-            self.period.map(|p| p.to_string()).unwrap_or_else(|| "none".into())
-        );
-        // Only when given, so that every other request keeps its identity.
-        match self.controls.is_empty() {
-            true => base,
-            false => format!("{base};controls={}", self.controls.canonical()),
-        }
     }
 
     /// Candidate weights `φ_1 = 2^16`, `φ_2 = (1+κ)²·2^16`, in integer arithmetic.

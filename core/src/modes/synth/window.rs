@@ -18,6 +18,7 @@ use crate::hash::{hash_tail, head, key, TAG_JITTER};
 use crate::lattice::round_to;
 use crate::mask::RandomnessMask;
 use crate::modes::params::ONE_Q16;
+use crate::modes::Declared;
 use super::controls::Controls;
 use super::history::{block_index, capture, for_rows, overlay, pending};
 use super::kernel::{projection_pairs, projection_run_pairs, tap_shifts, tap_spans, Kernel};

@@ -5,13 +5,11 @@
 //! once a pixel covers a whole period. Needs only the exemplar; seed and world change nothing
 //! (its period, the exemplar side, divides every allowed world).
 
-use serde_json::{json, Map, Value};
-
 use crate::cache::Pyramid;
 use crate::error::Result;
 use crate::image::{box_mip, Rendered, RgbWindow};
 use crate::maps::{UvWindow, UV_SCALE};
-use crate::modes::params::{check_period, Common, ParamReader, ParamSpec};
+use crate::modes::params::check_period;
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
 /// Largest window, in pixels, one call may render (2^26).
@@ -20,13 +18,16 @@ pub const MAX_PIXELS: i64 = 1 << 26;
 /// The tiling mode.
 pub struct Tiling;
 
-/// Tiling parameters: only the common ones, kept so that requests stay canonical.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
-pub struct TilingParams {
-    /// Accepted like every mode's; the tiling does not depend on it.
-    pub seed: u64,
-    /// Accepted like every mode's; every allowed period is a multiple of the exemplar side.
-    pub period: Option<i64>,
+crate::declare_params! {
+    /// Tiling parameters: only the common ones, kept so that requests stay canonical; neither
+    /// changes the pixels, so neither is part of the canonical text.
+    pub struct TilingParams {
+        /// Accepted like every mode's; the tiling does not depend on it.
+        pub seed: u64 { default: 0, canonical: none, seed }
+        /// Accepted like every mode's; every allowed period is a multiple of the exemplar side.
+        pub period: Option<i64> { default: None, canonical: none, period }
+    }
+    check(p, src) { check_period(p.period, src.side()) }
 }
 
 impl Mode for Tiling {
@@ -37,33 +38,9 @@ impl Mode for Tiling {
     const COST: Cost = Cost::Light;
     const HAS_UV: bool = true;
     type Params = TilingParams;
+    type State = ();
 
-    fn specs() -> &'static [ParamSpec] {
-        &[]
-    }
-
-    fn defaults() -> TilingParams {
-        TilingParams::default()
-    }
-
-    fn parse(base: &TilingParams, common: &Common, _: &mut ParamReader, src: &Source) -> Result<TilingParams> {
-        let mut p = base.clone();
-        common.apply(&mut p.seed, &mut p.period);
-        check_period(p.period, src.side())?;
-        Ok(p)
-    }
-
-    fn values(p: &TilingParams, _: &Source) -> Map<String, Value> {
-        let mut m = Map::new();
-        m.insert("seed".into(), json!(p.seed));
-        m
-    }
-
-    fn canonical(_: &TilingParams) -> String {
-        String::new()
-    }
-
-    fn render(_: &TilingParams, src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
+    fn render(_: &TilingParams, _: &(), src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
         let texels = src.texels();
@@ -85,7 +62,7 @@ impl Mode for Tiling {
 
     /// Native and magnified: the pixel centre's place in the exemplar; zoomed out, the centre
     /// of the block it averages (the exemplar's centre once it covers the whole exemplar).
-    fn coordinates(_: &TilingParams, src: &Source, _: &Pyramid, view: View) -> Result<UvWindow> {
+    fn coordinates(_: &TilingParams, _: &(), src: &Source, _: &Pyramid, view: View) -> Result<UvWindow> {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
         let period = (src.side() * UV_SCALE) as i64;

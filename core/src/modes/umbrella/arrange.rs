@@ -4,7 +4,7 @@
 //! to back, the umbrellas that cover part of it (an exact polygon–square test) up to the `k`-th,
 //! with those in front of it that may shade the cell, positions relative to the cell so that
 //! far-away cells lose no precision. Lists are built a window at a time and kept in the
-//! texture's caches ([`super::prepared::Caches`]), shared by its requests.
+//! texture's caches ([`super::caches::Caches`]), shared by its requests.
 
 use std::cell::OnceCell;
 use std::sync::Arc;
@@ -12,11 +12,13 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::extract::{ray, Elements, RAYS};
-use super::prepared::Caches;
+pub use super::caches::Placed;
+use super::caches::Caches;
 use super::shape::{fold_free, Rim};
 use super::UmbrellaParams;
 use crate::hash::hash;
 use crate::modes::params::ONE_Q16;
+use crate::modes::Declared;
 
 const TAG_TABLE: u64 = 0x554D_4252_0001;
 const TAG_COUNT: u64 = 0x554D_4252_0002;
@@ -52,32 +54,6 @@ pub struct Modified {
     pub rim: Rim,
 }
 
-/// An umbrella in a cell list, relative to that cell's origin.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Placed {
-    /// Centre, texels from the cell's origin.
-    pub cx: f32,
-    /// Centre, texels from the cell's origin.
-    pub cy: f32,
-    /// Rotation (cosine) of the umbrella.
-    pub cos: f32,
-    /// Rotation (sine).
-    pub sin: f32,
-    /// 1 / scale.
-    pub inv_scale: f32,
-    /// Placed radius (largest rim radius × scale).
-    pub reach: f32,
-    /// Its square.
-    pub reach2: f32,
-    /// Square of the placed radius of the disc certainly inside.
-    pub inner2: f32,
-    /// Index into the modified table.
-    pub modified: u32,
-    /// Depth key (larger is in front).
-    pub depth: u64,
-    /// Id: spawn cell and index in it.
-    pub id: (i64, i64, u32),
-}
 
 /// Everything needed to place umbrellas for one texture and parameter set.
 pub struct Arrangement {

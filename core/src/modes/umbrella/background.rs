@@ -130,11 +130,11 @@ pub(super) fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view
         }
         Background::Synth => {
             let sp = SynthParams { seed: p.seed, period: p.period, ..SynthParams::default() };
-            <Synth as Mode>::render(&sp, src, cache, view)?.image
+            <Synth as Mode>::render(&sp, &(), src, cache, view)?.image
         }
         Background::Tiling => {
             let tp = TilingParams { seed: p.seed, period: p.period };
-            <Tiling as Mode>::render(&tp, src, cache, view)?.image
+            <Tiling as Mode>::render(&tp, &(), src, cache, view)?.image
         }
         Background::Mean => {
             let (w, h) = (view.rect.width() as usize, view.rect.height() as usize);

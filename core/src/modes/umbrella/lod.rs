@@ -22,6 +22,7 @@ use std::sync::Arc;
 
 
 use super::arrange::{Arrangement, Placed};
+pub use super::caches::Merged;
 use super::extract::{Elements, RAYS};
 use super::raster::{disc_reaches, Poly};
 use super::shape::{self, SectorTable};
@@ -35,27 +36,6 @@ pub const LOD_PIXELS: i64 = 8;
 pub const MERGED_VERTICES: usize = 12;
 const KMEANS_ITERATIONS: usize = 10;
 
-/// A merged umbrella: a convex rim around its centre, colours at the centre and the vertices
-/// (no texture).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Merged {
-    /// Centre, absolute texels.
-    pub o: [f64; 2],
-    /// Rim, absolute texels, convex, in angular order about `o`.
-    pub rim: Vec<[f64; 2]>,
-    /// Colour at each rim vertex, RGB in `[0, 1]` (none for a cluster of one).
-    pub colour: Vec<[f32; 3]>,
-    /// Colour at the centre (a cluster of one: the background, unused).
-    pub centre: [f32; 3],
-    /// Largest centre–vertex distance.
-    pub reach: f64,
-    /// Depth key (the front-most member's).
-    pub depth: u64,
-    /// Id (the front-most member's).
-    pub id: (i64, i64, u32),
-    /// A cluster of one: its umbrella, still coloured from its (mipmapped) base texture.
-    pub single: Option<Placed>,
-}
 
 /// The level drawn `zoom_out` steps out: 0 while a grid cell is at least [`LOD_PIXELS`]
 /// pixels wide, else the least `j` whose cells are; `None` past [`MAX_LEVEL`].

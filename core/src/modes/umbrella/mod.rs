@@ -12,6 +12,7 @@
 
 pub mod arrange;
 mod background;
+pub mod caches;
 pub mod extract;
 pub mod handmade;
 pub mod lod;
@@ -28,16 +29,16 @@ use std::sync::Arc;
 
 
 use rayon::prelude::*;
-use serde_json::{json, Map, Value};
+
 
 use crate::cache::Pyramid;
 use crate::error::Result;
 use crate::exemplar::Exemplar;
 use crate::image::{Rendered, RgbWindow};
 use crate::memo::Memo;
-use crate::prepare::{Step, StepOf};
 use crate::modes::mosaic::{self, MosaicParams};
-use crate::modes::params::{check_period, Common, Kind, ParamReader, ParamSpec, Scope, ONE_Q16};
+use crate::modes::params::{check_period, Kind, ONE_Q16};
+use crate::modes::Declared;
 use crate::modes::synth::{Synth, SynthParams};
 use crate::modes::tiling::{Tiling, TilingParams};
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
@@ -46,7 +47,6 @@ use arrange::{Arrangement, Placed};
 use extract::{Elements, RAYS};
 pub use prepared::{extraction_id, Extraction};
 pub use params::{Background, UmbrellaParams};
-use params::{BACKGROUND, COLOUR, DENSITY, K, SCALE, SHADOW, SHADOW_OFFSET, SHAPE, SPECS};
 use background::{background, colour_shift, gap_shift, shifted};
 use paint::paint;
 pub use paint::storage_words;
@@ -79,87 +79,24 @@ impl Mode for Umbrella {
     const VERSION: u32 = 13;
     const SUMMARY: &'static str =
         "just-in-time umbrella patches: elements of the exemplar, diversified and scattered, evaluated per sample";
-    const NEEDS: Needs = Needs::Exemplar;
+    const NEEDS: Needs = Needs::Prepared;
     const COST: Cost = Cost::Heavy;
     type Params = UmbrellaParams;
-
-    fn specs() -> &'static [ParamSpec] {
-        SPECS
-    }
-
-    fn defaults() -> UmbrellaParams {
-        UmbrellaParams::default()
-    }
-
-    fn parse(base: &UmbrellaParams, common: &Common, r: &mut ParamReader, src: &Source) -> Result<UmbrellaParams> {
-        let mut p = base.clone();
-        common.apply(&mut p.seed, &mut p.period);
-        if let Some(s) = r.get(&DENSITY) {
-            p.density = DENSITY.integer(&s)? as u32;
-        }
-        if let Some(s) = r.get(&SCALE) {
-            p.scale = SCALE.interval_milli(&s)?;
-        }
-        if let Some(s) = r.get(&SHAPE) {
-            p.shape = SHAPE.unit(&s)?;
-        }
-        if let Some(s) = r.get(&COLOUR) {
-            p.colour = COLOUR.unit(&s)?;
-        }
-        if let Some(s) = r.get(&SHADOW) {
-            p.shadow = SHADOW.unit(&s)?;
-        }
-        if let Some(s) = r.get(&SHADOW_OFFSET) {
-            p.shadow_offset = SHADOW_OFFSET.integer(&s)? as u32;
-        }
-        if let Some(s) = r.get(&K) {
-            p.k = K.integer(&s)? as u32;
-        }
-        if let Some(s) = r.get(&BACKGROUND) {
-            BACKGROUND.check(&s)?;
-            p.background = Background::parse(&s).unwrap_or(Background::Mosaic);
-        }
-        check_period(p.period, src.side())?;
-        Ok(p)
-    }
-
-    fn values(p: &UmbrellaParams, _: &Source) -> Map<String, Value> {
-        let q = |v: u32| v as f64 / ONE_Q16 as f64;
-        let mut m = Map::new();
-        m.insert("seed".into(), json!(p.seed));
-        m.insert(DENSITY.name.into(), json!(p.density));
-        m.insert(SCALE.name.into(), json!([p.scale.0 as f64 / 1000.0, p.scale.1 as f64 / 1000.0]));
-        m.insert(SHAPE.name.into(), json!(q(p.shape)));
-        m.insert(COLOUR.name.into(), json!(q(p.colour)));
-        m.insert(SHADOW.name.into(), json!(q(p.shadow)));
-        m.insert(SHADOW_OFFSET.name.into(), json!(p.shadow_offset));
-        m.insert(K.name.into(), json!(p.k));
-        m.insert(BACKGROUND.name.into(), json!(p.background.name()));
-        m
-    }
-
-    fn canonical(p: &UmbrellaParams) -> String {
-        p.canonical()
-    }
-
-    fn preparation() -> Option<&'static dyn Step> {
-        Some(&StepOf::<Extraction>::NEW)
-    }
+    type State = Extraction;
 
     /// The extraction: each base umbrella magnified with its rim and centre, and modified
     /// umbrellas of it below.
-    fn sheet(p: &UmbrellaParams, src: &Source) -> Option<Result<RgbWindow>> {
+    fn sheet(p: &UmbrellaParams, state: &Extraction, _: &Source) -> Option<Result<RgbWindow>> {
         let sheet = || {
-            let (el, id) = state(src)?.elements()?;
+            let (el, id) = state.elements()?;
             Ok(sheet::debug_sheet(&el, &Arrangement::new(&el, p, &id)))
         };
         Some(sheet())
     }
 
-    fn render(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
+    fn render(p: &UmbrellaParams, state: &Extraction, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
-        let state = state(src)?;
         let (elements, ident) = match src.map {
             Some(map) => state.map_elements(src.exemplar, map)?,
             None => state.elements()?,
@@ -196,15 +133,6 @@ impl Mode for Umbrella {
 /// [`lod::MAX_LEVEL`]. Further out the view is the background's zoomed-out pixels.
 pub fn umbrella_zooms(arr: &Arrangement) -> u32 {
     (0..64).take_while(|&z| lod::level(arr, z).is_some()).last().unwrap_or(0)
-}
-
-/// The texture's umbrella state: prepared with it, or (for a caller that prepared none) extracted
-/// now.
-fn state(src: &Source) -> Result<Arc<Extraction>> {
-    if let Some(s) = src.prepared.and_then(|p| p.get::<Extraction>(Umbrella::NAME)) {
-        return Ok(s);
-    }
-    Ok(Arc::new(Extraction::extract(src.exemplar)))
 }
 
 /// The elements of an exemplar, extracted now, with the id that names them; none → a

@@ -1,7 +1,7 @@
 //! What the umbrella mode prepares per texture ([`Extraction`]): the elements extracted from
 //! the exemplar (or given by a hand-made set, the texture setting `set`), stored beside the
 //! analysis as `<texture>.umbrella` ([`super::store`]), and the caches its requests share — cell
-//! lists, merged levels of detail, colour calibrations — bounded in bytes
+//! lists, merged levels of detail, colour calibrations ([`Caches`]) — bounded in bytes
 //! ([`Preparation::limit_caches`]) and counted in what the texture holds.
 
 use std::path::Path;
@@ -9,16 +9,14 @@ use std::sync::{Arc, Mutex};
 
 use serde_json::{json, Map, Value};
 
-use super::arrange::Placed;
+use super::caches::Caches;
 use super::extract::{self, Elements};
-use super::lod::Merged;
 use super::store::{self, Outcome};
 use crate::progress::Progress;
 use crate::cancel::Cancel;
 use crate::error::{AnalysisFileProblem, CoreError, Result};
 use crate::exemplar::Exemplar;
 use crate::maps::MaterialMap;
-use crate::memo::Memo;
 use crate::prepare::{Input, Preparation, Setting};
 
 /// The setting naming a hand-made set.
@@ -27,60 +25,6 @@ pub const SET: Setting = Setting {
     help: "a hand-made umbrella set instead of elements extracted from the exemplar: JSON naming element images \
            with alpha, relative to the set file (path relative to the configuration)",
 };
-
-/// Bytes of caches a texture keeps unless told otherwise ([`Preparation::limit_caches`]).
-pub const DEFAULT_CACHE_BYTES: u64 = 16 << 20;
-/// Bytes the colour calibrations may hold (a few dozen entries).
-const CALIBRATION_BYTES: u64 = 64 << 10;
-
-/// The caches of one texture's umbrella requests.
-pub struct Caches {
-    /// Cell lists, by arrangement and cell.
-    pub(crate) lists: Memo<(u64, i64, i64), Arc<Vec<Placed>>>,
-    /// Merged umbrellas, by arrangement, level and cell.
-    pub(crate) cells: Memo<(u64, u32, i64, i64), Arc<Vec<Merged>>>,
-    /// Background shifts for the gaps, by canonical parameters.
-    pub(crate) gaps: Memo<String, [f32; 3]>,
-    /// Background shifts beyond the drawn zooms, by canonical parameters.
-    pub(crate) colours: Memo<String, [f32; 3]>,
-}
-
-impl Caches {
-    /// Empty caches of at most `bytes` in all.
-    pub fn new(bytes: u64) -> Caches {
-        let (lists, cells) = Self::split(bytes);
-        Caches {
-            lists: Memo::new(lists),
-            cells: Memo::new(cells),
-            gaps: Memo::new(CALIBRATION_BYTES.min(bytes / 4)),
-            colours: Memo::new(CALIBRATION_BYTES.min(bytes / 4)),
-        }
-    }
-
-    fn split(bytes: u64) -> (u64, u64) {
-        let rest = bytes.saturating_sub(2 * CALIBRATION_BYTES.min(bytes / 4));
-        (rest * 3 / 8, rest - rest * 3 / 8)
-    }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> u64 {
-        self.lists.bytes() + self.cells.bytes() + self.gaps.bytes() + self.colours.bytes()
-    }
-
-    fn set_limit(&self, bytes: u64) {
-        let (lists, cells) = Self::split(bytes);
-        self.lists.set_limit(lists);
-        self.cells.set_limit(cells);
-        self.gaps.set_limit(CALIBRATION_BYTES.min(bytes / 4));
-        self.colours.set_limit(CALIBRATION_BYTES.min(bytes / 4));
-    }
-}
-
-impl Default for Caches {
-    fn default() -> Self {
-        Caches::new(DEFAULT_CACHE_BYTES)
-    }
-}
 
 /// A texture's umbrella state: its elements (or why it has none), their id, and its caches.
 pub struct Extraction {
