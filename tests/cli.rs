@@ -116,6 +116,61 @@ async fn render_writes_the_same_bytes_as_the_server() {
     assert_eq!((img.width(), img.height()), (300, 200));
 }
 
+#[tokio::test]
+async fn render_writes_the_glb_the_server_serves() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = shared_data_dir();
+    let s = Server::builder().start();
+    // A plain tile's model, and a material's with its maps and a displaced mesh.
+    for (texture, z, x, y, params, query) in [
+        ("gravel", "6", "1", "-1", vec!["--seed", "3"], "?seed=3"),
+        ("flagstones", "8", "3", "-2", vec!["--param", "relief=4"], "?relief=4"),
+    ] {
+        let out = dir.path().join(format!("{texture}.glb"));
+        let mut args = vec!["render", "--texture", texture, "--data-dir", data.to_str().unwrap()];
+        args.extend(["--z", z, "--x", x, "--y", y, "-o", out.to_str().unwrap()]);
+        args.extend(params);
+        let (code, _, err) = run(&args);
+        assert_eq!(code, 0, "{err}");
+        let (status, body) = s.get_bytes(&format!("/gltf/{texture}/{z}/{x}/{y}.glb{query}")).await;
+        assert_eq!(status, 200);
+        let written = std::fs::read(&out).unwrap();
+        assert_eq!(&written[..4], b"glTF");
+        assert!(
+            written == body,
+            "{texture}: the CLI's GLB ({} bytes) is not the served one ({})",
+            written.len(),
+            body.len()
+        );
+    }
+    // A model takes no window, and relief needs a height map.
+    let out = dir.path().join("bad.glb");
+    let (code, _, err) = run(&[
+        "render",
+        "--texture",
+        "gravel",
+        "--data-dir",
+        data.to_str().unwrap(),
+        "--window=0,0,8,8",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(code != 0 && err.contains(".glb"), "{err}");
+    let (code, _, err) = run(&[
+        "render",
+        "--texture",
+        "gravel",
+        "--data-dir",
+        data.to_str().unwrap(),
+        "--param",
+        "relief=4",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(code != 0 && err.contains("height map"), "{err}");
+    assert!(!out.exists());
+}
+
 #[test]
 fn help_describes_every_command() {
     let (code, out, _) = run(&["--help"]);

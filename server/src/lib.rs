@@ -20,6 +20,8 @@ pub mod export;
 pub mod http;
 pub mod memory;
 pub mod metrics;
+pub mod model;
+pub mod output;
 pub mod pipeline;
 pub mod queue;
 pub mod request;

@@ -205,7 +205,9 @@ pub struct RenderArgs {
     /// List every mode's parameters (name, range, description) and exit.
     #[arg(long)]
     pub list_params: bool,
-    /// Output image (.png, .jpg, .webp).
+    /// Output file: an image (.png, .jpg, .webp), or the tile's GLB (.glb: what
+    /// /gltf/{id}/{z}/{x}/{y}.glb serves, byte for byte; `--param relief=SCALE` displaces its
+    /// mesh by the texture's height map).
     #[arg(short, long, value_name = "FILE", required_unless_present = "list_params")]
     pub output: Option<PathBuf>,
 }

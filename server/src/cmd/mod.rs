@@ -89,7 +89,7 @@ pub(crate) fn output_format(output: &Path) -> Result<Format, &'static str> {
         .extension()
         .and_then(|e| e.to_str())
         .and_then(Format::from_ext)
-        .ok_or("output must end in .png, .jpg, .jpeg or .webp")
+        .ok_or("output must end in .png, .jpg, .jpeg or .webp (or, for `textile render`, .glb)")
 }
 
 /// A configured or uploaded texture, loaded (analysed if its analysis is not stored) from the

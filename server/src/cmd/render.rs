@@ -15,7 +15,9 @@ use textile_core::{Analysis, Cancel, ExemplarOptions, ModeParams, ParamReader, P
 use super::args::{CliResult, RenderArgs};
 use super::{configured_texture, output_format, param_pairs, read_exemplar};
 use crate::config::TextureConfig;
-use crate::encode::{encode, Effort};
+use crate::encode::{encode, Effort, Format};
+use crate::model::Model;
+use crate::output::Output;
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::textures::Texture;
@@ -98,6 +100,12 @@ pub fn run(a: RenderArgs) -> CliResult {
         let compact = serde_json::to_vec(&json).map_err(|e| e.to_string())?;
         pairs.push(("controls".into(), base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(compact)));
     }
+    // A GLB reads its own `relief` (as the served one does), the image its mode's parameters.
+    let glb = output.extension().is_some_and(|e| e == "glb");
+    let model_pairs = pairs.clone();
+    if glb {
+        pairs.retain(|(k, _)| k != "relief");
+    }
     let params = tex.defaults.request(&tex.source(), ParamReader::texture(pairs)?)?;
     // A texture made from --exemplar has no data directory: what its mode prepares is made once
     // here, in memory, not again by every window the mode renders (a camera view renders many).
@@ -118,6 +126,21 @@ pub fn run(a: RenderArgs) -> CliResult {
     }
     if let Some(cam) = &a.camera {
         return render_camera(&tex, &params, cam, &a.at, &a.size, &output);
+    }
+    if glb {
+        if a.window.is_some() || a.sheet || a.camera.is_some() || map != MapChoice::Albedo {
+            return Err("a .glb output is a tile's model: --x, --y, --z and --param only".into());
+        }
+        let (x, y) = (a.x.unwrap_or(0), a.y.unwrap_or(0));
+        if !(COORD_MIN..=COORD_MAX).contains(&x) || !(COORD_MIN..=COORD_MAX).contains(&y) {
+            return Err("--x and --y must be in [-2^31, 2^31-1]".into());
+        }
+        let spec = TileSpec { z, x, y, scale: 1, format: Format::Png };
+        let model = Model::read(tex, spec, 1, ParamReader::texture(model_pairs)?, Default::default())?;
+        let bytes = Output::Glb(model).bytes(&Pyramid::off())?;
+        write_atomic(&output, &bytes)?;
+        println!("wrote {} (GLB of tile {z}/{}/{}, {} bytes)", output.display(), spec.x, spec.y, bytes.len());
+        return Ok(());
     }
     let format = output_format(&output)?;
     let target = if let Some(win) = &a.window {

@@ -1,9 +1,16 @@
-//! HTTP semantics of image answers, in one place: strong ETags derived from everything that
-//! determines the bytes, `If-None-Match` → 304, Cache-Control, Content-Type and `X-Cache`.
+//! HTTP semantics of every content answer, in one place: [`answer`] answers an
+//! [`Output`] (images, GLB, glTF, X3D) with its strong ETag (derived from everything that
+//! determines the bytes), `If-None-Match` → 304, Cache-Control, Content-Type and `X-Cache`.
+
+use std::sync::Arc;
 
 use axum::body::Bytes;
 use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
+
+use crate::error::ApiError;
+use crate::output::{produce, Output};
+use crate::state::AppState;
 
 /// Does `If-None-Match` match this ETag? (Weak comparison, as RFC 9110 asks for this header.)
 pub fn if_none_match(headers: &HeaderMap, etag: &str) -> bool {
@@ -43,4 +50,17 @@ pub fn image(bytes: Bytes, content_type: &'static str, etag: &str, cache_control
     common(h, etag, cache_control);
     h.insert("x-cache", HeaderValue::from_static(if hit { "HIT" } else { "MISS" }));
     r
+}
+
+/// An output's answer: `304` when the client has it, else its bytes (through the tile cache
+/// where it keeps them) with its ETag and content type.
+pub async fn answer(st: &Arc<AppState>, headers: &HeaderMap, out: Output) -> Result<Response, ApiError> {
+    let cc = &st.config.cache_control;
+    let etag = out.etag();
+    if if_none_match(headers, &etag) {
+        return Ok(not_modified(&etag, cc));
+    }
+    let content_type = out.content_type();
+    let (bytes, hit) = produce(st, &etag, out).await;
+    Ok(image(bytes?, content_type, &etag, cc, hit))
 }

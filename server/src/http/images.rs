@@ -1,6 +1,6 @@
 //! Image endpoints: tiles (`/tiles/{id}/{z}/{x}/{y}.{fmt}`) and windows (`/windows/{id}.{fmt}`).
-//! Each validates its request into an [`ImageJob`], answers `If-None-Match` without rendering,
-//! and otherwise produces the job's bytes through the pipeline. The mode parameters accepted
+//! Each validates its request into an [`ImageJob`] and answers it as an [`Output`] (`If-None-Match`
+//! without rendering, else the bytes through the pipeline). The mode parameters accepted
 //! in the query are documented from the modes' specs (see `http::openapi`).
 
 use std::sync::Arc;
@@ -11,23 +11,12 @@ use axum::http::HeaderMap;
 use axum::response::Response;
 
 use crate::error::ApiError;
-use crate::http::content::{if_none_match, image, not_modified};
+use crate::http::content::answer;
 use crate::http::extract::{path_error, texture};
-use crate::pipeline::{produce, ImageJob, Target};
+use crate::output::Output;
+use crate::pipeline::{ImageJob, Target};
 use crate::request::{map_choice, params, parse_tile, parse_window, query_reader, split_format};
 use crate::state::AppState;
-
-/// Answer an image job: 304 when the client holds it, else its bytes with the image headers.
-async fn answer(st: &Arc<AppState>, headers: &HeaderMap, job: ImageJob) -> Result<Response, ApiError> {
-    let etag = job.etag();
-    let cc = &st.config.cache_control;
-    if if_none_match(headers, &etag) {
-        return Ok(not_modified(&etag, cc));
-    }
-    let content_type = job.format().content_type();
-    let (bytes, hit) = produce(st, &etag, job).await;
-    Ok(image(bytes?, content_type, &etag, cc, hit))
-}
 
 /// A tile of the infinite texture.
 #[utoipa::path(get, path = "/tiles/{id}/{z}/{x}/{y}.{fmt}", tag = "tiles",
@@ -54,7 +43,7 @@ pub async fn tile(
     let mut r = query_reader(q.as_deref())?;
     let map = map_choice(&tex, &mut r, spec.format)?;
     let params = params(&tex, r)?;
-    answer(&st, &headers, ImageJob { tex, params, target: Target::Tile(spec), map }).await
+    answer(&st, &headers, Output::Image(ImageJob { tex, params, target: Target::Tile(spec), map })).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -81,5 +70,5 @@ pub async fn window(
     let spec = parse_window(&tex, &mut r, fmt)?;
     let map = map_choice(&tex, &mut r, fmt)?;
     let params = params(&tex, r)?;
-    answer(&st, &headers, ImageJob { tex, params, target: Target::Window(spec), map }).await
+    answer(&st, &headers, Output::Image(ImageJob { tex, params, target: Target::Window(spec), map })).await
 }

@@ -12,9 +12,12 @@ use axum::response::Response;
 
 use crate::encode::Format;
 use crate::error::ApiError;
+use crate::http::content::answer;
 use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{path_error, texture};
-use crate::http::models::{generator, glb_tile, params_with_relief, split_ext, TileRequest};
+use crate::http::models::split_ext;
+use crate::model::{generator, params_with_relief, Model};
+use crate::output::Output;
 use crate::pipeline::{cache_key, etag_for};
 use crate::request::{query_pairs, query_string, TileSpec};
 use crate::state::AppState;
@@ -156,6 +159,6 @@ pub async fn content_tile(
     let (y, _) = split_ext(&y, &["glb"])?;
     let (level, x, y) = implicit(&tree(&tex), &level, &x, y)?;
     let spec = TileSpec { z: level, x, y: xyz_row(level, y), scale: 1, format: Format::Png };
-    let r = TileRequest::new(tex, spec, without_anchoring(raw.as_deref()))?;
-    glb_tile(&st, &r, &headers).await
+    let model = Model::request(tex, spec, without_anchoring(raw.as_deref()))?;
+    answer(&st, &headers, Output::Glb(model)).await
 }

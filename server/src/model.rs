@@ -1,0 +1,268 @@
+//! What a 3D model of tiles is made of: a tile (or an N×N patch of tiles) of a texture with a
+//! mode's parameters, `relief`, and the query carried into its URLs — its ground quads, the
+//! images they show (each tile with a border of the neighbouring texture, [`BORDER`] texels, a
+//! window of the one texture), its glTF material's maps, and the parts of its cache keys.
+//! [`crate::output::Output`] turns a [`Model`] into GLB, glTF and X3D bytes; `http/` only
+//! parses requests into one.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use base64::Engine;
+use textile_core::maps::MapChoice;
+use textile_core::{ModeParams, ParamReader, TILE_SIZE};
+
+use crate::assets::{image_side, metallic_roughness, Quad, Slot, BORDER, LAYOUT};
+use crate::encode::Format;
+use crate::error::ApiError;
+use crate::pipeline::{cache_key, engine_version, ImageJob, Target};
+use crate::request::{params, query_string, TileSpec, WindowSpec, COORD_MAX};
+use crate::textures::Texture;
+
+/// A request's parameters, sorted, as carried into tile URLs.
+pub type Query = BTreeMap<String, String>;
+
+/// Largest patch side in tiles.
+pub const MAX_PATCH: i64 = 8;
+
+/// The parameter of a .gltf document's sibling image naming the material slot it fills.
+pub const SLOT: &str = "slot";
+
+/// The `generator` of every 3D document.
+pub fn generator() -> String {
+    format!("textile {} ({})", env!("CARGO_PKG_VERSION"), engine_version())
+}
+
+/// A model of `tiles × tiles` tiles from `spec` (its top-left tile) of a texture.
+#[derive(Clone)]
+pub struct Model {
+    /// The texture.
+    pub tex: Arc<Texture>,
+    /// The (top-left) tile.
+    pub spec: TileSpec,
+    /// Side in tiles: 1 for a tile, up to [`MAX_PATCH`] for a patch.
+    pub tiles: i64,
+    /// The request's parameters, carried into URLs.
+    pub query: Query,
+    /// The mode and its parameters.
+    pub params: ModeParams,
+    /// `relief=SCALE`: a GLB's mesh displaced by the height map, white `SCALE` texels high.
+    pub relief: Option<f32>,
+}
+
+impl Model {
+    /// Tile `spec` of `tex` (a patch of `tiles` from it) with the parameters `r` reads (its
+    /// `relief` first), carrying `query` into URLs.
+    pub fn read(
+        tex: Arc<Texture>,
+        spec: TileSpec,
+        tiles: i64,
+        r: ParamReader,
+        query: Query,
+    ) -> Result<Model, ApiError> {
+        if !(1..=MAX_PATCH).contains(&tiles) {
+            return Err(ApiError::bad_request(
+                "invalid_parameter",
+                format!("parameter 'tiles': '{tiles}' is not an integer in 1..={MAX_PATCH}"),
+            ));
+        }
+        if spec.x > COORD_MAX - (tiles - 1) || spec.y > COORD_MAX - (tiles - 1) {
+            return Err(ApiError::bad_request(
+                "invalid_coordinate",
+                format!("the patch must end at or before {COORD_MAX}"),
+            ));
+        }
+        let (params, relief) = params_with_relief(&tex, r)?;
+        Ok(Model { tex, spec, tiles, query, params, relief })
+    }
+
+    /// Tile `spec` of `tex` with the request parameters of the query's `pairs`.
+    pub fn request(tex: Arc<Texture>, spec: TileSpec, pairs: Vec<(String, String)>) -> Result<Model, ApiError> {
+        let r = ParamReader::request(pairs.clone())?;
+        Model::read(tex, spec, 1, r, pairs.into_iter().collect())
+    }
+
+    /// Refuse `relief` where the answer has no mesh to displace.
+    pub fn flat_only(&self, what: &str) -> Result<(), ApiError> {
+        match self.relief {
+            Some(_) => Err(ApiError::bad_request(
+                "invalid_parameter",
+                format!("parameter 'relief' applies to .glb tiles (and 3D Tiles content), not {what}"),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The tiles, row by row.
+    pub fn tile_specs(&self) -> impl Iterator<Item = TileSpec> + '_ {
+        let (o, n) = (self.spec, self.tiles);
+        (0..n).flat_map(move |j| (0..n).map(move |i| TileSpec { x: o.x + i, y: o.y + j, ..o }))
+    }
+
+    /// The ground quad of tile `t`.
+    pub fn quad(&self, t: &TileSpec) -> Quad {
+        // Native texels per tile side (a fraction of a tile when magnified).
+        let size = TILE_SIZE as f64 * 2f64.powi(self.tex.native_zoom() as i32 - t.z as i32);
+        // `tile_z_x_y`: names clients keep as they are (three.js would fold "tile 7/1/11" and
+        // "tile 7/11/1" into one).
+        Quad { name: format!("tile_{}_{}_{}", t.z, t.x, t.y), origin: (size * t.x as f64, size * t.y as f64), size }
+    }
+
+    /// The image of the (top-left) tile.
+    pub fn image(&self) -> ImageJob {
+        self.image_at(self.spec)
+    }
+
+    /// The image of the tile at `spec` with this model's texture and parameters: the PNG window
+    /// of the tile and [`BORDER`] texels around it, at the tile's zoom.
+    pub fn image_at(&self, spec: TileSpec) -> ImageJob {
+        let (b, side) = (BORDER as i64, image_side() as i64);
+        let window = WindowSpec {
+            z: spec.z,
+            x: TILE_SIZE * spec.x - b,
+            y: TILE_SIZE * spec.y - b,
+            w: side,
+            h: side,
+            format: Format::Png,
+        };
+        ImageJob {
+            tex: self.tex.clone(),
+            params: self.params.clone(),
+            target: Target::Window(window),
+            map: MapChoice::Albedo,
+        }
+    }
+
+    /// The tile's image of material map `name`.
+    pub fn map_image(&self, name: &str) -> ImageJob {
+        ImageJob { map: MapChoice::Map(name.to_string()), ..self.image() }
+    }
+
+    /// The material maps of this tile that go into its glTF material, `(slot, name)`: those of
+    /// the texture with a glTF slot.
+    pub fn material_maps(&self) -> Vec<(Slot, String)> {
+        self.tex.exemplar.maps.iter().filter_map(|m| Slot::of(&m.name).map(|s| (s, m.name.clone()))).collect()
+    }
+
+    /// The material maps that fill image `only` (all, without one): roughness and metallic
+    /// fill the packed one.
+    pub fn material_maps_of(&self, only: Option<Slot>) -> Vec<(Slot, String)> {
+        self.material_maps().into_iter().filter(|(s, _)| only.is_none_or(|o| s.image() == o)).collect()
+    }
+
+    /// The material images of this tile's glTF material, one per slot (roughness and metallic
+    /// maps share the packed one).
+    pub fn material_slots(&self) -> Vec<Slot> {
+        let mut slots: Vec<Slot> = Vec::new();
+        for (s, _) in self.material_maps() {
+            if !slots.contains(&s.image()) {
+                slots.push(s.image());
+            }
+        }
+        slots
+    }
+
+    /// What of the texture's maps the glTF material holds, for cache keys: empty without maps.
+    pub fn material_key(&self) -> String {
+        let each: Vec<String> = self
+            .material_maps()
+            .iter()
+            .filter_map(|(_, n)| self.tex.exemplar.map(n).map(|m| format!("{n}:{}", m.hash)))
+            .collect();
+        if each.is_empty() {
+            String::new()
+        } else {
+            format!("maps{}={}", crate::encode::MAP_ENCODER_VERSION, each.join(","))
+        }
+    }
+
+    /// `extra` for a cache key, with [`Model::material_key`] after it when there are maps (so
+    /// that documents of textures without maps keep their keys).
+    pub fn with_material(&self, extra: &str) -> String {
+        match self.material_key() {
+            m if m.is_empty() => extra.to_string(),
+            m => format!("{extra}|{m}"),
+        }
+    }
+
+    /// The cache key of this model's answer of `kind`, with `extra`.
+    pub fn key(&self, kind: &str, extra: &str) -> String {
+        let s = self.spec;
+        cache_key(&self.tex, &self.params, format_args!("{kind}{LAYOUT}|{}|{}|{}|{extra}", s.z, s.x, s.y))
+    }
+
+    /// The tile URL (absolute) with the request's parameters.
+    pub fn tile_url(&self, base: &str, t: &TileSpec) -> String {
+        let qs = query_string(&self.query);
+        let sep = if qs.is_empty() { "" } else { "?" };
+        format!("{base}/tiles/{}/{}/{}/{}.png{sep}{qs}", self.tex.config.id, t.z, t.x, t.y)
+    }
+
+    /// The relative URI of a tile's image served beside its .gltf document: `{y}.png`, or
+    /// `{y}.{token}.png` with the parameters as a base64url token (glTF wants URIs without a
+    /// query); a material image's (`slot`) has `slot=NAME` among them.
+    pub fn sibling_image(&self, spec: &TileSpec, slot: Option<Slot>) -> String {
+        let mut q = self.query.clone();
+        if let Some(s) = slot {
+            q.insert(SLOT.into(), s.name().into());
+        }
+        if q.is_empty() {
+            return format!("{}.png", spec.y);
+        }
+        format!("{}.{}.png", spec.y, base64::engine::general_purpose::URL_SAFE_NO_PAD.encode(query_string(&q)))
+    }
+
+    /// The absolute URL of a tile's image (border included) for X3D documents, or of one of its
+    /// material images (`slot`).
+    pub fn image_url(&self, base: &str, spec: &TileSpec, slot: Option<Slot>) -> String {
+        format!("{base}/gltf/{}/{}/{}/{}", self.tex.config.id, spec.z, spec.x, self.sibling_image(spec, slot))
+    }
+
+    /// The absolute URLs of a tile's material images by slot, for X3D documents.
+    pub fn material_urls(&self, base: &str, spec: &TileSpec) -> Vec<(Slot, String)> {
+        self.material_slots().into_iter().map(|s| (s, self.image_url(base, spec, Some(s)))).collect()
+    }
+}
+
+/// A 3D asset's query: the mode's parameters and `relief`.
+pub fn params_with_relief(tex: &Texture, mut r: ParamReader) -> Result<(ModeParams, Option<f32>), ApiError> {
+    let relief = r.take("relief").map(|v| relief_scale(tex, &v)).transpose()?;
+    Ok((params(tex, r)?, relief))
+}
+
+/// Read `relief=SCALE`: the height in texels of the height map's white, in (0, 256]; the
+/// texture must have a height map.
+fn relief_scale(tex: &Texture, v: &str) -> Result<f32, ApiError> {
+    let bad = |m: String| ApiError::bad_request("invalid_parameter", format!("parameter 'relief': {m}"));
+    let scale: f32 = v.parse().map_err(|_| bad(format!("'{}' is not a number", textile_core::error::clip(v))))?;
+    if !(scale > 0.0 && scale <= 256.0) {
+        return Err(bad(format!("{scale} is outside (0, 256] texels")));
+    }
+    if tex.exemplar.map("height").is_none() {
+        return Err(bad(format!("texture '{}' has no height map", tex.config.id)));
+    }
+    Ok(scale)
+}
+
+/// The material images of a glTF material from its maps' PNGs, by slot: roughness and
+/// metallic packed into one `metallicRoughnessTexture`, the others as they are.
+pub fn material_images(maps: Vec<(Slot, Vec<u8>)>) -> Result<Vec<(Slot, Vec<u8>)>, ApiError> {
+    let mut out = Vec::new();
+    let (mut roughness, mut metallic) = (None, None);
+    for (slot, png) in maps {
+        let grey = || image::load_from_memory(&png).map(|i| i.to_luma8());
+        match slot {
+            Slot::Roughness => roughness = Some(grey().map_err(|e| ApiError::internal(format!("roughness: {e}")))?),
+            Slot::Metallic => metallic = Some(grey().map_err(|e| ApiError::internal(format!("metallic: {e}")))?),
+            _ => out.push((slot, png)),
+        }
+    }
+    if roughness.is_some() || metallic.is_some() {
+        let packed = metallic_roughness(roughness.as_ref(), metallic.as_ref());
+        let side = image_side();
+        let png = crate::encode::encode(packed.as_raw(), side, side, Format::Png, crate::encode::Effort::Map)
+            .map_err(|e| ApiError::internal(format!("encoding: {e}")))?;
+        out.push((Slot::MetallicRoughness, png));
+    }
+    Ok(out)
+}
