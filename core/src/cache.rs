@@ -8,6 +8,12 @@
 //! what is cached changes the work done, never the result. [`crate::modes::synth::window`] asks for the blocks
 //! a window's plan touches, computes only the pixels no block holds (and what those need), and
 //! offers back every block it now knows completely.
+//!
+//! The same byte bound holds everything else a render derives and keeps: the coordinates of the
+//! last windows synthesized (another map of the same tile costs lookups only) and the texel
+//! stacks derived from a texture on first use (an exemplar's or a map's box means at every
+//! scale, a map's low-pass) — all counted in [`PyramidStats::bytes`] and evicted, least recently
+//! used first, to stay within the limit.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -102,26 +108,64 @@ pub struct PyramidStats {
     pub blocks: u64,
 }
 
-struct Lru {
-    map: LruCache<BlockKey, Arc<Block>>,
-    bytes: u64,
-}
+/// Texel stacks derived from a texture on first use: each level row-major, keyed by what they
+/// are of (see [`Pyramid::derived`]).
+pub type Stack = Arc<Vec<Vec<[u8; 3]>>>;
 
 /// Finished windows a cache keeps, besides its blocks: the coordinates of the last windows
 /// rendered, so that another map of the same tile (issue 39) costs only lookups. At most
-/// [`WINDOW_PIXELS`] each (a `@2x` tile), so they hold at most 16 MiB.
+/// [`WINDOW_PIXELS`] each (a `@2x` tile).
 const WINDOWS: usize = 16;
 /// Largest window whose coordinates are kept.
 const WINDOW_PIXELS: usize = 512 * 512;
+/// Bytes charged for a kept window or stack besides its data.
+const ENTRY_OVERHEAD: u64 = 128;
 
 /// A window's coordinates: stream, level and pixels.
 type WindowKey = (StreamId, u32, Rect);
 
-/// A byte-bounded, thread-safe LRU of synthesized blocks shared by any number of streams, and
-/// the coordinates of the last [`WINDOWS`] windows synthesized. A limit of 0 turns it off:
-/// nothing is kept and every synthesis starts cold.
+/// What a cache holds, under one byte count.
+struct Lru {
+    map: LruCache<BlockKey, Arc<Block>>,
+    windows: LruCache<WindowKey, Arc<[u32]>>,
+    stacks: LruCache<String, Stack>,
+    bytes: u64,
+}
+
+fn window_bytes(coords: &[u32]) -> u64 {
+    coords.len() as u64 * 4 + ENTRY_OVERHEAD
+}
+
+fn stack_bytes(stack: &Stack) -> u64 {
+    stack.iter().map(|l| l.len() as u64 * 3).sum::<u64>() + ENTRY_OVERHEAD
+}
+
+impl Lru {
+    /// Evict, least recently used first — blocks, then windows, then stacks (the dearest to
+    /// derive again) — until at most `limit` bytes are held; the number of blocks evicted.
+    fn evict_to(&mut self, limit: u64) -> u64 {
+        let mut evicted = 0;
+        while self.bytes > limit {
+            if let Some((_, old)) = self.map.pop_lru() {
+                self.bytes -= old.bytes();
+                evicted += 1;
+            } else if let Some((_, old)) = self.windows.pop_lru() {
+                self.bytes -= window_bytes(&old);
+            } else if let Some((_, old)) = self.stacks.pop_lru() {
+                self.bytes -= stack_bytes(&old);
+            } else {
+                break;
+            }
+        }
+        evicted
+    }
+}
+
+/// A byte-bounded, thread-safe LRU of synthesized blocks shared by any number of streams, with
+/// the coordinates of the last [`WINDOWS`] windows synthesized and the texel stacks renders
+/// derive, all within one limit. A limit of 0 turns it off: nothing is kept and every
+/// synthesis starts cold.
 pub struct Pyramid {
-    windows: Mutex<LruCache<WindowKey, Arc<[u32]>>>,
     lru: Mutex<Lru>,
     limit: u64,
     hits: AtomicU64,
@@ -134,8 +178,7 @@ impl Pyramid {
     pub fn new(limit: u64) -> Self {
         let windows = std::num::NonZeroUsize::new(WINDOWS).map_or_else(LruCache::unbounded, LruCache::new);
         Pyramid {
-            windows: Mutex::new(windows),
-            lru: Mutex::new(Lru { map: LruCache::unbounded(), bytes: 0 }),
+            lru: Mutex::new(Lru { map: LruCache::unbounded(), windows, stacks: LruCache::unbounded(), bytes: 0 }),
             limit,
             hits: AtomicU64::new(0),
             misses: AtomicU64::new(0),
@@ -181,14 +224,43 @@ impl Pyramid {
         if !self.is_on() {
             return None;
         }
-        self.windows.lock().unwrap_or_else(|e| e.into_inner()).get(key).cloned()
+        self.lock().windows.get(key).cloned()
     }
 
-    /// Keep a finished window's coordinates (the least recently used of [`WINDOWS`] goes).
+    /// Keep a finished window's coordinates (the least recently used of [`WINDOWS`] goes, and
+    /// whatever the byte limit asks).
     pub(crate) fn keep_window(&self, key: WindowKey, coords: Arc<[u32]>) {
-        if self.is_on() && coords.len() <= WINDOW_PIXELS {
-            self.windows.lock().unwrap_or_else(|e| e.into_inner()).put(key, coords);
+        if !self.is_on() || coords.len() > WINDOW_PIXELS {
+            return;
         }
+        let mut g = self.lock();
+        g.bytes += window_bytes(&coords);
+        if let Some((_, old)) = g.windows.push(key, coords) {
+            g.bytes -= window_bytes(&old);
+        }
+        let evicted = g.evict_to(self.limit);
+        self.evictions.fetch_add(evicted, Ordering::Relaxed);
+    }
+
+    /// The texel stack called `key` (everything it is derived from, by id or hash), derived by
+    /// `make` on first use and kept within the limit; derived afresh each time when the cache
+    /// is off or it was evicted.
+    pub fn derived(&self, key: &str, make: impl FnOnce() -> Vec<Vec<[u8; 3]>>) -> Stack {
+        if !self.is_on() {
+            return Arc::new(make());
+        }
+        if let Some(s) = self.lock().stacks.get(key) {
+            return s.clone();
+        }
+        let stack: Stack = Arc::new(make());
+        let mut g = self.lock();
+        g.bytes += stack_bytes(&stack);
+        if let Some(old) = g.stacks.put(key.to_string(), stack.clone()) {
+            g.bytes -= stack_bytes(&old);
+        }
+        let evicted = g.evict_to(self.limit);
+        self.evictions.fetch_add(evicted, Ordering::Relaxed);
+        stack
     }
 
     /// The blocks of `level` covering `r`, row-major over the block grid of `r` (see
@@ -226,16 +298,7 @@ impl Pyramid {
                 g.bytes -= old.bytes();
             }
         }
-        let mut evicted = 0;
-        while g.bytes > self.limit {
-            match g.map.pop_lru() {
-                Some((_, old)) => {
-                    g.bytes -= old.bytes();
-                    evicted += 1;
-                }
-                None => break,
-            }
-        }
+        let evicted = g.evict_to(self.limit);
         self.evictions.fetch_add(evicted, Ordering::Relaxed);
     }
 }
@@ -260,5 +323,46 @@ impl BlockGrid {
     /// The pixels of block `(i, j)` of the grid.
     pub fn rect(&self, i: usize, j: usize) -> Rect {
         Rect::new((self.bx0 + i as i64) * BLOCK, (self.by0 + j as i64) * BLOCK, BLOCK, BLOCK)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stack(levels: usize, texels: usize) -> Vec<Vec<[u8; 3]>> {
+        (0..levels).map(|l| vec![[l as u8; 3]; texels]).collect()
+    }
+
+    #[test]
+    fn windows_and_derived_stacks_are_counted_and_evicted_within_the_limit() {
+        let cache = Pyramid::new(1 << 20);
+        // Derived once, then found.
+        let made = std::cell::Cell::new(0);
+        let make = || {
+            made.set(made.get() + 1);
+            stack(4, 40_000)
+        };
+        let a = cache.derived("a", make);
+        assert_eq!(cache.derived("a", make), a);
+        assert_eq!(made.get(), 1);
+        assert_eq!(cache.stats().bytes, stack_bytes(&a));
+        // Windows count too, and everything stays within the limit: the least recently used
+        // goes (blocks first, then windows, then stacks).
+        let stream = StreamId::new("s");
+        for i in 0..12 {
+            cache.keep_window((stream, 7, Rect::new(i * 300, 0, 256, 256)), vec![0u32; 256 * 256].into());
+            assert!(cache.stats().bytes <= cache.limit(), "{:?}", cache.stats());
+        }
+        assert!(cache.window(&(stream, 7, Rect::new(11 * 300, 0, 256, 256))).is_some(), "the newest window is kept");
+        assert!(cache.window(&(stream, 7, Rect::new(0, 0, 256, 256))).is_none(), "the oldest window went");
+        let b = cache.derived("b", || stack(4, 60_000));
+        assert!(cache.stats().bytes <= cache.limit());
+        assert_eq!(b.len(), 4);
+        // A cache that is off keeps nothing and derives each time.
+        let off = Pyramid::off();
+        off.derived("a", make);
+        off.derived("a", make);
+        assert_eq!((made.get(), off.stats().bytes), (3, 0));
     }
 }

@@ -9,13 +9,11 @@
 //! Normals are stored and served in glTF's convention: OpenGL, +Y up (green high where the
 //! surface faces the top of the image), `rgb = (n + 1) / 2 · 255`, unit length.
 
-use std::borrow::Cow;
-use std::sync::OnceLock;
-
 use serde::{Deserialize, Serialize};
 
+use crate::cache::{Pyramid, Stack};
 use crate::error::{CoreError, Result};
-use crate::image::box_stack;
+use crate::image::{box_stack, Integral};
 use crate::stack::low_pass;
 
 /// The maps every material tool knows by name (any other valid name is an extra map).
@@ -52,15 +50,7 @@ pub struct MaterialMap {
     pub normal: bool,
     /// Hash of everything above: part of its tiles' ETags, and of no other map's.
     pub hash: String,
-    /// Centred box means at every scale, derived on first zoomed-out use.
-    boxes: OnceLock<Vec<Vec<[u8; 3]>>>,
-    /// The low-pass native views blend seams with, derived on first use, with the
-    /// `(toroidal, steps)` it was asked for.
-    low: OnceLock<HeldLowPass>,
 }
-
-/// A derived low-pass with the `(toroidal, steps)` it was derived for.
-type HeldLowPass = ((bool, u32), Vec<[u8; 3]>);
 
 impl MaterialMap {
     /// Map `name` from its texels, prepared like the exemplar's (and its `2·side`
@@ -97,15 +87,7 @@ impl MaterialMap {
             h.update(hi.as_flattened());
         }
         let hash = h.finalize().to_hex()[..16].to_string();
-        Ok(MaterialMap {
-            name: name.to_string(),
-            texels,
-            hires,
-            normal,
-            hash,
-            boxes: OnceLock::new(),
-            low: OnceLock::new(),
-        })
+        Ok(MaterialMap { name: name.to_string(), texels, hires, normal, hash })
     }
 
     /// Exemplar side.
@@ -113,27 +95,24 @@ impl MaterialMap {
         (self.texels.len() as f64).sqrt() as u32
     }
 
-    /// The centred `2^k × 2^k` box means of the map, per texel (see [`box_stack`]).
-    pub fn box_colours(&self, k: u32) -> &[[u8; 3]] {
-        let n = self.side() as usize;
-        let stack = self.boxes.get_or_init(|| box_stack(&self.texels, n));
-        &stack[(k as usize).min(stack.len() - 1)]
+    /// The centred `2^k × 2^k` box means of the map, per texel, for every `k` (see
+    /// [`box_stack`]), derived on first use and kept in `cache` within its bytes.
+    pub fn box_stack(&self, cache: &Pyramid) -> Stack {
+        cache.derived(&format!("boxes|map|{}", self.hash), || box_stack(&self.texels, self.side() as usize))
     }
 
     /// The map low-passed `steps` stack levels (see [`crate::stack::low_pass`]), with the
-    /// addressing of a `toroidal` exemplar or not: held for the arguments of the first call
-    /// (a texture always asks with its exemplar's), derived afresh for others.
-    pub fn low_pass(&self, toroidal: bool, steps: u32) -> Cow<'_, [[u8; 3]]> {
-        let derive = || low_pass(&self.texels, self.side() as usize, toroidal, steps);
-        match self.low.get_or_init(|| ((toroidal, steps), derive())) {
-            (key, held) if *key == (toroidal, steps) => Cow::Borrowed(held),
-            _ => Cow::Owned(derive()),
-        }
+    /// addressing of a `toroidal` exemplar or not, as a one-level stack kept in `cache`.
+    pub fn low_pass(&self, cache: &Pyramid, toroidal: bool, steps: u32) -> Stack {
+        cache.derived(&format!("low|map|{}|{toroidal}|{steps}", self.hash), || {
+            vec![low_pass(&self.texels, self.side() as usize, toroidal, steps)]
+        })
     }
 
-    /// The map's mean.
+    /// The map's mean (the box mean over the whole map).
     pub fn mean(&self) -> [u8; 3] {
-        self.box_colours(u32::MAX)[0]
+        let n = self.side() as usize;
+        Integral::new(&self.texels, n, n).mean_around(0, 0)
     }
 }
 
@@ -243,9 +222,10 @@ mod tests {
         let texels: Vec<[u8; 3]> =
             (0..m * m).map(|i| [(i * 37 % 251) as u8, (i % m * 16) as u8, (i / m * 16) as u8]).collect();
         let map = MaterialMap::new("height", texels.clone(), None, None).unwrap();
+        let cache = Pyramid::new(1 << 20);
         for (toroidal, steps) in [(true, 2), (false, 2), (true, 1), (true, 2)] {
             assert_eq!(
-                &map.low_pass(toroidal, steps)[..],
+                &map.low_pass(&cache, toroidal, steps)[0][..],
                 &low_pass(&texels, m, toroidal, steps)[..],
                 "{toroidal} {steps}"
             );

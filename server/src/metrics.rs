@@ -53,7 +53,7 @@ pub struct Metrics {
     pub level_cache_bytes: IntGauge,
     /// Blocks held by the pyramidal cache.
     pub level_cache_blocks: IntGauge,
-    /// Bytes held by the textures' prepared states (analyses, extractions and their caches).
+    /// Bytes held by the textures (exemplars, maps, analyses, extractions and their caches).
     pub prepared_bytes: IntGauge,
     /// Bytes of caches the textures' prepared states may keep, in all.
     pub prepared_cache_limit_bytes: IntGauge,
@@ -113,7 +113,7 @@ impl Metrics {
             level_cache_blocks: must(IntGauge::new("level_cache_blocks", "blocks held by the pyramidal cache")),
             prepared_bytes: must(IntGauge::new(
                 "prepared_bytes",
-                "bytes held by the textures' prepared states (analyses, extractions and their caches)",
+                "bytes held by the textures: exemplars, maps, analyses, extractions and their caches",
             )),
             prepared_cache_limit_bytes: must(IntGauge::new(
                 "prepared_cache_limit_bytes",

@@ -19,6 +19,7 @@ use crate::analysis::features::{
     principal_directions, project_runtime, quantise_projection, InnerTaps, LevelColours, SearchProjection,
     RUNTIME_DIMS, SEARCH_DIMS,
 };
+use crate::cache::{Pyramid, Stack};
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
@@ -195,9 +196,6 @@ pub struct Analysis {
     pub corrected: Vec<CorrectionLevel>,
     /// Derived: 8-bit stack colours (not stored).
     pub(crate) stack8: Vec<Vec<[u8; 3]>>,
-    /// Derived on first use (zoomed-out views): the exemplar's centred box means at every
-    /// scale (not stored; see [`crate::image::box_stack`]).
-    pub(crate) boxes: OnceLock<Vec<Vec<[u8; 3]>>>,
     /// Derived on first use: [`Analysis::fine_detail`].
     pub(crate) detail: OnceLock<FineDetail>,
     /// The exemplar's randomness mask (not stored: [`Analysis::attach`]).
@@ -267,14 +265,12 @@ impl Analysis {
             lattice: ex.lattice,
         };
         let randomness_mask = ex.randomness_mask.clone();
-        let boxes = OnceLock::new();
         Ok(Analysis {
             header,
             exemplar: ex.pixels.clone(),
             stack,
             corrected,
             stack8,
-            boxes,
             detail: OnceLock::new(),
             randomness_mask,
         })
@@ -322,10 +318,11 @@ impl Analysis {
         &self.stack8[l as usize]
     }
 
-    /// The exemplar's box means over `2^k × 2^k` texels centred on each texel (`k = 0`: the
-    /// exemplar itself; `k = levels`: the mean colour everywhere).
-    pub fn box_colours(&self, k: u32) -> &[[u8; 3]] {
-        &self.boxes.get_or_init(|| box_stack(&self.exemplar, self.header.side as usize))[k as usize]
+    /// The exemplar's box means over `2^k × 2^k` texels centred on each texel, for every `k`
+    /// (`0`: the exemplar itself; `levels`: the mean colour everywhere), derived on first use
+    /// and kept in `cache` within its bytes.
+    pub fn box_stack(&self, cache: &Pyramid) -> Stack {
+        cache.derived(&format!("boxes|{}", self.header.id), || box_stack(&self.exemplar, self.header.side as usize))
     }
 
     /// How much of the exemplar's variation is fine detail: its energy above stack level
@@ -360,16 +357,7 @@ impl Analysis {
         corrected: Vec<CorrectionLevel>,
     ) -> Analysis {
         let stack8 = derive_stack8(&stack);
-        Analysis {
-            header,
-            exemplar,
-            stack,
-            corrected,
-            stack8,
-            boxes: OnceLock::new(),
-            detail: OnceLock::new(),
-            randomness_mask: None,
-        }
+        Analysis { header, exemplar, stack, corrected, stack8, detail: OnceLock::new(), randomness_mask: None }
     }
 
     /// Attach what an analysis read from a file keeps with the exemplar instead (its

@@ -104,12 +104,13 @@ impl<'a> Source<'a> {
         self.map.map_or(&self.exemplar.pixels, |m| &m.texels)
     }
 
-    /// The centred `2^k × 2^k` box means of [`Source::texels`] (`k ≤ levels`), when something
-    /// holds them: the map, or the analysis for the colour (each derives them once).
-    pub fn box_colours(&self, k: u32) -> Option<&'a [[u8; 3]]> {
+    /// The centred `2^k × 2^k` box means of [`Source::texels`] for every `k ≤ levels`, when
+    /// something names them: the map, or the analysis for the colour (derived once and kept in
+    /// `cache`, within its bytes).
+    pub fn box_stack(&self, cache: &Pyramid) -> Option<crate::cache::Stack> {
         match self.map {
-            Some(m) => Some(m.box_colours(k)),
-            None => self.analysis.map(|a| a.box_colours(k)),
+            Some(m) => Some(m.box_stack(cache)),
+            None => self.analysis.map(|a| a.box_stack(cache)),
         }
     }
 

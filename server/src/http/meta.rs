@@ -46,6 +46,7 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
             "budget_bytes": st.config.memory_budget_mib << 20,
             "reserved_bytes": st.reserved(),
             "prepared_caches_bytes": crate::state::prepared_share_mib(&st.config) << 20,
+            "textures_bytes": st.registry().map_or(0, |r| r.list.iter().map(|t| t.held_bytes()).sum::<u64>()),
         },
         "level_cache": {
             "blocks": pyr.blocks, "bytes": pyr.bytes, "limit_bytes": st.config.level_cache_mib << 20,
@@ -376,15 +377,7 @@ pub async fn tilejson(
 pub async fn metrics(State(st): State<Arc<AppState>>) -> Response {
     st.metrics.observe_pyramid(&st.pyramid.stats());
     if let Some(reg) = st.registry() {
-        let held: u64 = reg
-            .list
-            .iter()
-            .map(|t| {
-                t.prepared.memory_bytes()
-                    + t.analysis()
-                        .map_or(0, |a| <textile_core::Analysis as textile_core::prepare::Preparation>::memory_bytes(a))
-            })
-            .sum();
+        let held: u64 = reg.list.iter().map(|t| t.held_bytes()).sum();
         st.metrics.prepared_bytes.set(held as i64);
         let limits: u64 = reg.list.iter().map(|t| t.cache_limit.load(std::sync::atomic::Ordering::Relaxed)).sum();
         st.metrics.prepared_cache_limit_bytes.set(limits as i64);

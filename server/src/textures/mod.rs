@@ -159,6 +159,23 @@ impl Texture {
         }
     }
 
+    /// Bytes it holds in memory: its exemplar (and high-resolution and PNG copies), its
+    /// material maps, its analysis, and its modes' prepared states with their caches. What
+    /// requests derive from it (box-mean stacks, low-passes) is held by the pyramidal cache,
+    /// within its limit.
+    pub fn held_bytes(&self) -> u64 {
+        let texels = |v: &[[u8; 3]]| v.len() as u64 * 3;
+        let ex = &self.exemplar;
+        let maps: u64 = ex.maps.iter().map(|m| texels(&m.texels) + m.hires.as_deref().map_or(0, texels)).sum();
+        let analysis = self.analysis().map_or(0, |a| <Analysis as textile_core::prepare::Preparation>::memory_bytes(a));
+        texels(&ex.pixels)
+            + ex.hires.as_deref().map_or(0, texels)
+            + self.exemplar_png.len() as u64
+            + maps
+            + analysis
+            + self.prepared.memory_bytes()
+    }
+
     /// Let its prepared states keep at most `bytes` of caches.
     pub fn limit_caches(&self, bytes: u64) {
         self.cache_limit.store(bytes, Ordering::Relaxed);

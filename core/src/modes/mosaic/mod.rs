@@ -39,9 +39,9 @@ impl Mode for Mosaic {
     type Params = MosaicParams;
     type State = ();
 
-    fn render(p: &MosaicParams, _: &(), src: &Source, _: &Pyramid, view: View) -> Result<Rendered> {
+    fn render(p: &MosaicParams, _: &(), src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
         Ok(Rendered {
-            image: render_texels(src, p, view.zoom_out, view.rect)?,
+            image: render_texels(src, cache, p, view.zoom_out, view.rect)?,
             synthesized: render_cost(view.zoom_out, view.rect),
         })
     }
@@ -61,12 +61,12 @@ pub fn render_cost(zoom_out: u32, rect: Rect) -> u64 {
 /// [`sampled`]): as cheap at every zoom as at native, and the box filter of the native pixels
 /// but where a pixel spans a block edge.
 pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
-    render_texels(&Source::exemplar(ex), p, zoom_out, rect)
+    render_texels(&Source::exemplar(ex), &Pyramid::off(), p, zoom_out, rect)
 }
 
 /// [`render`] showing `src`'s texels at the exemplar's coordinates: its colours, or one of its
-/// material maps.
-pub fn render_texels(src: &Source, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
+/// material maps; what it derives from them is kept in `cache`.
+pub fn render_texels(src: &Source, cache: &Pyramid, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
     let ex = src.exemplar;
     p.validate(ex.side)?;
     check_window(rect, MAX_PIXELS)?;
@@ -74,7 +74,7 @@ pub fn render_texels(src: &Source, p: &MosaicParams, zoom_out: u32, rect: Rect) 
     if zoom_out == 0 {
         return Ok(native(ex, src.texels(), &layout, rect));
     }
-    Ok(sampled(src, &layout, zoom_out, rect))
+    Ok(sampled(src, cache, &layout, zoom_out, rect))
 }
 
 /// Pixels per parallel piece of [`sampled`]'s colouring.
@@ -86,7 +86,7 @@ const SAMPLED_PIXELS: usize = 1 << 13;
 /// the map holds, else from an integral image): the exact box filter of the native pixels
 /// wherever they all share the label, all but a block edge's pixels; the mean colour once a
 /// pixel covers the whole exemplar.
-fn sampled(src: &Source, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
+fn sampled(src: &Source, cache: &Pyramid, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let (ex, texels) = (src.exemplar, src.texels());
     let n = layout.n as usize;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
@@ -98,8 +98,8 @@ fn sampled(src: &Source, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     }
     let labels = sources(layout, rect, ex.toroidal, step, step / 2);
     // The box means the analysis or the map holds, else each pixel's from an integral image.
-    let mean: Box<dyn Fn(usize, usize) -> [u8; 3] + Sync> = match src.box_colours(k) {
-        Some(boxes) => Box::new(move |x, y| boxes[y * n + x]),
+    let mean: Box<dyn Fn(usize, usize) -> [u8; 3] + Sync> = match src.box_stack(cache) {
+        Some(stack) => Box::new(move |x, y| stack[k as usize][y * n + x]),
         None => {
             let sums = Integral::new(texels, n, step as usize);
             Box::new(move |x, y| sums.mean_around(x, y))

@@ -51,8 +51,8 @@ pub fn render_map(
         let (texels, low) = match map {
             None => (&an.exemplar[..], an.colours8(levels.saturating_sub(style.low_steps))),
             Some(mp) => {
-                map_low = mp.low_pass(toroidal, style.low_steps);
-                (&mp.texels[..], &map_low[..])
+                map_low = mp.low_pass(pyr, toroidal, style.low_steps);
+                (&mp.texels[..], &map_low[0][..])
             }
         };
         seams::blend(&sw.window.coords, (w, h), &seams::Texels { texels, low, m, toroidal }, style.fade, &mut pixels);
@@ -63,7 +63,8 @@ pub fn render_map(
         // jitter or correction moved texels).
         let sw = synthesize_with(pyr, an, params, levels - zoom_out, rect)?;
         synthesized = sw.synthesized;
-        let boxes = map.map_or_else(|| an.box_colours(zoom_out), |m| m.box_colours(zoom_out));
+        let stack = map.map_or_else(|| an.box_stack(pyr), |m| m.box_stack(pyr));
+        let boxes = &stack[zoom_out as usize];
         for &v in &sw.window.coords {
             pixels.extend_from_slice(&boxes[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
         }

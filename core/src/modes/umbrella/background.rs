@@ -126,7 +126,7 @@ pub(super) fn background(p: &UmbrellaParams, src: &Source, cache: &Pyramid, view
     Ok(match p.background {
         Background::Mosaic => {
             let mp = MosaicParams { seed: p.seed, period: p.period, ..MosaicParams::default() };
-            mosaic::render_texels(src, &mp, view.zoom_out, view.rect)?
+            mosaic::render_texels(src, cache, &mp, view.zoom_out, view.rect)?
         }
         Background::Synth => {
             let sp = SynthParams { seed: p.seed, period: p.period, ..SynthParams::default() };
