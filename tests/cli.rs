@@ -269,6 +269,37 @@ fn tileable_writes_a_seamless_texture_deterministically_and_refuses_bad_input() 
     }
 }
 
+/// Every service setting with a flag is a flag of `textile serve` (and `--data-dir` of every
+/// command that reads the configuration) with the table's help, and the flag sets that key.
+#[test]
+fn setting_flags_come_from_the_settings_table() {
+    use textile_server::config::settings::{describe, Kind, SERVICE};
+    let (code, help, err) = run(&["serve", "--help"]);
+    assert_eq!(code, 0, "{err}");
+    let flagged: Vec<_> = SERVICE.iter().filter(|s| s.flag.is_some()).collect();
+    assert!(flagged.len() >= 6, "{} flagged settings", flagged.len());
+    for s in &flagged {
+        let flag = s.flag.unwrap();
+        let line = help.lines().find(|l| l.trim_start().starts_with(&format!("--{} ", flag.long)));
+        let line = line.unwrap_or_else(|| panic!("--{} is not in serve --help:\n{help}", flag.long));
+        assert!(line.contains(s.help), "--{}: {line}", flag.long);
+        // The flag sets its key, as --print-config shows.
+        let value = match s.kind {
+            Kind::Int { min, max, .. } => (min + (max - min) / 3).max(1).min(max).to_string(),
+            _ if s.key == "bind" => "127.0.0.1:9".to_string(),
+            _ => "/tmp/textile-flag-test".to_string(),
+        };
+        let (code, out, err) = run(&["serve", &format!("--{}", flag.long), &value, "--print-config"]);
+        assert_eq!(code, 0, "--{} {value}: {err}", flag.long);
+        let shown = out.lines().find(|l| l.starts_with(&format!("{} = ", s.key))).unwrap_or_default();
+        assert!(shown.contains(&value), "--{} {value} gave '{shown}' ({})", flag.long, describe(s));
+        if flag.every_command {
+            let (_, help, _) = run(&["render", "--help"]);
+            assert!(help.contains(&format!("--{}", flag.long)), "render --help lacks --{}", flag.long);
+        }
+    }
+}
+
 /// The settings table drives `--print-config` (each service key preceded by what it does, its
 /// range, default and environment variable), the environment keys, and the upload fields the
 /// OpenAPI document lists.

@@ -7,6 +7,9 @@ use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
 use textile_core::analysis::IndexChoice;
 
+pub use super::flags::SettingFlags;
+use crate::config::Overrides;
+
 /// Any error ending a command, as text for the user.
 pub type CliResult = Result<(), Box<dyn std::error::Error>>;
 
@@ -52,9 +55,18 @@ pub struct ConfigArgs {
     /// Configuration file (TOML), layered over the built-in defaults.
     #[arg(long, value_name = "FILE", env = "TEXTILE_CONFIG", hide_env_values = true)]
     pub config: Option<PathBuf>,
-    /// Directory where analyses are stored [env: TEXTILE_DATA_DIR].
-    #[arg(long, value_name = "DIR")]
-    pub data_dir: Option<String>,
+    /// The settings every such command takes as flags (`--data-dir`), from the settings table.
+    #[command(flatten)]
+    pub settings: SettingFlags<true>,
+}
+
+impl ConfigArgs {
+    /// What the flags set, over the configuration's other layers (`serve`: its own flags too).
+    pub fn overrides(&self, serve: Option<&SettingFlags<false>>) -> Overrides {
+        let mut values = self.settings.0.clone();
+        values.extend(serve.map(|s| s.0.clone()).unwrap_or_default());
+        Overrides(values)
+    }
 }
 
 /// `textile serve`.
@@ -62,21 +74,10 @@ pub struct ConfigArgs {
 pub struct ServeArgs {
     #[command(flatten)]
     pub config: ConfigArgs,
-    /// Address to listen on, e.g. 127.0.0.1:8080 (port 0: any free port) [env: TEXTILE_BIND].
-    #[arg(long, value_name = "ADDR")]
-    pub bind: Option<String>,
-    /// Tile cache size in MiB [env: TEXTILE_CACHE_MIB].
-    #[arg(long, value_name = "MIB")]
-    pub cache_mib: Option<u64>,
-    /// Pyramidal cache size in MiB, 0 = off [env: TEXTILE_LEVEL_CACHE_MIB].
-    #[arg(long, value_name = "MIB")]
-    pub level_cache_mib: Option<u64>,
-    /// Synthesis threads, 0 = one per core [env: TEXTILE_WORKER_THREADS].
-    #[arg(long, value_name = "N")]
-    pub workers: Option<usize>,
-    /// Syntheses in flight before answering 503 [env: TEXTILE_MAX_IN_FLIGHT].
-    #[arg(long, value_name = "N")]
-    pub max_in_flight: Option<usize>,
+    /// The service settings that have a flag (`--bind`, `--cache-mib`, `--workers`, …), from
+    /// the settings table.
+    #[command(flatten)]
+    pub settings: SettingFlags<false>,
     /// Print the effective configuration as TOML and exit.
     #[arg(long)]
     pub print_config: bool,

@@ -7,6 +7,7 @@
 pub mod analyze;
 pub mod args;
 pub mod export;
+pub mod flags;
 pub mod info;
 pub mod loadtest;
 pub mod render;
@@ -19,7 +20,7 @@ use std::sync::{Arc, Mutex};
 use indicatif::{ProgressBar, ProgressStyle};
 use textile_core::{Exemplar, ExemplarOptions, Progress};
 
-use crate::config::{Config, Overrides};
+use crate::config::Config;
 use crate::encode::Format;
 use crate::textures::{exemplar_bytes, load_registry, Texture};
 use args::ConfigArgs;
@@ -95,7 +96,7 @@ pub(crate) fn output_format(output: &Path) -> Result<Format, &'static str> {
 /// A configured or uploaded texture, loaded (analysed if its analysis is not stored) from the
 /// data directory.
 pub(crate) fn configured_texture(c: &ConfigArgs, id: &str) -> Result<Arc<Texture>, Box<dyn std::error::Error>> {
-    let overrides = Overrides { data_dir: c.data_dir.clone(), ..Default::default() };
+    let overrides = c.overrides(None);
     let cfg = crate::uploads::with_stored(&Config::load(c.config.as_deref(), &overrides)?, &|s| eprintln!("{s}"));
     let mut only = cfg.clone();
     only.textures.retain(|t| t.id == id);

@@ -12,21 +12,14 @@ use tokio::sync::watch;
 use tracing::{info, warn};
 
 use crate::cmd::args::{CliResult, ServeArgs};
-use crate::config::{Config, Overrides};
+use crate::config::Config;
 use crate::http::listen::{self, Limits};
 use crate::state::AppState;
 use crate::textures::{analyse_registry, has_current_analysis, prepare_registry, LoadError, Texture};
 
 /// Run the server until a shutdown signal.
 pub fn run(args: ServeArgs) -> CliResult {
-    let overrides = Overrides {
-        bind: args.bind.clone(),
-        data_dir: args.config.data_dir.clone(),
-        cache_mib: args.cache_mib,
-        level_cache_mib: args.level_cache_mib,
-        worker_threads: args.workers,
-        max_in_flight: args.max_in_flight,
-    };
+    let overrides = args.config.overrides(Some(&args.settings));
     let cfg = Config::load(args.config.config.as_deref(), &overrides)?;
     if args.print_config {
         print!("{}", cfg.to_commented_toml()?);

@@ -110,28 +110,11 @@ pub struct Config {
     pub base_dir: PathBuf,
 }
 
-/// Values given on the command line (override everything else when present).
+/// Values the command line gives, by setting key (`cmd::flags`): they override every other
+/// layer.
 #[derive(Debug, Default, Clone, Serialize)]
-pub struct Overrides {
-    /// `--bind`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub bind: Option<String>,
-    /// `--data-dir`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub data_dir: Option<String>,
-    /// `--cache-mib`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub cache_mib: Option<u64>,
-    /// `--level-cache-mib`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub level_cache_mib: Option<u64>,
-    /// `--workers`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub worker_threads: Option<usize>,
-    /// `--max-in-flight`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_in_flight: Option<usize>,
-}
+#[serde(transparent)]
+pub struct Overrides(pub serde_json::Map<String, serde_json::Value>);
 
 /// A configuration problem, naming the key.
 #[derive(Debug, thiserror::Error)]
@@ -307,7 +290,11 @@ mod tests {
 
     #[test]
     fn overrides_win() {
-        let o = Overrides { bind: Some("127.0.0.1:0".into()), cache_mib: Some(5), ..Default::default() };
+        let o = Overrides(
+            [("bind".to_string(), serde_json::json!("127.0.0.1:0")), ("cache_mib".to_string(), serde_json::json!(5))]
+                .into_iter()
+                .collect(),
+        );
         let cfg = Config::load(None, &o).unwrap();
         assert_eq!((cfg.bind.as_str(), cfg.cache_mib), ("127.0.0.1:0", 5));
     }

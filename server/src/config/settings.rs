@@ -1,7 +1,9 @@
 //! Every setting declared once. [`SERVICE`]: the service's keys — type, range, default,
-//! whether the environment sets it (`TEXTILE_<KEY>`) and what it does — which drive the
-//! defaults under the built-in configuration, the environment keys read, range validation and
-//! the comments of `--print-config`. [`TEXTURE_FIELDS`]: the texture keys an upload may set, as
+//! whether the environment sets it (`TEXTILE_<KEY>`), its command-line flag if it has one, and
+//! what it does — which drive the defaults under the built-in configuration, the environment
+//! keys read, the flags of `textile serve` (and `--data-dir` of every command that reads the
+//! configuration: `cmd::args::SettingFlags`), range validation and the comments of
+//! `--print-config`. [`TEXTURE_FIELDS`]: the texture keys an upload may set, as
 //! parameter specs, which drive upload field checks and the admin API's OpenAPI.
 
 use serde_json::{json, Map, Value as Json};
@@ -48,44 +50,73 @@ pub struct Setting {
     pub kind: Kind,
     /// Whether `TEXTILE_<KEY>` sets it.
     pub env: bool,
+    /// Its command-line flag, if it has one.
+    pub flag: Option<Flag>,
     /// What it does.
     pub help: &'static str,
 }
 
+/// A setting's command-line flag.
+#[derive(Debug, Clone, Copy)]
+pub struct Flag {
+    /// `--LONG`.
+    pub long: &'static str,
+    /// The value's name in `--help`.
+    pub value: &'static str,
+    /// Whether every command that reads the configuration takes it (else `textile serve` only).
+    pub every_command: bool,
+}
+
+impl Setting {
+    /// This setting with flag `--long VALUE` on `textile serve`.
+    const fn flag(self, long: &'static str, value: &'static str) -> Setting {
+        Setting { flag: Some(Flag { long, value, every_command: false }), ..self }
+    }
+
+    /// This setting with flag `--long VALUE` on every command that reads the configuration.
+    const fn flag_everywhere(self, long: &'static str, value: &'static str) -> Setting {
+        Setting { flag: Some(Flag { long, value, every_command: true }), ..self }
+    }
+}
+
 const fn int(key: &'static str, min: u64, max: u64, default: u64, help: &'static str) -> Setting {
-    Setting { key, kind: Kind::Int { min, max, default, zero: None }, env: true, help }
+    Setting { key, kind: Kind::Int { min, max, default, zero: None }, env: true, flag: None, help }
 }
 
 const fn int0(key: &'static str, max: u64, default: u64, zero: &'static str, help: &'static str) -> Setting {
-    Setting { key, kind: Kind::Int { min: 0, max, default, zero: Some(zero) }, env: true, help }
+    Setting { key, kind: Kind::Int { min: 0, max, default, zero: Some(zero) }, env: true, flag: None, help }
 }
 
 const fn text(key: &'static str, default: &'static str, help: &'static str) -> Setting {
-    Setting { key, kind: Kind::Text { default }, env: true, help }
+    Setting { key, kind: Kind::Text { default }, env: true, flag: None, help }
 }
 
 /// The service's settings, in the order `--print-config` shows them.
 pub const SERVICE: &[Setting] = &[
-    text("bind", "127.0.0.1:8080", "listen address (host:port)"),
-    text("data_dir", "", "directory of analyses and uploads (empty: $XDG_DATA_HOME/textile)"),
-    int("cache_mib", 1, 65536, 256, "tile cache size in MiB"),
-    int0("level_cache_mib", 65536, 128, "off", "pyramidal (synthesis level) cache size in MiB"),
+    text("bind", "127.0.0.1:8080", "listen address (host:port; port 0: any free port)").flag("bind", "ADDR"),
+    text("data_dir", "", "directory of analyses and uploads (empty: $XDG_DATA_HOME/textile)")
+        .flag_everywhere("data-dir", "DIR"),
+    int("cache_mib", 1, 65536, 256, "tile cache size in MiB").flag("cache-mib", "MIB"),
+    int0("level_cache_mib", 65536, 128, "off", "pyramidal (synthesis level) cache size in MiB")
+        .flag("level-cache-mib", "MIB"),
     text("cache_control", "public, max-age=31536000, immutable", "Cache-Control of tiles"),
     Setting {
         key: "cors_origins",
         kind: Kind::List { default: &["*"] },
         env: false,
+        flag: None,
         help: "CORS origins (\"*\": any)",
     },
-    int0("worker_threads", 1024, 0, "one per core", "synthesis threads"),
+    int0("worker_threads", 1024, 0, "one per core", "synthesis threads").flag("workers", "N"),
     int("request_timeout_secs", 1, 3600, 30, "request timeout in seconds"),
-    int("max_in_flight", 1, 100_000, 64, "syntheses in flight before shedding with 503"),
+    int("max_in_flight", 1, 100_000, 64, "syntheses in flight before shedding with 503").flag("max-in-flight", "N"),
     int("max_queue_wait_ms", 1, 600_000, 1000, "longest wait for a pool thread or memory before 503, in ms"),
     int("max_exemplar_side", 16, 8192, 1024, "largest exemplar side accepted, in pixels"),
     Setting {
         key: "include_default_textures",
         kind: Kind::Bool { default: false },
         env: false,
+        flag: None,
         help: "keep the built-in textures beside a configuration file's own",
     },
     text("public_url", "", "the URL clients reach the service at, for absolute URLs (empty: from the request)"),
@@ -93,6 +124,7 @@ pub const SERVICE: &[Setting] = &[
         key: "trusted_proxies",
         kind: Kind::List { default: &[] },
         env: false,
+        flag: None,
         help: "addresses of reverse proxies whose forwarded headers are believed",
     },
     int("max_connections", 1, 1_000_000, 1024, "open connections at most; beyond, new ones wait"),
@@ -151,6 +183,12 @@ pub fn check_ranges(values: &Json) -> Result<(), (&'static str, String)> {
 /// One comment line for `--print-config`: what the setting does, its range and default, and
 /// its environment variable.
 pub fn comment(s: &Setting) -> String {
+    format!("# {}", describe(s))
+}
+
+/// What the setting does, its range and default, and its environment variable (its flag's
+/// help, and [`comment`]).
+pub fn describe(s: &Setting) -> String {
     let range = match s.kind {
         Kind::Int { min, max, default, zero } => {
             let zero = zero.map(|z| format!(", 0 = {z}")).unwrap_or_default();
@@ -161,7 +199,7 @@ pub fn comment(s: &Setting) -> String {
         Kind::Bool { default } => format!("default {default}"),
     };
     let env = if s.env { format!("; env TEXTILE_{}", s.key.to_uppercase()) } else { String::new() };
-    format!("# {} ({range}{env})", s.help)
+    format!("{} ({range}{env})", s.help)
 }
 
 /// `id`: a texture's URL id.
