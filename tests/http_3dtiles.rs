@@ -203,6 +203,16 @@ async fn bad_3dtiles_requests_are_json_4xx() {
     ] {
         assert_error(&s, path, status, code).await;
     }
+    // The refusal names the levels the tileset has, and the last of them is served.
+    let levels = s.json("/3dtiles/gravel/tileset.json").await["root"]["implicitTiling"]["availableLevels"]
+        .as_u64()
+        .expect("availableLevels");
+    let body: serde_json::Value =
+        s.get(&format!("/3dtiles/gravel/tiles/{levels}/0/0.glb")).await.json().await.expect("JSON error");
+    let message = body["message"].as_str().unwrap_or_default();
+    assert!(message.contains(&format!("levels 0 to {}", levels - 1)), "{message}");
+    let last = s.get(&format!("/3dtiles/gravel/tiles/{}/0/0.glb", levels - 1)).await;
+    assert_eq!(last.status(), 200, "level {} is named as served", levels - 1);
 }
 
 #[tokio::test]

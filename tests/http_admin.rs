@@ -383,3 +383,107 @@ async fn two_servers_on_one_data_directory_cannot_both_store_an_id() {
     until_ready(&b, "/textures/shared").await;
     assert_eq!(b.get_bytes("/tiles/shared/7/1/1.png").await, (200, from_a));
 }
+
+/// A PNG of `w × h` pixels, `colour(x, y)` each.
+fn png(w: u32, h: u32, colour: impl Fn(u32, u32) -> [u8; 3]) -> Vec<u8> {
+    let img = image::RgbImage::from_fn(w, h, |x, y| image::Rgb(colour(x, y)));
+    let mut out = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png).unwrap();
+    out
+}
+
+/// A JPEG of `img` carrying an EXIF orientation tag (1–8) in an APP1 segment after SOI.
+fn jpeg_with_orientation(img: &image::RgbImage, orientation: u16) -> Vec<u8> {
+    let mut plain = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut plain), image::ImageFormat::Jpeg).unwrap();
+    // TIFF header (big-endian), one IFD with one entry: Orientation (0x0112), SHORT, count 1.
+    let mut tiff = b"MM\0\x2a\0\0\0\x08\0\x01\x01\x12\0\x03\0\0\0\x01".to_vec();
+    tiff.extend_from_slice(&orientation.to_be_bytes());
+    tiff.extend_from_slice(&[0, 0, 0, 0, 0, 0]);
+    let mut app1 = vec![0xFF, 0xE1];
+    app1.extend_from_slice(&((2 + 6 + tiff.len()) as u16).to_be_bytes());
+    app1.extend_from_slice(b"Exif\0\0");
+    app1.extend_from_slice(&tiff);
+    let mut out = plain[..2].to_vec();
+    out.extend_from_slice(&app1);
+    out.extend_from_slice(&plain[2..]);
+    out
+}
+
+/// The hostile run's findings on uploads and deletion (issue 62, items 8 and 10): an image too
+/// small is named so (not "too large"), an EXIF orientation is applied, and a texture whose
+/// record cannot be removed is kept, with an error saying so — never a 204 for a texture that
+/// comes back.
+#[tokio::test]
+async fn small_images_exif_orientation_and_failed_deletions_are_answered_truly() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[]);
+    let tiny = png(8, 8, |x, y| [(x * 30) as u8, (y * 30) as u8, 90]);
+    let (status, _, body) = upload(&s, "?id=tiny", "image/png", tiny, Some(TOKEN)).await;
+    assert_eq!((status, body["error"].as_str()), (422, Some("image_too_small")), "{body}");
+    assert!(body["message"].as_str().unwrap_or("").contains("8x8"), "{body}");
+    // Stored sideways with orientation 6 (turn 90° clockwise to view): the red quadrant, top
+    // left as stored, is top right as meant.
+    let stored = image::RgbImage::from_fn(64, 64, |x, y| {
+        let n = ((x * 7 + y * 13) % 23) as u8;
+        if x < 32 && y < 32 {
+            image::Rgb([220, 30 + n, 30])
+        } else {
+            image::Rgb([30, 30 + n, 220])
+        }
+    });
+    let (status, _, body) =
+        upload(&s, "?id=turned", "image/jpeg", jpeg_with_orientation(&stored, 6), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let ex = s.image("/textures/turned/exemplar.png").await;
+    let (tl, tr) = (ex.get_pixel(8, 8).0, ex.get_pixel(56, 8).0);
+    assert!(tr[0] > 150 && tr[2] < 100 && tl[2] > 150, "top left {tl:?}, top right {tr:?}: not turned upright");
+    // A record that cannot be removed (a directory in its place): the texture stays.
+    let (status, _, body) = upload(&s, "?id=keep", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let record = data.path().join("uploads").join("keep.toml");
+    assert!(record.is_file(), "{record:?}");
+    let text = std::fs::read(&record).unwrap();
+    std::fs::remove_file(&record).unwrap();
+    std::fs::create_dir_all(record.join("stuck")).unwrap();
+    let (status, body) = delete(&s, "keep", Some(TOKEN)).await;
+    assert_eq!((status, body["error"].as_str()), (500, Some("not_deleted")), "{body}");
+    assert_eq!(s.get("/textures/keep").await.status(), 200, "a texture that could not be deleted is kept");
+    std::fs::remove_dir_all(&record).unwrap();
+    std::fs::write(&record, text).unwrap();
+    let (status, _) = delete(&s, "keep", Some(TOKEN)).await;
+    assert_eq!(status, 204);
+    assert!(!record.exists());
+    assert_eq!(s.get("/textures/keep").await.status(), 404);
+}
+
+/// A request body that stops arriving (issue 62, item 6) is answered `408 body_timeout` within
+/// the headers' deadline, on the samples route and the upload route alike.
+#[tokio::test]
+async fn a_stalled_body_is_answered_within_the_header_deadline() {
+    use std::io::{Read, Write};
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[("TEXTILE_HEADER_READ_TIMEOUT_SECS", "2")]);
+    let addr = s.base.trim_start_matches("http://").to_string();
+    for (path, ctype, auth) in [
+        ("/samples/gravel", "application/json", String::new()),
+        ("/admin/textures?id=slow", "image/png", format!("Authorization: Bearer {TOKEN}\r\n")),
+    ] {
+        let mut c = std::net::TcpStream::connect(&addr).unwrap();
+        c.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+        let head = format!(
+            "POST {path} HTTP/1.1\r\nHost: {addr}\r\nContent-Type: {ctype}\r\n{auth}Content-Length: 1000\r\n\r\n"
+        );
+        c.write_all(head.as_bytes()).unwrap();
+        c.write_all(b"0123456789").unwrap();
+        let started = std::time::Instant::now();
+        let mut answer = vec![0u8; 4096];
+        let n = c.read(&mut answer).unwrap_or(0);
+        let answer = String::from_utf8_lossy(&answer[..n]).to_string();
+        let took = started.elapsed();
+        assert!(answer.starts_with("HTTP/1.1 408"), "{path}: {answer:?} after {took:?}");
+        assert!(answer.contains("body_timeout"), "{path}: {answer}");
+        assert!(took < Duration::from_secs(8), "{path}: answered after {took:?}");
+    }
+    assert!(!data.path().join("uploads").join("slow.toml").exists());
+}

@@ -4,7 +4,7 @@
 
 use std::io::Cursor;
 
-use image::{DynamicImage, ImageReader, ImageResult, Limits};
+use image::{DynamicImage, ImageDecoder, ImageReader, ImageResult, Limits};
 
 /// A reader of encoded image bytes, its format guessed from them.
 pub fn reader(bytes: &[u8]) -> ImageResult<ImageReader<Cursor<&[u8]>>> {
@@ -12,7 +12,9 @@ pub fn reader(bytes: &[u8]) -> ImageResult<ImageReader<Cursor<&[u8]>>> {
 }
 
 /// Decode encoded image bytes whose header size the caller has already checked, refusing any
-/// axis over `max_side` and more than `max_alloc` bytes of allocation while decoding.
+/// axis over `max_side` and more than `max_alloc` bytes of allocation while decoding, and turned
+/// upright as its EXIF orientation says (a phone's JPEG is stored sideways with a tag that says
+/// so; the image a viewer shows is the one meant).
 pub fn decode_within(bytes: &[u8], max_side: u32, max_alloc: u64) -> ImageResult<DynamicImage> {
     let mut r = reader(bytes)?;
     let mut limits = Limits::default();
@@ -20,7 +22,11 @@ pub fn decode_within(bytes: &[u8], max_side: u32, max_alloc: u64) -> ImageResult
     limits.max_image_height = Some(max_side);
     limits.max_alloc = Some(max_alloc);
     r.limits(limits);
-    r.decode()
+    let mut decoder = r.into_decoder()?;
+    let orientation = decoder.orientation()?;
+    let mut img = DynamicImage::from_decoder(decoder)?;
+    img.apply_orientation(orientation);
+    Ok(img)
 }
 
 /// An RGB8 image of a window.

@@ -20,6 +20,8 @@ pub enum Kind {
     MethodNotAllowed,
     /// The request body is larger than allowed.
     TooLarge,
+    /// The request body stopped arriving (no data within the header deadline).
+    RequestTimeout,
     /// The request target (path and query) is longer than allowed.
     UriTooLong,
     /// The request headers are more or larger than allowed.

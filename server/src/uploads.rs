@@ -214,14 +214,28 @@ fn place(path: &Path, record: &Path, bytes: &[u8]) -> Result<(), StoreError> {
     }
 }
 
+/// Remove an uploaded texture's record, its configuration: what makes it a texture at the next
+/// start. Until this succeeds nothing of it is gone; once it has, the rest of its files are
+/// orphans that [`remove_files`] (or the next start) removes.
+pub fn remove_record(dir: &Path, id: &str) -> std::io::Result<()> {
+    match std::fs::remove_file(dir.join(format!("{id}.toml"))) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
+    }
+}
+
 /// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
 /// orphan that start-up removes, never a half texture), then its exemplar, then its analysis
 /// and what its modes prepared in `data_dir`.
 pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
-    match std::fs::remove_file(dir.join(format!("{id}.toml"))) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
-        _ => {}
-    }
+    remove_record(dir, id)?;
+    remove_files(dir, data_dir, id);
+    Ok(())
+}
+
+/// Remove the files of an uploaded texture whose record is gone (best effort: what is left is
+/// an orphan the next start removes).
+pub fn remove_files(dir: &Path, data_dir: &Path, id: &str) {
     for ext in ["png", "jpg", "webp"] {
         let _ = std::fs::remove_file(dir.join(format!("{id}.{ext}")));
     }
@@ -235,7 +249,6 @@ pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
     for ext in crate::textures::stored_extensions() {
         let _ = std::fs::remove_file(data_dir.join(format!("{id}.{ext}")));
     }
-    Ok(())
 }
 
 /// The stored uploads, in upload order (oldest first), their exemplar paths made absolute.

@@ -59,13 +59,7 @@ async fn read_upload(req: Request, query: Option<&str>, limit: u64) -> Result<Se
     let mut fields: Vec<(String, String)> =
         form_urlencoded::parse(query.unwrap_or("").as_bytes()).map(|(k, v)| (k.into_owned(), v.into_owned())).collect();
     let media = media_type(req.headers());
-    let read_error = |e: String| {
-        if e.contains("length limit") || e.contains("limit exceeded") || e.contains("too large") {
-            too_large(limit)
-        } else {
-            ApiError::bad_request("invalid_body", format!("the body could not be read: {}", clip(&e)))
-        }
-    };
+    let read_error = |e: String| crate::http::extract::body_error(&e, || too_large(limit));
     match media.as_str() {
         "image/png" | "image/jpeg" | "image/webp" | "application/octet-stream" => {
             let image = to_bytes(req.into_body(), limit as usize).await.map_err(|e| read_error(e.to_string()))?;
@@ -126,6 +120,11 @@ async fn read_upload(req: Request, query: Option<&str>, limit: u64) -> Result<Se
 /// A failure to prepare an uploaded exemplar, as an answer.
 fn refused(e: LoadError) -> ApiError {
     match e {
+        LoadError::Core { source: CoreError::ExemplarSize { width, height, min, .. }, .. }
+            if width.min(height) < min =>
+        {
+            ApiError::new(Kind::Unprocessable, "image_too_small", e.to_string())
+        }
         LoadError::Core { source: CoreError::ExemplarSize { .. }, .. } => {
             ApiError::new(Kind::TooLarge, "image_too_large", e.to_string())
         }
@@ -159,6 +158,7 @@ fn status_body(tex: &crate::textures::Texture) -> serde_json::Value {
               (status = 401, description = "no or wrong bearer token"),
               (status = 404, description = "the admin API is off (no admin token configured)"),
               (status = 409, description = "the id is in use, or the upload limit is reached"),
+              (status = 408, description = "the body stopped arriving"),
               (status = 413, description = "the body or the image's dimensions are over the limits"),
               (status = 415, description = "neither an image nor a multipart form"),
               (status = 507, description = "the data directory could not store the upload (the path is in the server log)"),
@@ -284,6 +284,7 @@ pub async fn upload(
               (status = 401, description = "no or wrong bearer token"),
               (status = 404, description = "no such texture, or the admin API is off"),
               (status = 409, description = "a configured texture (remove it from the configuration instead)"),
+              (status = 500, description = "its record could not be removed: the texture is kept"),
               (status = 503, description = "still loading")),
     security(("admin_token" = [])))]
 pub async fn delete(
@@ -304,16 +305,25 @@ pub async fn delete(
             format!("texture '{id}' is configured, not uploaded: remove it from the configuration"),
         ));
     }
+    // Its record first: if that cannot go, nothing has changed and the answer says so (a
+    // texture answered as deleted must not come back at the next start).
+    let (dir, data_dir) = (uploads::dir(&st.config), st.config.data_dir());
+    let record = dir.clone();
+    let rid = id.clone();
+    let gone = tokio::task::spawn_blocking(move || uploads::remove_record(&record, &rid))
+        .await
+        .map_err(|e| ApiError::internal(format!("removing texture '{id}': {e}")))?;
+    if let Err(e) = gone {
+        tracing::warn!("texture '{id}': not deleted, its record could not be removed: {e}");
+        return Err(ApiError::new(
+            Kind::Internal,
+            "not_deleted",
+            format!("texture '{id}' is kept: its record could not be removed from the uploads directory ({e})"),
+        ));
+    }
     tex.removed.set();
     st.set_registry(Arc::new(reg.without(&id)));
-    let (dir, data_dir) = (uploads::dir(&st.config), st.config.data_dir());
-    let removed = tokio::task::spawn_blocking(move || uploads::remove(&dir, &data_dir, &id)).await;
-    if !matches!(removed, Ok(Ok(()))) {
-        tracing::warn!(
-            "texture '{}': removed from the catalogue, but its files could not all be deleted",
-            tex.config.id
-        );
-    }
+    let _ = tokio::task::spawn_blocking(move || uploads::remove_files(&dir, &data_dir, &id)).await;
     tracing::info!("texture '{}': deleted", tex.config.id);
     Ok(StatusCode::NO_CONTENT.into_response())
 }

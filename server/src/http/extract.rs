@@ -99,3 +99,20 @@ pub fn base_url(st: &AppState, headers: &HeaderMap, peer: Peer) -> String {
 pub fn path_error(e: PathRejection) -> ApiError {
     ApiError::bad_request("invalid_path", format!("malformed path: {}", e.body_text()))
 }
+
+/// The answer to a request body that could not be read: `408 body_timeout` when it stopped
+/// arriving (the router's idle deadline, `header_read_timeout_secs`, the same as the headers'),
+/// else `too_large` when over its limit, else `400 invalid_body` saying why.
+pub fn body_error(e: &str, too_large: impl FnOnce() -> ApiError) -> ApiError {
+    if e.contains("designated timeout") {
+        ApiError::new(
+            crate::error::Kind::RequestTimeout,
+            "body_timeout",
+            "the request body stopped arriving: no data within the header deadline",
+        )
+    } else if e.contains("length limit") || e.contains("limit exceeded") || e.contains("too large") {
+        too_large()
+    } else {
+        ApiError::bad_request("invalid_body", format!("the body could not be read: {}", textile_core::error::clip(e)))
+    }
+}

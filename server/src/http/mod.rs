@@ -139,8 +139,12 @@ fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Route
         } else {
             AllowOrigin::list(state.config.cors_origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()))
         });
+    // A body that stops arriving gets the headers' deadline too (per frame: a slow but steady
+    // upload is fine), answered as 408 by the routes that read one.
+    let body_deadline = std::time::Duration::from_secs(state.config.header_read_timeout_secs);
     let app = routes
         .fallback(meta::not_found)
+        .layer(tower_http::timeout::RequestBodyTimeoutLayer::new(body_deadline))
         .layer(middleware::from_fn_with_state(state.clone(), track))
         .layer(middleware::from_fn(limits))
         .with_state(state);

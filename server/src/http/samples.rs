@@ -31,6 +31,7 @@ use crate::state::AppState;
     responses((status = 200, description = "JSON `{\"colors\": [[r, g, b], …]}`, or packed RGB8 (3 bytes per sample) for a binary request; X-Textile-Computed: pixels computed for it"),
               (status = 400, description = "malformed body, sample outside the tile range or bad parameters"),
               (status = 404, description = "unknown texture"),
+              (status = 408, description = "the body stopped arriving"),
               (status = 413, description = "more than 262144 samples or a body over 8 MiB"),
               (status = 415, description = "body neither application/json nor application/octet-stream"),
               (status = 503, description = "overloaded or loading; see Retry-After")))]
@@ -81,13 +82,8 @@ pub async fn samples(
     // size at most, measured), and a batch cache of its own when the shared one is off.
     let own_cache = if st.pyramid.is_on() { 0 } else { sampling::BATCH_CACHE };
     let _memory = st.reserve((16 << 20) + 12 * declared.unwrap_or(MAX_BODY as u64) + own_cache).await?;
-    let bytes = to_bytes(body, MAX_BODY).await.map_err(|e| {
-        if e.to_string().contains("length limit") {
-            too_large()
-        } else {
-            ApiError::bad_request("invalid_body", format!("the body could not be read: {e}"))
-        }
-    })?;
+    let bytes =
+        to_bytes(body, MAX_BODY).await.map_err(|e| crate::http::extract::body_error(&e.to_string(), too_large))?;
     let points = if binary {
         parse_binary(&tex, &bytes, records.unwrap_or(Records::Texels))?
     } else {

@@ -50,7 +50,10 @@ fn implicit(tree: &Tree, level: &str, x: &str, y: &str) -> Result<(u32, i64, i64
     let bad = || {
         ApiError::bad_request(
             "invalid_coordinate",
-            format!("'{level}/{x}/{y}' is not a tile of the tileset (levels 0..{})", tree.levels),
+            format!(
+                "'{level}/{x}/{y}' is not a tile of the tileset (levels 0 to {}, x and y 0 to 2^level − 1)",
+                tree.levels.saturating_sub(1)
+            ),
         )
     };
     let level: u32 = level.parse().map_err(|_| bad())?;
