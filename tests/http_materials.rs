@@ -428,9 +428,22 @@ async fn uploads_carry_maps_that_serve_as_a_configured_material_does() {
             .unwrap();
         buf.into_inner()
     };
+    // An all-black "normal map" of the exemplar's size: every texel decodes into the surface.
+    let black = {
+        let side = image::load_from_memory(&normal).unwrap().width();
+        let mut buf = std::io::Cursor::new(Vec::new());
+        image::RgbImage::new(side, side).write_to(&mut buf, image::ImageFormat::Png).unwrap();
+        buf.into_inner()
+    };
     // Refused: each with a 400 naming the problem, and nothing stored.
     type Refusal<'a> = (&'a [(&'a str, &'a str)], Vec<(&'a str, Vec<u8>)>, &'a str, &'a str);
-    let refusals: [Refusal; 5] = [
+    let refusals: [Refusal; 6] = [
+        (
+            &[("id", "mat"), ("normal_convention", "opengl")],
+            vec![("map.normal", black.clone())],
+            "invalid_map",
+            "into the surface",
+        ),
         (&[("id", "mat")], vec![("map.normal", normal.clone())], "invalid_upload", "normal_convention"),
         (
             &[("id", "mat"), ("normal_convention", "opengl")],

@@ -74,6 +74,9 @@ impl MaterialMap {
             }
             (false, _) => None,
         };
+        if normal {
+            check_normals(name, &texels)?;
+        }
         let fix = |px: Vec<[u8; 3]>| match convention {
             Some(c) => px.into_iter().map(|t| unit(t, c == NormalConvention::DirectX)).collect(),
             None => px,
@@ -172,6 +175,39 @@ fn decode(c: [u8; 3]) -> [f64; 3] {
     c.map(|v| v as f64 / 127.5 - 1.0)
 }
 
+/// Largest share of a normal map's texels that may be wrong — pointing sideways or into the
+/// surface (`z ≤ 0`), or longer than [`LONGEST_NORMAL`] — before the map is refused.
+const MAX_WRONG_NORMALS: f64 = 0.01;
+/// Longest encoded normal accepted: a unit vector is 1 within rounding; box-filtered maps hold
+/// shorter ones (down to 0.08 in the development set's), never longer (at most 1.07).
+const LONGEST_NORMAL: f64 = 1.25;
+
+/// Refuse a normal map that is not one: more than [`MAX_WRONG_NORMALS`] of its texels point
+/// sideways or down, or are far too long (an all-black image decodes to `(−1, −1, −1)`, into
+/// the surface). The development set's normal maps have none such.
+fn check_normals(name: &str, texels: &[[u8; 3]]) -> Result<()> {
+    let wrong = texels
+        .iter()
+        .filter(|&&c| {
+            let n = decode(c);
+            n[2] <= 0.0 || (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() > LONGEST_NORMAL
+        })
+        .count();
+    let share = wrong as f64 / texels.len().max(1) as f64;
+    if share > MAX_WRONG_NORMALS {
+        return Err(CoreError::Map {
+            name: name.to_string(),
+            message: format!(
+                "is not a tangent-space normal map: {:.0} % of its texels point sideways or into the surface, \
+                 or are longer than a unit vector (at most {:.0} % may)",
+                share * 100.0,
+                MAX_WRONG_NORMALS * 100.0
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// Encode a unit vector, rounding each channel.
 fn encode(n: [f64; 3]) -> [u8; 3] {
     n.map(|v| ((v + 1.0) * 127.5).round().clamp(0.0, 255.0) as u8)
@@ -230,6 +266,22 @@ mod tests {
                 "{toroidal} {steps}"
             );
         }
+    }
+
+    #[test]
+    fn maps_that_are_not_normal_maps_are_refused() {
+        let flat = vec![[128, 128, 255]; 64 * 64];
+        assert!(MaterialMap::new("normal", flat, None, Some(NormalConvention::OpenGl)).is_ok());
+        // All black (the hostile run's upload), all white, and pointing down.
+        for c in [[0, 0, 0], [255, 255, 255], [128, 128, 20]] {
+            let e = MaterialMap::new("normal", vec![c; 64 * 64], None, Some(NormalConvention::OpenGl)).unwrap_err();
+            assert!(e.to_string().contains("normal") && e.to_string().contains("100 %"), "{c:?}: {e}");
+        }
+        // A few wrong texels are tolerated; a height map is not checked as one.
+        let mut few = vec![[128, 128, 255]; 64 * 64];
+        few[..30].fill([0, 0, 0]);
+        assert!(MaterialMap::new("normal", few, None, Some(NormalConvention::DirectX)).is_ok());
+        assert!(MaterialMap::new("height", vec![[0, 0, 0]; 64 * 64], None, None).is_ok());
     }
 
     #[test]
