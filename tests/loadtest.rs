@@ -109,6 +109,65 @@ fn coordinated_omission_is_corrected() {
     assert_eq!(r["status"]["200"], r["requests"], "{r}");
 }
 
+/// A server stalled past the end of the run (SIGSTOP at 1 s, SIGCONT only after the run should
+/// have ended): the run ends at its deadline plus the stated grace; what timed out in flight
+/// and what was due but never sent count in the corrected latency at least until the end; every
+/// second has its timeline row; the summary says no answer came (issue 62, items 1–3).
+#[test]
+fn a_stall_past_the_end_shows_in_the_figures_and_does_not_hold_the_run() {
+    let s = Server::builder().start();
+    let pid = s.pid().to_string();
+    let base = s.base.clone();
+    let started = std::time::Instant::now();
+    let run = std::thread::spawn(move || {
+        let args = ["--texture", "grass", "--pattern", "hot", "--rate", "100", "--duration", "4", "--concurrency", "4"];
+        let out = Command::new(binary()).args(["loadtest", "--url", &base]).args(args).output().unwrap();
+        (out, started.elapsed())
+    });
+    std::thread::sleep(Duration::from_secs(1));
+    assert!(Command::new("kill").args(["-STOP", &pid]).status().unwrap().success());
+    // Resumed well after the run's 4 s and its 2 s grace: the run must not wait for it.
+    std::thread::sleep(Duration::from_secs(9));
+    assert!(Command::new("kill").args(["-CONT", &pid]).status().unwrap().success());
+    let (out, took) = run.join().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(took < Duration::from_secs(9), "the 4 s run returned after {took:?}, when the server resumed: {text}");
+    assert!(text.contains("NO ANSWER for"), "the summary hides the stall: {text}");
+    assert!(text.contains("did not answer within"), "{text}");
+    // The same run as JSON: the figures themselves.
+    let s2 = Server::builder().start();
+    let pid = s2.pid().to_string();
+    let base = s2.base.clone();
+    let run = std::thread::spawn(move || {
+        let args = ["--texture", "grass", "--pattern", "hot", "--rate", "100", "--duration", "4", "--concurrency", "4"];
+        loadtest(&base, &args)
+    });
+    std::thread::sleep(Duration::from_secs(1));
+    assert!(Command::new("kill").args(["-STOP", &pid]).status().unwrap().success());
+    std::thread::sleep(Duration::from_secs(9));
+    assert!(Command::new("kill").args(["-CONT", &pid]).status().unwrap().success());
+    let r = run.join().unwrap();
+    let (unsent, timed_out) = (r["unsent"].as_u64().unwrap(), r["timed_out"].as_u64().unwrap());
+    assert!(unsent > 150 && timed_out >= 1, "{r}");
+    assert_eq!(r["offered"].as_u64().unwrap(), r["requests"].as_u64().unwrap() + unsent, "{r}");
+    // Due from about 1 s on and unanswered at 4 s: the corrected p99 is seconds, not the
+    // healthy second's milliseconds.
+    let p99 = ms(&r["latency_ms"]["p99"]);
+    assert!(p99 >= 2000.0, "the corrected p99 is {p99} ms: the stall vanished from it; {r}");
+    assert!(ms(&r["latency_ms"]["p50"]) >= 500.0, "{r}");
+    let timeline = r["timeline"].as_array().unwrap();
+    assert_eq!(timeline.len(), 4, "a row per second of the 4 s run: {r}");
+    for t in &timeline[2..] {
+        assert_eq!(t["requests"], 0, "nothing sent while stalled: {t}");
+        assert!(t["unanswered"].as_u64().unwrap() >= 80, "{t}");
+        // Due in second k and unanswered at 4 s: at least (3 − k) s, up to (4 − k) s.
+        let k = t["second"].as_f64().unwrap();
+        assert!(t["p99_ms"].as_f64().is_some_and(|v| v >= 1000.0 * (3.9 - k)), "{t}");
+    }
+    assert_eq!(r["server_metrics"], false, "{r}");
+}
+
 #[test]
 fn warmup_stays_out_of_the_figures_and_the_histogram_is_written() {
     let s = Server::builder().start();

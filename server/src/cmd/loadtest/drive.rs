@@ -20,6 +20,9 @@ use super::verify::{digest, References};
 pub const TRANSPORT_ERROR: u16 = 0;
 /// Status recorded for a request still in flight at the deadline.
 pub const TIMED_OUT: u16 = u16::MAX;
+/// Status recorded for an arrival that was due before the deadline but never sent (open model:
+/// every connection was waiting on the server until the end).
+pub const NEVER_SENT: u16 = u16::MAX - 1;
 
 /// One request started: times since the phase began, the answer's status and size.
 #[derive(Debug, Clone, Copy)]
@@ -47,9 +50,22 @@ impl Sample {
     pub fn uncorrected(&self) -> Duration {
         self.done.saturating_sub(self.sent)
     }
-    /// Whether it counts as an error (no answer, or a 4xx/5xx).
+    /// Whether it counts as an error: a transport failure, a 4xx/5xx, or a body that differs
+    /// from its reference. A request still unanswered at the end ([`Sample::unanswered`]) is
+    /// counted apart, not as an error: a closed loop always ends with some in flight.
     pub fn is_error(&self) -> bool {
-        self.status == TRANSPORT_ERROR || self.status == TIMED_OUT || self.status >= 400 || self.mismatch
+        !self.unanswered() && (self.status == TRANSPORT_ERROR || self.status >= 400 || self.mismatch)
+    }
+
+    /// Whether it was sent at all.
+    pub fn was_sent(&self) -> bool {
+        self.status != NEVER_SENT
+    }
+
+    /// Whether it got no answer by the end of the run: timed out in flight, or never sent. Its
+    /// latency from its intended send time is then at least the run's end minus that time.
+    pub fn unanswered(&self) -> bool {
+        self.status == TIMED_OUT || self.status == NEVER_SENT
     }
 }
 
@@ -89,7 +105,7 @@ pub struct Outcome {
     /// Wall-clock length of the phase.
     pub seconds: f64,
     /// Open model: arrivals due before the deadline that were never sent (every connection was
-    /// busy until then).
+    /// busy until then); each is also a [`NEVER_SENT`] sample ending at the deadline.
     pub unsent: u64,
 }
 
@@ -288,6 +304,7 @@ impl Load {
         let connections = Arc::new(Semaphore::new(self.concurrency));
         let mut tasks = Vec::new();
         let mut unsent = 0;
+        let mut never_sent = Vec::new();
         let mut i = 0u64;
         while i < phase.max_requests {
             let t = due(i);
@@ -299,8 +316,20 @@ impl Load {
             // A free connection, waited for up to the deadline: the wait is part of the
             // request's corrected latency.
             let Ok(Ok(permit)) = tokio::time::timeout_at(deadline, connections.clone().acquire_owned()).await else {
-                // Every connection stayed busy to the end: the arrivals still due were never sent.
+                // Every connection stayed busy to the end: the arrivals still due were never
+                // sent. Each ends unanswered at the deadline, its latency counted from when it
+                // was due (as wrk2 and k6 count it), not left out.
+                let end = deadline.saturating_duration_since(start);
                 while i < phase.max_requests && due(i) < phase.seconds {
+                    let intended = Duration::from_secs_f64(due(i));
+                    never_sent.push(Sample {
+                        intended,
+                        sent: end,
+                        done: end,
+                        status: NEVER_SENT,
+                        bytes: 0,
+                        mismatch: false,
+                    });
                     unsent += 1;
                     i += 1;
                 }
@@ -318,12 +347,13 @@ impl Load {
             }));
             i += 1;
         }
-        let mut all = Vec::with_capacity(tasks.len());
+        let mut all = Vec::with_capacity(tasks.len() + never_sent.len());
         for t in tasks {
             if let Ok(s) = t.await {
                 all.push(s);
             }
         }
+        all.extend(never_sent);
         (all, unsent)
     }
 }

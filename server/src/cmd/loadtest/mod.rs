@@ -42,6 +42,9 @@ const DEFAULT_SECONDS: f64 = 30.0;
 const MAX_SECONDS: f64 = 3600.0;
 /// How late a send may be before the report says the client could not keep up.
 const LATE: std::time::Duration = std::time::Duration::from_millis(10);
+/// Longest wait for the server's `/metrics` before and after the run: a run ends at its
+/// deadline plus at most this (twice: before it starts and after it ends).
+const METRICS_GRACE: std::time::Duration = std::time::Duration::from_secs(2);
 
 /// A ratio of the report as text: three decimals, or "n/a" when undefined.
 fn na(v: &serde_json::Value) -> String {
@@ -222,11 +225,20 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             None
         };
         let load = make(references);
-        let metrics_before = client.get(format!("{root}/metrics")).send().await?.text().await?;
+        // The server's counters around the run, each asked for at most METRICS_GRACE: a stalled
+        // server must not hold the run past its deadline (its figures are then unknown).
+        let metrics = || async {
+            let get = async { client.get(format!("{root}/metrics")).send().await?.text().await };
+            tokio::time::timeout(METRICS_GRACE, get).await.ok().and_then(Result::ok)
+        };
+        let metrics_before = metrics().await;
         let out = load.run(Phase { seconds: duration, max_requests }).await;
-        let metrics_after = client.get(format!("{root}/metrics")).send().await?.text().await?;
+        let metrics_after = metrics().await;
+        let server_known = metrics_before.is_some() && metrics_after.is_some();
+        let (before, after) = (metrics_before.unwrap_or_default(), metrics_after.unwrap_or_default());
         let (all, elapsed) = (&out.samples, out.seconds);
-        let d = |n: &str| scrape(&metrics_after, n) - scrape(&metrics_before, n);
+        let sent = all.iter().filter(|s| s.was_sent()).count();
+        let d = |n: &str| scrape(&after, n) - scrape(&before, n);
         let (hits, misses) = (d("textile_cache_hits_total"), d("textile_cache_misses_total"));
         let open = !matches!(model, Model::Closed { .. });
         // The figure the report leads with: from the intended send time in the open model.
@@ -246,15 +258,17 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let mut report = json!({
             "pattern": a.pattern, "texture": a.texture, "concurrency": a.concurrency,
             "model": if open { "open" } else { "closed" },
-            "requests": all.len(), "seconds": elapsed, "requests_per_second": all.len() as f64 / elapsed,
+            "requests": sent, "seconds": elapsed, "requests_per_second": sent as f64 / elapsed,
             "warmup_seconds": a.warmup,
             "latency_ms": lat, "latency_ms_200": ok,
             "status": statuses, "bytes": bytes,
             "timed_out": statuses.get("timed_out").copied().unwrap_or(0),
-            "server_cache_hit_ratio": (hits + misses > 0.0).then(|| hits / (hits + misses)),
-            "server_syntheses": textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_syntheses_total{{mode=\"{m}\"}}"))).sum::<f64>() as u64,
-            "server_computation_ratio": ratio,
-            "timeline": report::timeline(all, elapsed, open),
+            "server_cache_hit_ratio": (server_known && hits + misses > 0.0).then(|| hits / (hits + misses)),
+            "server_syntheses": server_known.then(|| textile_core::MODE_NAMES.iter().map(|m| d(&format!("textile_syntheses_total{{mode=\"{m}\"}}"))).sum::<f64>() as u64),
+            "server_computation_ratio": ratio.filter(|_| server_known),
+            "server_metrics": server_known,
+            // A row per second of the run as asked (its measured end is a hair later).
+            "timeline": report::timeline(all, duration.min(elapsed), open),
         });
         if open {
             report["rate"] = match &model {
@@ -264,6 +278,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             report["latency_ms_uncorrected"] = report::percentiles(&report::latencies(all, false, false));
             report["late_sends"] = json!(late);
             report["unsent"] = json!(out.unsent);
+            report["offered"] = json!(all.len());
         }
         let mismatches = load.mismatches.lock().unwrap_or_else(|e| e.into_inner()).clone();
         let mismatched: u64 = all.iter().filter(|s| s.mismatch).count() as u64;
@@ -310,8 +325,8 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             a.pattern,
             a.texture,
             elapsed,
-            all.len(),
-            all.len() as f64 / elapsed,
+            sent,
+            sent as f64 / elapsed,
             bytes as f64 / 1048576.0
         );
         if open {
@@ -324,21 +339,33 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             let _ = writeln!(w, "  200 only: {}", report::line(&report["latency_ms_200"]));
         }
         let _ = writeln!(w, "status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
-        if open && (late > 0 || out.unsent > 0) {
+        let timed_out = statuses.get("timed_out").copied().unwrap_or(0);
+        if open && (timed_out > 0 || out.unsent > 0) {
+            let unanswered = timed_out + out.unsent;
             let _ = writeln!(
                 w,
-                "the client could not keep up: {late} sends more than {} ms late, {} never sent (every connection busy)",
-                LATE.as_millis(),
+                "NO ANSWER for {unanswered} of {} requests offered ({:.0} %): {timed_out} timed out in flight, {} never \
+                 sent (every connection was waiting on the server); each counts in the corrected latency at least \
+                 until the end of the run",
+                all.len(),
+                100.0 * unanswered as f64 / all.len().max(1) as f64,
                 out.unsent
             );
         }
-        let _ = writeln!(
-            w,
-            "server: cache hit ratio {} ({hits} hits, {misses} misses), {} syntheses, computation ratio {}",
-            na(&report["server_cache_hit_ratio"]),
-            report["server_syntheses"],
-            na(&report["server_computation_ratio"])
-        );
+        if open && late > 0 {
+            let _ = writeln!(w, "{late} sends more than {} ms late", LATE.as_millis());
+        }
+        if server_known {
+            let _ = writeln!(
+                w,
+                "server: cache hit ratio {} ({hits} hits, {misses} misses), {} syntheses, computation ratio {}",
+                na(&report["server_cache_hit_ratio"]),
+                report["server_syntheses"],
+                na(&report["server_computation_ratio"])
+            );
+        } else {
+            let _ = writeln!(w, "server: its /metrics did not answer within {} s: figures unknown", METRICS_GRACE.as_secs());
+        }
         if verifying {
             let _ = writeln!(w, "verified: {} answers against their references, {mismatched} differed", report["verified"]);
         }

@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use hdrhistogram::Histogram;
 use serde_json::{json, Value};
 
-use super::drive::{Sample, TIMED_OUT, TRANSPORT_ERROR};
+use super::drive::{Sample, NEVER_SENT, TIMED_OUT, TRANSPORT_ERROR};
 
 /// Microseconds, 1 µs to an hour, three significant digits.
 pub fn histogram<'a>(latencies: impl Iterator<Item = std::time::Duration> + 'a) -> Histogram<u64> {
@@ -20,14 +20,30 @@ pub fn histogram<'a>(latencies: impl Iterator<Item = std::time::Duration> + 'a) 
     h
 }
 
-/// The latencies of the samples that ended with an answer (`ok_only`: a 200), corrected or not.
+/// Whether a sample's latency enters a histogram: an answer (`ok_only`: a 200); and, from the
+/// intended send time (`corrected`), a request unanswered by the end too — timed out in flight
+/// or never sent — whose latency is then at least the end of the run minus when it was due, so
+/// a stalled server shows as the disaster it is instead of vanishing from the figures.
+fn counted(s: &Sample, ok_only: bool, corrected: bool) -> bool {
+    match s.status {
+        200 => true,
+        _ if ok_only => false,
+        TRANSPORT_ERROR => false,
+        _ if s.unanswered() => corrected,
+        _ => true,
+    }
+}
+
+/// The latencies of the samples that ended with an answer (`ok_only`: a 200), corrected or not;
+/// corrected, the unanswered ones too (see [`counted`]).
 pub fn latencies(samples: &[Sample], ok_only: bool, corrected: bool) -> Histogram<u64> {
-    histogram(
-        samples
-            .iter()
-            .filter(|s| s.status != TIMED_OUT && s.status != TRANSPORT_ERROR && (!ok_only || s.status == 200))
-            .map(|s| if corrected { s.corrected() } else { s.uncorrected() }),
-    )
+    histogram(samples.iter().filter(|s| counted(s, ok_only, corrected)).map(|s| {
+        if corrected {
+            s.corrected()
+        } else {
+            s.uncorrected()
+        }
+    }))
 }
 
 /// Percentiles in milliseconds; null when there is nothing to measure.
@@ -52,6 +68,7 @@ pub fn statuses(samples: &[Sample]) -> BTreeMap<String, u64> {
         let key = match s.status {
             TRANSPORT_ERROR => "error".to_string(),
             TIMED_OUT => "timed_out".to_string(),
+            NEVER_SENT => "never_sent".to_string(),
             c => c.to_string(),
         };
         *m.entry(key).or_insert(0) += 1;
@@ -63,10 +80,12 @@ pub fn statuses(samples: &[Sample]) -> BTreeMap<String, u64> {
 /// were sent): requests, errors, and p50 / p99 of the latency the report leads with
 /// (`corrected` for the open model) — what became of the load offered that second, as
 /// open-model tools chart it. Answers still arriving after the last send (the drain) count
-/// with their requests' seconds, so a run of `D` seconds has `D` rows; `seconds` (the run's
-/// length) sizes the timeline of a run that sent nothing.
+/// with their requests' seconds, and every second of the run has its row, sends or none (a run
+/// of `D` seconds has at least `D` rows). Requests never sent count in the second they were due,
+/// and with the corrected latency, they and those timed out count at their latency to the end.
 pub fn timeline(samples: &[Sample], seconds: f64, corrected: bool) -> Vec<Value> {
-    let n = samples.iter().map(|s| s.intended.as_secs() as usize + 1).max().unwrap_or(seconds.ceil().max(1.0) as usize);
+    let last = samples.iter().map(|s| s.intended.as_secs() as usize + 1).max().unwrap_or(0);
+    let n = last.max((seconds - 1e-6).ceil().max(1.0) as usize);
     let mut by: Vec<Vec<&Sample>> = vec![Vec::new(); n];
     for s in samples {
         by[s.intended.as_secs() as usize].push(s);
@@ -74,12 +93,13 @@ pub fn timeline(samples: &[Sample], seconds: f64, corrected: bool) -> Vec<Value>
     by.iter()
         .enumerate()
         .map(|(i, v)| {
-            let answered: Vec<&&Sample> =
-                v.iter().filter(|s| s.status != TIMED_OUT && s.status != TRANSPORT_ERROR).collect();
-            let h = histogram(answered.iter().map(|s| if corrected { s.corrected() } else { s.uncorrected() }));
+            let counted: Vec<&&Sample> = v.iter().filter(|s| counted(s, false, corrected)).collect();
+            let h = histogram(counted.iter().map(|s| if corrected { s.corrected() } else { s.uncorrected() }));
             let q = |p: f64| (!h.is_empty()).then(|| h.value_at_quantile(p) as f64 / 1e3);
             json!({
-                "second": i, "requests": v.len(), "errors": v.iter().filter(|s| s.is_error()).count(),
+                "second": i, "requests": v.iter().filter(|s| s.was_sent()).count(),
+                "unanswered": v.iter().filter(|s| s.unanswered()).count(),
+                "errors": v.iter().filter(|s| s.is_error()).count(),
                 "p50_ms": q(0.5), "p99_ms": q(0.99),
             })
         })
