@@ -241,6 +241,9 @@ fn verification_passes_on_a_healthy_server_and_names_a_mismatch() {
     let r = loadtest(&s.base, &[&common[..], &["--verify", "--record", refs_s]].concat());
     assert_eq!(r["verified"], 30, "{r}");
     assert_eq!(r["mismatched"], 0, "{r}");
+    // The references are fetched after the run: the measured run made its three tiles itself
+    // (fetched before, they would have been cache hits: 0 syntheses).
+    assert_eq!(r["server_syntheses"], 3, "{r}");
     let text = std::fs::read_to_string(&refs).unwrap();
     let lines: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
     assert_eq!(lines.len(), 3, "{text}");

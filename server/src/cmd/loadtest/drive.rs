@@ -127,6 +127,10 @@ pub struct Load {
     pub references: Option<Arc<References>>,
     /// Paths whose answers differed from their reference: (expected, got, how often).
     pub mismatches: Mutex<std::collections::BTreeMap<String, (String, String, u64)>>,
+    /// Verifying, the digests of the 200 answers of paths without a reference yet, by path and
+    /// digest, with their counts: checked once the references are fetched after the run (so
+    /// that fetching them does not warm the server's cache for the measured run).
+    pub unchecked: Mutex<std::collections::BTreeMap<String, std::collections::BTreeMap<String, u64>>>,
 }
 
 /// Seconds after the start at which arrival `i` is due, at a rate going linearly from `from` to
@@ -194,7 +198,12 @@ impl Load {
             Ok(Err(_)) => return Answer { status: TRANSPORT_ERROR, bytes: 0, retry: None, mismatch: false },
             Err(_) => return Answer { status: TIMED_OUT, bytes: 0, retry: None, mismatch: false },
         };
-        let expected = self.references.as_ref().filter(|_| status == 200).and_then(|r| r.get(path));
+        let references = self.references.as_ref().filter(|_| status == 200);
+        if references.is_some_and(|r| !r.contains_key(path)) {
+            let mut u = self.unchecked.lock().unwrap_or_else(|e| e.into_inner());
+            *u.entry(path.to_string()).or_default().entry(digest(&body)).or_insert(0) += 1;
+        }
+        let expected = references.and_then(|r| r.get(path));
         let mismatch = match expected {
             Some(want) => {
                 let got = digest(&body);

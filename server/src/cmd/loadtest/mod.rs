@@ -176,7 +176,6 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             .await?;
         let native = meta["native_zoom"].as_u64().ok_or_else(|| format!("no texture '{}' at {root}", a.texture))? as u32;
         let minzoom = meta["minzoom"].as_u64().unwrap_or(0) as u32;
-        let distinct_lines = lines.clone();
         let paths = Arc::new(Mutex::new(pattern::pattern(
             &a.pattern,
             &a.texture,
@@ -197,34 +196,28 @@ pub fn run(a: LoadtestArgs) -> CliResult {
                 progress,
                 references,
                 mismatches: Default::default(),
+                unchecked: Default::default(),
             })
         };
         // The warm-up runs the same load; nothing of it enters the figures.
         if let Some(w) = a.warmup {
             let _ = make(None).run(Phase { seconds: w, max_requests: u64::MAX }).await;
         }
-        // Verification: the run's distinct paths (a replay's lines, or the next N of the pattern,
-        // which the run then plays) get their references before the load starts.
-        let references = if verifying {
-            let distinct: Vec<String> = if a.pattern == "replay" {
-                distinct_lines
-            } else {
+        // Verification: the run plays known paths (a replay's lines, or the next N of the
+        // pattern); answers are checked during the run against the references `--expect` gave,
+        // and against those fetched after the run (one at a time, nothing else running) for the
+        // rest — after, so that fetching them does not warm the cache the run measures.
+        let known = if verifying {
+            if a.pattern != "replay" {
                 let mut p = paths.lock().unwrap_or_else(|e| e.into_inner());
                 let drawn: Vec<String> = p.by_ref().take(max_requests as usize).collect();
-                *p = Box::new(drawn.clone().into_iter());
-                drawn
-            };
-            let mut seen = std::collections::HashSet::new();
-            let distinct = distinct.into_iter().filter(|d| seen.insert(d.clone()));
-            verify::fetch(&client, &root, distinct, &mut references).await?;
-            if let Some(f) = &a.record {
-                verify::write(f, &root, &references)?;
+                *p = Box::new(drawn.into_iter());
             }
-            Some(Arc::new(std::mem::take(&mut references)))
+            Some(Arc::new(references.clone()))
         } else {
             None
         };
-        let load = make(references);
+        let load = make(known);
         // The server's counters around the run, each asked for at most METRICS_GRACE: a stalled
         // server must not hold the run past its deadline (its figures are then unknown).
         let metrics = || async {
@@ -280,8 +273,25 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             report["unsent"] = json!(out.unsent);
             report["offered"] = json!(all.len());
         }
+        // The answers of paths that had no reference, against the references fetched now.
+        let unchecked = std::mem::take(&mut *load.unchecked.lock().unwrap_or_else(|e| e.into_inner()));
+        let mut late_mismatched = 0u64;
+        if verifying {
+            verify::fetch(&client, &root, unchecked.keys().cloned(), &mut references).await?;
+            let mut m = load.mismatches.lock().unwrap_or_else(|e| e.into_inner());
+            for (path, digests) in &unchecked {
+                let Some(want) = references.get(path) else { continue };
+                for (got, n) in digests.iter().filter(|(got, _)| *got != want) {
+                    m.entry(path.clone()).or_insert_with(|| (want.clone(), got.clone(), 0)).2 += n;
+                    late_mismatched += n;
+                }
+            }
+            if let Some(f) = &a.record {
+                verify::write(f, &root, &references)?;
+            }
+        }
         let mismatches = load.mismatches.lock().unwrap_or_else(|e| e.into_inner()).clone();
-        let mismatched: u64 = all.iter().filter(|s| s.mismatch).count() as u64;
+        let mismatched: u64 = all.iter().filter(|s| s.mismatch).count() as u64 + late_mismatched;
         if verifying {
             report["verified"] = json!(all.iter().filter(|s| s.status == 200).count());
             report["mismatched"] = json!(mismatched);
