@@ -224,15 +224,6 @@ pub fn remove_record(dir: &Path, id: &str) -> std::io::Result<()> {
     }
 }
 
-/// Remove an uploaded texture's files: its configuration first (so an interruption leaves an
-/// orphan that start-up removes, never a half texture), then its exemplar, then its analysis
-/// and what its modes prepared in `data_dir`.
-pub fn remove(dir: &Path, data_dir: &Path, id: &str) -> std::io::Result<()> {
-    remove_record(dir, id)?;
-    remove_files(dir, data_dir, id);
-    Ok(())
-}
-
 /// Remove the files of an uploaded texture whose record is gone (best effort: what is left is
 /// an orphan the next start removes).
 pub fn remove_files(dir: &Path, data_dir: &Path, id: &str) {
@@ -461,7 +452,8 @@ mod tests {
         assert_eq!(std::fs::read(listed[0].map_images().next().unwrap().1).unwrap(), b"height");
         assert!(!dir.join("orphan.jpg").exists());
         assert!(dir.join("fresh.jpg").exists(), "a file just written may be an upload in progress");
-        remove(&dir, d.path(), "one").unwrap();
+        remove_record(&dir, "one").unwrap();
+        remove_files(&dir, d.path(), "one");
         assert!(stored(&dir, &|_| {}).is_empty());
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
     }

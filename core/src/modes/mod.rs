@@ -342,9 +342,22 @@ macro_rules! modes {
                 all
             }
 
-            /// Whether each mode has its state, by mode name.
-            fn ready(&self) -> Vec<(&'static str, bool)> {
-                vec![$((<$module::$ty as Mode>::NAME, self.$module.get().is_some())),+]
+            /// Mode `mode`'s state without its type, once prepared (none for a mode that
+            /// prepares nothing).
+            pub fn state_of(&self, mode: &str) -> Option<Arc<dyn State>> {
+                $(if mode == <$module::$ty as Mode>::NAME {
+                    return self.$module.get().and_then(ModeState::erased);
+                })+
+                None
+            }
+
+            /// Whether mode `mode` has what it needs to render (a mode that prepares nothing
+            /// always has).
+            pub fn has(&self, mode: &str) -> bool {
+                $(if mode == <$module::$ty as Mode>::NAME {
+                    return self.$module.get().is_some();
+                })+
+                false
             }
         }
 

@@ -84,8 +84,6 @@ pub(crate) fn with_state<M: Slot, R>(prepared: Option<&Prepared>, f: impl FnOnce
 /// A mode's preparation without naming the mode: its constants, and [`load_or_compute`] into
 /// the mode's slot.
 pub trait Step: Send + Sync {
-    /// The mode it prepares for.
-    fn mode(&self) -> &'static str;
     /// See [`Preparation::WHAT`].
     fn what(&self) -> &'static str;
     /// See [`Preparation::EXTENSION`].
@@ -118,9 +116,6 @@ impl<M: Slot> Step for StepOf<M>
 where
     M::State: Preparation,
 {
-    fn mode(&self) -> &'static str {
-        M::NAME
-    }
     fn what(&self) -> &'static str {
         <M::State as Preparation>::WHAT
     }
@@ -183,13 +178,7 @@ impl Prepared {
     /// What the states of mode `mode` add to its ETags (empty while there is none, or when the
     /// exemplar determines it).
     pub fn etag(&self, mode: &str) -> String {
-        self.all().into_iter().find(|(m, _)| *m == mode).map(|(_, s)| s.etag()).unwrap_or_default()
-    }
-
-    /// Whether mode `mode` has what it needs to render (a mode that prepares nothing always
-    /// has).
-    pub fn has(&self, mode: &str) -> bool {
-        self.ready().into_iter().any(|(m, ready)| m == mode && ready)
+        self.state_of(mode).map(|s| s.etag()).unwrap_or_default()
     }
 
     /// Bytes held by all states.

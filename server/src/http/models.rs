@@ -32,13 +32,12 @@ pub(super) fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'
 
 /// A .gltf document's sibling image: the slot (`slot=NAME`) among its pairs, if any, which the
 /// texture must have a map for.
-fn sibling_slot(model: &Model, pairs: &mut Vec<(String, String)>) -> Result<Option<Slot>, ApiError> {
-    let Some(i) = pairs.iter().position(|(k, _)| k == SLOT) else { return Ok(None) };
-    let (_, v) = pairs.remove(i);
-    let slot = Slot::parse(&v).ok_or_else(|| {
+fn sibling_slot(model: &Model, pairs: &[(String, String)]) -> Result<Option<Slot>, ApiError> {
+    let Some((_, v)) = pairs.iter().find(|(k, _)| k == SLOT) else { return Ok(None) };
+    let slot = Slot::parse(v).ok_or_else(|| {
         ApiError::bad_request(
             "invalid_map",
-            format!("slot '{}' is not a material image of this texture", textile_core::error::clip(&v)),
+            format!("slot '{}' is not a material image of this texture", textile_core::error::clip(v)),
         )
     })?;
     if !model.material_maps().iter().any(|(s, _)| s.image() == slot) {
@@ -76,14 +75,14 @@ fn tile_request(
         _ => (y, raw),
     };
     let spec = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
-    let mut pairs = query_pairs(raw.as_deref());
+    let pairs = query_pairs(raw.as_deref());
     if ext != "png" {
         return Ok((Model::request(tex, spec, pairs)?, ext.to_string(), None));
     }
     // The slot is read after the parameters, as a key of the sibling's own.
     let without: Vec<(String, String)> = pairs.iter().filter(|(k, _)| k != SLOT).cloned().collect();
     let model = Model::request(tex, spec, without)?;
-    let slot = sibling_slot(&model, &mut pairs)?;
+    let slot = sibling_slot(&model, &pairs)?;
     Ok((model, ext.to_string(), slot))
 }
 
