@@ -46,6 +46,38 @@ fn analyze_then_info() {
 }
 
 #[test]
+fn analyze_detects_a_lattice_and_info_prints_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("brick.tex");
+    let (code, stdout, err) = run(&["analyze", &exemplar("brick.png"), "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("lattice: stripes every (18."), "brick's courses are found: {stdout}");
+    let (code, info, err) = run(&["info", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(info.contains("lattice:           stripes every (18.") && info.contains("detected"), "{info}");
+    // Turned off, and given as waves.
+    let (code, stdout, err) =
+        run(&["analyze", &exemplar("brick.png"), "--lattice", "none", "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("lattice: none"), "{stdout}");
+    let (code, stdout, err) =
+        run(&["analyze", &exemplar("brick.png"), "--lattice", "18.5@0", "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("stripes every (18.50, 0.00) texels, given"), "{stdout}");
+    // Gravel has none; a bad spelling is a clear error that writes nothing.
+    let (_, stdout, _) = run(&["analyze", &exemplar("gravel.png"), "-o", out.to_str().unwrap()]);
+    assert!(stdout.contains("lattice: none, stochastic"), "{stdout}");
+    let bad = dir.path().join("bad.tex");
+    for spelling in ["sometimes", "1@0,1@1", "20@0,20@5", "3,4"] {
+        let (code, _, err) =
+            run(&["analyze", &exemplar("brick.png"), "--lattice", spelling, "-o", bad.to_str().unwrap()]);
+        assert_ne!(code, 0, "{spelling}");
+        assert!(err.contains("lattice"), "{spelling}: {err}");
+        assert!(!bad.exists(), "{spelling}");
+    }
+}
+
+#[test]
 fn bad_inputs_are_clear_errors_and_leave_no_file() {
     let dir = tempfile::tempdir().unwrap();
     let text = dir.path().join("notes.png");

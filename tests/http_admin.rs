@@ -197,6 +197,7 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     assert_eq!(status, 200);
     let meta = until_ready(&s, &location).await;
     assert_eq!((meta["name"].as_str(), meta["uploaded"].as_bool()), (Some("My brick"), Some(true)));
+    assert_eq!(meta["exemplar"]["lattice"]["kind"], "stripes", "uploads detect the lattice: {}", meta["exemplar"]);
     let (status, tile) = s.get_bytes("/tiles/mine/7/1/2.png?seed=3").await;
     assert_eq!(status, 200);
     let out = tempfile::tempdir().unwrap();

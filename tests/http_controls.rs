@@ -73,7 +73,9 @@ async fn a_lattice_is_configured_served_and_checked() {
     let dir = tempfile::tempdir().unwrap();
     let s = Server::builder().start();
     let meta = s.json("/textures/corkboard").await;
-    assert_eq!(meta["exemplar"]["lattice"], serde_json::json!([2, 4]), "{meta}");
+    let lattice = &meta["exemplar"]["lattice"];
+    assert_eq!((lattice["kind"].as_str(), lattice["origin"].as_str()), (Some("grid"), Some("given")), "{meta}");
+    assert_eq!(lattice["basis"], serde_json::json!([[0.0, 32.0], [64.0, 0.0]]), "{meta}");
     assert_eq!(meta["exemplar"]["toroidal"], true);
     assert_eq!(s.json("/textures/gravel").await["exemplar"]["lattice"], serde_json::Value::Null);
     // Tiles under the lattice are one window, and what `textile render --lattice` makes of the

@@ -75,13 +75,17 @@ async fn zoomed_out_tiles_are_reduced_views_of_their_children() {
     // mean of the exemplar block under each (so it costs what a native tile does): close to its
     // children box-filtered, not exact — what the finer levels' correction moved differs. Bound
     // 8 of 255 per channel, as core/tests/zoom_consistency.rs keeps for synth (measured there
-    // on 16 tiles: gravel 3.5, 5.6, 7.2 one to three steps out; brick at most 4.2).
+    // on 16 tiles: gravel 3.5, 5.6, 7.2 one to three steps out). Brick's detected lattice
+    // holds its columns at every level while the bricks along them stay free, so where its
+    // thin, bright mortar falls along a column differs more between levels: 8.3 here (4.2
+    // before the lattice), the columns in place in both; its bound is 10.
     for (id, z, x, y) in [("gravel", 6, 0, 0), ("brick", 6, -3, 2), ("gravel", 5, 0, 0), ("gravel", 4, 1, -1)] {
         let parent = s.image(&format!("/tiles/{id}/{z}/{x}/{y}.png")).await;
         let children = block(&s, id, z + 1, 2 * x, 2 * y, "").await;
         let mad = mean_abs_diff(&parent, &box_half(&children));
         eprintln!("{id}: z{z} vs z{} mean abs difference {mad}", z + 1);
-        assert!(mad < 8.0, "{id} z{z}: mean abs difference {mad}");
+        let bound = if id == "brick" { 10.0 } else { 8.0 };
+        assert!(mad < bound, "{id} z{z}: mean abs difference {mad}");
     }
 }
 

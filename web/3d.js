@@ -190,8 +190,13 @@ async function selectTexture(id, keepView) {
   state.t = id;
   const modes = $('mode');
   modes.textContent = '';
-  for (const m of meta.modes) modes.append(new Option(m, m));
-  if (!meta.modes.includes(state.m)) state.m = meta.default_mode;
+  const declined = meta.declined_modes || {};
+  for (const m of meta.modes) {
+    const o = new Option(declined[m] ? `${m} (declines this texture)` : m, m);
+    if (declined[m]) { o.disabled = true; o.title = declined[m]; }
+    modes.append(o);
+  }
+  if (!meta.modes.includes(state.m) || declined[state.m]) state.m = meta.default_mode;
   modes.value = state.m;
   buildParams();
   $('sun').value = state.sun;

@@ -8,7 +8,7 @@
 // a: the map shown (albedo, a material map, or 'lit': colour shaded by the normal map); l: the
 // light's direction in degrees for 'lit'.
 const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false, a: 'albedo', l: 135 };
-let catalog = null, meta = null, map = null, layer = null, grid = null, debounce = null;
+let catalog = null, meta = null, map = null, layer = null, grid = null, latticeLayer = null, debounce = null;
 const $ = (id) => document.getElementById(id);
 
 function readHash() {
@@ -275,11 +275,17 @@ async function selectTexture(id, keepView) {
   $('thumb').src = entry ? entry.exemplar : '';
   const modes = $('mode');
   modes.textContent = '';
-  for (const m of meta.modes) modes.append(new Option(m, m));
-  if (!meta.modes.includes(state.m)) state.m = meta.default_mode;
+  const declined = meta.declined_modes || {};
+  for (const m of meta.modes) {
+    const o = new Option(declined[m] ? `${m} (declines this texture)` : m, m);
+    if (declined[m]) { o.disabled = true; o.title = declined[m]; }
+    modes.append(o);
+  }
+  if (!meta.modes.includes(state.m) || declined[state.m]) state.m = meta.default_mode;
   modes.value = state.m;
   buildMapPicker();
   buildControls();
+  showLatticeRow();
   map.setMinZoom(meta.minzoom);
   map.setMaxZoom(meta.maxzoom + 2);
   if (layer) { map.removeLayer(layer); layer = null; }
@@ -305,6 +311,62 @@ function setGrid(on) {
     grid = null;
   }
   writeHash();
+}
+
+// The texture's lattice drawn over the map: for each wave (period p texels, normal at angle a)
+// the lines where the texel coordinates' projection on the normal is a multiple of p — the
+// spacing and direction the modes keep (their phase is the texture's own).
+function latticeLines(canvas, c) {
+  const lat = meta && meta.exemplar.lattice;
+  const ctx = canvas.getContext('2d');
+  if (!lat) return;
+  const per = 2 ** (native() - c.z); // texels per screen pixel
+  const x0 = c.x * 256 * per, y0 = c.y * 256 * per;
+  ctx.strokeStyle = 'rgba(0, 255, 255, 0.85)';
+  ctx.lineWidth = 1;
+  for (const w of lat.waves) {
+    const spacing = w.period / per; // screen pixels between lines
+    if (spacing < 4) continue;
+    const t = (w.angle * Math.PI) / 180, nx = Math.cos(t), ny = Math.sin(t);
+    // Projections of the tile's corners on the normal bound the lines that cross it.
+    const ds = [[0, 0], [256, 0], [0, 256], [256, 256]].map(([u, v]) => (x0 / per + u) * nx + (y0 / per + v) * ny);
+    const first = Math.ceil(Math.min(...ds) / spacing), last = Math.floor(Math.max(...ds) / spacing);
+    ctx.beginPath();
+    for (let k = first; k <= last; k++) {
+      const d = k * spacing - (x0 / per) * nx - (y0 / per) * ny; // line: u nx + v ny = d
+      const big = 1024;
+      ctx.moveTo(d * nx - big * ny, d * ny + big * nx);
+      ctx.lineTo(d * nx + big * ny, d * ny - big * nx);
+    }
+    ctx.stroke();
+  }
+}
+
+function showLatticeRow() {
+  const lat = meta && meta.exemplar.lattice;
+  $('latticerow').hidden = !lat;
+  if (!lat) { setLattice(false); return; }
+  const waves = lat.waves.map((w) => `${w.period.toFixed(2)} px at ${w.angle.toFixed(1)}°`).join(', ');
+  $('latticeinfo').textContent = `${lat.kind}: ${waves} (${lat.origin}, confidence ${lat.confidence})`;
+  if (latticeLayer) latticeLayer.redraw();
+}
+
+function setLattice(on) {
+  $('lattice').checked = on;
+  if (on && !latticeLayer) {
+    latticeLayer = L.gridLayer({ tileSize: 256, noWrap: true, zIndex: 11 });
+    latticeLayer.createTile = (c) => {
+      const canvas = document.createElement('canvas');
+      canvas.width = canvas.height = 256;
+      canvas.className = 'lattice-tile';
+      latticeLines(canvas, c);
+      return canvas;
+    };
+    latticeLayer.addTo(map);
+  } else if (!on && latticeLayer) {
+    map.removeLayer(latticeLayer);
+    latticeLayer = null;
+  }
 }
 
 function onMove() {
@@ -408,6 +470,7 @@ async function init() {
   });
   $('resetp').addEventListener('click', () => { state.p = {}; buildControls(); refreshLayer(); });
   $('grid').addEventListener('change', (e) => setGrid(e.target.checked));
+  $('lattice').addEventListener('change', (e) => setLattice(e.target.checked));
   setupUpload();
   $('worldlink').addEventListener('click', (e) => {
     e.currentTarget.href = `/world.html#t=${encodeURIComponent(state.t)}&m=${state.m}&s=${state.s}`;

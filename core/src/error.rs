@@ -126,6 +126,15 @@ pub enum CoreError {
         /// What is wrong with it.
         message: String,
     },
+    /// The mode does not serve this texture (umbrella on a near-regular exemplar, whose lattice
+    /// its patch collage would break); `reason` says why and what serves it instead.
+    #[error("mode={mode} does not serve this texture: {reason}")]
+    Declined {
+        /// The mode asked for.
+        mode: &'static str,
+        /// Why, in a sentence.
+        reason: String,
+    },
     /// The work was abandoned: its requester went away, or the service is stopping.
     #[error("cancelled: the requester went away or the service is stopping")]
     Cancelled,

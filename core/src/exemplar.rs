@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
-use crate::lattice::Lattice;
+use crate::lattice::{Lattice, LatticeChoice};
 use crate::maps::{MaterialMap, NormalConvention};
 use crate::mask::RandomnessMask;
 
@@ -175,9 +175,7 @@ impl Exemplar {
             h.update(mask.hash.as_bytes());
         }
         if let Some(l) = &self.lattice {
-            h.update(b"lattice");
-            h.update(&l.nx.to_le_bytes());
-            h.update(&l.ny.to_le_bytes());
+            l.hash_into(h);
         }
         if let Some(hires) = &self.hires {
             h.update(b"hires");
@@ -291,7 +289,17 @@ impl Exemplar {
                 message: "needs a toroidal exemplar (the lattice tiles it, so it wraps around): set toroidal".into(),
             });
         }
-        self.lattice = Some(Lattice::new(nx, ny, self.side)?);
+        self.lattice = Some(Lattice::cells(nx, ny, self.side)?);
+        Ok(self)
+    }
+
+    /// This exemplar with the lattice `choice` gives it: detected from its pixels (`auto`),
+    /// none, cells ([`Exemplar::with_lattice`]) or given waves.
+    pub fn with_lattice_choice(mut self, choice: &LatticeChoice) -> Result<Exemplar> {
+        if let LatticeChoice::Cells(nx, ny) = *choice {
+            return self.with_lattice(nx, ny);
+        }
+        self.lattice = choice.resolve(&self.pixels, self.side)?;
         Ok(self)
     }
 }

@@ -88,9 +88,10 @@ fn windows_with_a_lattice_are_stitched_parts() {
 
 #[test]
 fn coarse_candidates_keep_their_lattice_phase() {
-    // 16×16 cells of 8×8 texels on a 128² exemplar: levels of stride 8 and 4 (at least half a
-    // cell) keep the phase, stride 2 and 1 do not have to.
-    let ex = common::toroidal_exemplar(128, 11).with_lattice(16, 16).unwrap();
+    // 4×4 cells of 32×32 texels on a 128² exemplar: a grid wave repeating 4 times holds from
+    // a quarter of its period up, so levels of stride 8 and more keep the phase, stride 4, 2
+    // and 1 do not have to.
+    let ex = common::toroidal_exemplar(128, 11).with_lattice(4, 4).unwrap();
     let an = Analysis::build(&ex, &NoProgress);
     let free = Analysis::build(&common::toroidal_exemplar(128, 11), &NoProgress);
     assert_ne!(an.header.id, free.header.id, "the lattice is part of the analysis id");
@@ -104,10 +105,10 @@ fn coarse_candidates_keep_their_lattice_phase() {
             .filter(|(u, c)| {
                 let (ux, uy) = ((u % 128) as u32, (u / 128) as u32);
                 let (vx, vy) = (c[1].coord & 0xFFFF, c[1].coord >> 16);
-                vx % 8 != ux % 8 || vy % 8 != uy % 8
+                vx % 32 != ux % 32 || vy % 32 != uy % 32
             })
             .count();
-        if 2 * h >= 8 {
+        if 4 * h >= 32 {
             assert_eq!(off_phase, 0, "level {l} (stride {h})");
         } else {
             assert!(off_phase > 0, "level {l} (stride {h}) should be free");

@@ -102,6 +102,7 @@ impl From<CoreError> for ApiError {
             CoreError::Window { .. } => Self::bad_request("invalid_window", msg),
             CoreError::Map { .. } => Self::bad_request("invalid_map", msg),
             CoreError::Sample { .. } => Self::bad_request("invalid_sample", msg),
+            CoreError::Declined { .. } => Self::new(Kind::Unprocessable, "mode_declines_texture", msg),
             CoreError::Cancelled => Self::new(Kind::Unavailable, "cancelled", msg),
             CoreError::ExemplarUndecodable(_) => Self::new(Kind::Unprocessable, "undecodable_image", msg),
             CoreError::ExemplarSize { .. } => Self::new(Kind::Unprocessable, "image_size", msg),

@@ -382,6 +382,39 @@ test('the map picker shows a material\'s maps, and the lit view shades colour by
   await page.close();
 });
 
+test('a near-regular texture shows its lattice, overlays it, and greys out the mode that declines it', async () => {
+  const { page, errors } = await open('/#t=brick&m=umbrella&z=7&x=0&y=0');
+  await settled(page);
+  const meta = await page.evaluate(async () => (await fetch('/textures/brick')).json());
+  assert.ok(meta.declined_modes.umbrella, JSON.stringify(meta.declined_modes));
+  // The declined mode is offered disabled, with its reason, and the view fell back to another.
+  const umbrella = await page.$eval('#mode option[value="umbrella"]', (o) => ({ disabled: o.disabled, title: o.title }));
+  assert.deepEqual(umbrella, { disabled: true, title: meta.declined_modes.umbrella });
+  assert.notEqual(await page.$eval('#mode', (s) => s.value), 'umbrella');
+  assert.ok(await page.evaluate(() => [...document.querySelectorAll('img.leaflet-tile')].every((i) => !i.src.includes('mode=umbrella'))));
+  // The lattice row names the detected waves; the overlay draws its lines.
+  assert.equal(await page.$eval('#latticerow', (r) => r.hidden), false);
+  const info = await page.$eval('#latticeinfo', (o) => o.textContent);
+  assert.match(info, new RegExp(`^stripes: ${meta.exemplar.lattice.waves[0].period.toFixed(2)} px`), info);
+  await page.check('#lattice');
+  await page.waitForSelector('canvas.lattice-tile');
+  const lines = await page.$$eval('canvas.lattice-tile', (cs) => cs.map((c) => {
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let cyan = 0;
+    for (let i = 0; i < d.length; i += 4) if (d[i + 3] > 100 && d[i + 1] > 200 && d[i + 2] > 200 && d[i] < 80) cyan++;
+    return cyan;
+  }));
+  // Stripes every ~18 texels: about 14 one-pixel lines down each 256 px tile.
+  assert.ok(lines.length > 0 && lines.every((n) => n > 256 * 8), JSON.stringify(lines));
+  // A stochastic texture has no lattice row.
+  await page.selectOption('#texture', 'gravel');
+  await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('/tiles/gravel/')));
+  assert.equal(await page.$eval('#latticerow', (r) => r.hidden), true);
+  assert.equal(await page.$$eval('canvas.lattice-tile', (cs) => cs.length), 0);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('readable on a phone-sized viewport', async () => {
   const { page, errors } = await open('/', { width: 390, height: 844 });
   await settled(page, 1);

@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use crate::analysis::features::SEARCH_DIMS;
 use crate::analysis::kdtree::KdTree;
 use crate::error::{CoreError, Result};
+use crate::lattice::LevelLattice;
 
 /// Geometry of one level's candidate problem.
 pub struct CandidateRules {
@@ -20,9 +21,9 @@ pub struct CandidateRules {
     pub toroidal: bool,
     /// Minimum distance between the two candidates.
     pub separation: usize,
-    /// Lattice phase moduli `(px, py)` (design note §1.9, near-regular textures): `C_2(u)` only
-    /// among texels `v ≡ u (mod px, py)`; `(1, 1)` without a lattice.
-    pub phase: (usize, usize),
+    /// The lattice at this level (design note §1.9, near-regular textures): `C_2(u)` only
+    /// among texels on `u`'s phase; free without a lattice.
+    pub phase: LevelLattice,
     /// Work budget: k-d tree leaves opened per texel, on average ([`LEAVES_PER_TEXEL`]).
     pub leaves_per_texel: u64,
 }
@@ -34,24 +35,21 @@ impl CandidateRules {
             m,
             toroidal,
             separation: (m * 5).div_ceil(100),
-            phase: (1, 1),
+            phase: LevelLattice::FREE,
             leaves_per_texel: LEAVES_PER_TEXEL,
         }
     }
 
-    /// These rules with second candidates restricted to the lattice phase of their texel
-    /// (moduli `px`, `py`; 1 leaves an axis free).
-    pub fn with_phase(mut self, px: usize, py: usize) -> Self {
-        self.phase = (px.max(1), py.max(1));
+    /// These rules with second candidates restricted to the lattice phase of their texel.
+    pub fn with_phase(mut self, phase: LevelLattice) -> Self {
+        self.phase = phase;
         self
     }
 
     /// Whether `v` may be the second candidate of `u`: far enough from it, on its lattice phase.
     fn allowed(&self, v: usize, u: usize) -> bool {
-        let (px, py) = self.phase;
-        let same_phase =
-            (px == 1 || (v % self.m) % px == (u % self.m) % px) && (py == 1 || (v / self.m) % py == (u / self.m) % py);
-        same_phase && self.far_enough(v, u)
+        let d = ((v % self.m) as i64 - (u % self.m) as i64, (v / self.m) as i64 - (u / self.m) as i64);
+        self.phase.same_phase(d) && self.far_enough(v, u)
     }
 
     /// Texel `c` moved by `(dx, dy)` (wrapping when toroidal), unless that leaves the exemplar.

@@ -24,7 +24,7 @@ use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
 use crate::image::box_stack;
-use crate::lattice::Lattice;
+use crate::lattice::{Lattice, LevelLattice};
 use crate::mask::RandomnessMask;
 use crate::stack::{build_stack, to_u8};
 
@@ -248,8 +248,8 @@ impl Analysis {
                 Ok(())
             };
             let h = 1 << (levels - l);
-            let phase = ex.lattice.map_or((1, 1), |lat| lat.moduli(ex.side, h));
-            let rules = CandidateRules::new(m, ex.toroidal).with_phase(phase.0 as usize, phase.1 as usize);
+            let phase = ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, m as u32));
+            let rules = CandidateRules::new(m, ex.toroidal).with_phase(phase);
             corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search, &between)?);
         }
         progress.step(total, total, "done");
@@ -262,7 +262,7 @@ impl Analysis {
             preparation: ex.preparation.clone(),
             index: search,
             randomness_mask: ex.randomness_mask.as_ref().map(|m| m.hash.clone()),
-            lattice: ex.lattice,
+            lattice: ex.lattice.clone(),
         };
         let randomness_mask = ex.randomness_mask.clone();
         Ok(Analysis {
@@ -293,7 +293,7 @@ impl Analysis {
             preparation: h.preparation.clone(),
             hires: None,
             randomness_mask: None,
-            lattice: h.lattice,
+            lattice: h.lattice.clone(),
             maps: Vec::new(),
         }
     }

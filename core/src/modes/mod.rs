@@ -216,6 +216,13 @@ pub trait Mode {
         None
     }
 
+    /// Why the mode does not serve the texture of `src`, if it does not: its renders then
+    /// answer [`CoreError::Declined`] instead of pixels that betray the exemplar. Every
+    /// texture is served by default.
+    fn declines(_src: &Source) -> Option<String> {
+        None
+    }
+
     /// Whether the mode's pixels are exemplar texels looked up by coordinate, which
     /// [`Mode::coordinates`] then gives (`map=uv`).
     const HAS_UV: bool = false;
@@ -429,8 +436,26 @@ macro_rules! modes {
                 }
             }
 
+            /// Why the mode does not serve `src`'s texture, if it does not (see [`Mode::declines`]).
+            pub fn declines(&self, src: &Source) -> Option<String> {
+                match self {
+                    $(ModeParams::$variant(_) => <$module::$ty as Mode>::declines(src),)+
+                }
+            }
+
+            /// [`ModeParams::declines`] as the error a render answers.
+            fn served(&self, src: &Source) -> Result<()> {
+                match self.declines(src) {
+                    Some(reason) => Err(CoreError::Declined { mode: self.name(), reason }),
+                    None => Ok(()),
+                }
+            }
+
             /// A picture of what the mode prepared (see [`Mode::sheet`]).
             pub fn sheet(&self, src: &Source) -> Option<Result<RgbWindow>> {
+                if let Err(e) = self.served(src) {
+                    return Some(Err(e));
+                }
                 match self {
                     $(ModeParams::$variant(p) => prepared::with_state::<$module::$ty, _>(src.prepared, |st| Ok(<$module::$ty as Mode>::sheet(p, st, src))).unwrap_or_else(|e| Some(Err(e))),)+
                 }
@@ -441,6 +466,7 @@ macro_rules! modes {
                 if view.zoom_in > 0 {
                     magnify::check_steps(view.zoom_in)?;
                 }
+                self.served(src)?;
                 match self {
                     $(ModeParams::$variant(_) if !<$module::$ty as Mode>::HAS_UV => Err(no_uv(<$module::$ty as Mode>::NAME)),)+
                     $(ModeParams::$variant(p) => prepared::with_state::<$module::$ty, _>(src.prepared, |st| <$module::$ty as Mode>::coordinates(p, st, src, cache, view)),)+
@@ -459,6 +485,7 @@ macro_rules! modes {
             }
 
             fn render_texels(&self, src: &Source, cache: &Pyramid, view: View) -> Result<Rendered> {
+                self.served(src)?;
                 if view.zoom_in > 0 {
                     magnify::check_steps(view.zoom_in)?;
                     return match self {

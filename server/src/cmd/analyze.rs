@@ -10,10 +10,12 @@ use std::sync::Mutex;
 
 /// `textile analyze EXEMPLAR -o FILE`.
 pub fn run(a: AnalyzeArgs) -> CliResult {
-    let toroidal = toroidal_flag(&a.toroidal);
+    let toroidal = if a.lattice.needs_toroidal() { Some(true) } else { toroidal_flag(&a.toroidal) };
     let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
     ex.check_not_flat().map_err(|e| format!("{}: {e}", a.exemplar.display()))?;
     let t = std::time::Instant::now();
+    let ex = ex.with_lattice_choice(&a.lattice)?;
+    let lattice_secs = t.elapsed().as_secs_f64();
     let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"), &Cancel::new())?;
     an.save(&a.output)?;
     // What each mode prepares, beside it (`FILE.<extension>`), for `textile info` and for a
@@ -32,6 +34,10 @@ pub fn run(a: AnalyzeArgs) -> CliResult {
         )? {
             return Err(format!("{}: {e}", beside.display()).into());
         }
+    }
+    match &ex.lattice {
+        Some(l) => println!("lattice: {l} ({:.0} ms)", 1000.0 * lattice_secs),
+        None => println!("lattice: none, stochastic ({:.0} ms)", 1000.0 * lattice_secs),
     }
     println!(
         "analysed {} ({}x{} → {}x{}, toroidal {}, {} search) in {:.2}s → {} (id {})",

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
 use textile_core::analysis::IndexChoice;
+use textile_core::lattice::LatticeChoice;
 
 pub use super::flags::SettingFlags;
 use crate::config::Overrides;
@@ -101,6 +102,11 @@ pub struct AnalyzeArgs {
     /// Largest accepted exemplar side.
     #[arg(long, default_value_t = 1024)]
     pub max_side: u32,
+    /// The lattice of a near-regular exemplar: auto (detected), none, NX,NY cells of a
+    /// rectified exemplar (powers of two dividing its side; implies toroidal), or
+    /// PERIOD@ANGLE[,PERIOD@ANGLE] waves (texels, degrees of the normal).
+    #[arg(long, value_name = "LATTICE", default_value = "auto", value_parser = lattice_choice)]
+    pub lattice: LatticeChoice,
 }
 
 /// `textile tileable`.
@@ -146,11 +152,11 @@ pub struct RenderArgs {
     /// Candidate search of the on-the-fly analysis (with --exemplar): auto, exact or coherent.
     #[arg(long, default_value = "auto", value_parser = index_choice, requires = "exemplar")]
     pub index: IndexChoice,
-    /// A near-regular exemplar (with --exemplar): the NX×NY lattice cells that tile it, each
-    /// count a power of two dividing its side; the output keeps that grid. Implies a toroidal
-    /// exemplar.
-    #[arg(long, value_name = "NX,NY", value_parser = lattice_counts, requires = "exemplar")]
-    pub lattice: Option<[u32; 2]>,
+    /// The lattice of a near-regular exemplar (with --exemplar): auto (detected), none, NX,NY
+    /// cells of a rectified exemplar (powers of two dividing its side; implies toroidal), or
+    /// PERIOD@ANGLE[,PERIOD@ANGLE] waves (texels, degrees of the normal); the output keeps it.
+    #[arg(long, value_name = "LATTICE", default_value = "auto", value_parser = lattice_choice, requires = "exemplar")]
+    pub lattice: LatticeChoice,
     /// Zoom (default: the texture's native zoom).
     #[arg(long)]
     pub z: Option<u32>,
@@ -351,15 +357,7 @@ pub struct LoadtestArgs {
     pub json: bool,
 }
 
-/// `--lattice NX,NY`: two positive cell counts.
-fn lattice_counts(s: &str) -> Result<[u32; 2], String> {
-    let v: Vec<u32> = s
-        .split(',')
-        .map(|p| p.trim().parse::<u32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| "expected NX,NY: two positive integers".to_string())?;
-    match v[..] {
-        [nx, ny] if nx > 0 && ny > 0 => Ok([nx, ny]),
-        _ => Err("expected NX,NY: two positive integers".into()),
-    }
+/// `--lattice`: see [`LatticeChoice`]'s command-line spelling.
+fn lattice_choice(s: &str) -> Result<LatticeChoice, String> {
+    s.parse()
 }

@@ -58,9 +58,9 @@ pub fn run(a: InfoArgs) -> CliResult {
         println!("{:<18} {}", format!("{}:", step.what()), fields.join(", "));
         println!("{:<18} {from}", format!("{} source:", step.what()));
     }
-    if let Some(l) = h.lattice {
-        let (cw, ch) = l.cell(h.side);
-        println!("lattice:           {}x{} cells of {cw}x{ch} texels (near-regular)", l.nx, l.ny);
+    match &h.lattice {
+        Some(l) => println!("lattice:           {l} (near-regular)"),
+        None => println!("lattice:           none (stochastic)"),
     }
     Ok(())
 }

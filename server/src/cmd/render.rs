@@ -80,11 +80,9 @@ pub fn run(a: RenderArgs) -> CliResult {
     }
     let output = a.output.clone().ok_or("--output is required")?;
     let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
-        let toroidal = a.lattice.map(|_| true);
+        let toroidal = a.lattice.needs_toroidal().then_some(true);
         let mut ex = read_exemplar(path, &ExemplarOptions { toroidal, ..ExemplarOptions::default() })?;
-        if let Some([nx, ny]) = a.lattice {
-            ex = ex.with_lattice(nx, ny)?;
-        }
+        ex = ex.with_lattice_choice(&a.lattice)?;
         let an = Analysis::try_build_with(&ex, a.index, &textile_core::NoProgress, &Cancel::new())?;
         Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
     } else {

@@ -274,13 +274,13 @@ mod tests {
         assert_eq!(cfg.textures.len(), 5);
         assert_eq!(cfg.textures[4].map_images().count(), 3, "the flagstones material");
         assert_eq!(cfg.bind, "127.0.0.1:8080");
-        assert_eq!(cfg.textures[3].lattice, Some([2, 4]));
+        assert_eq!(cfg.textures[3].lattice, textile_core::lattice::LatticeChoice::Cells(2, 4));
     }
 
     #[test]
     fn a_lattice_needs_a_wrapping_exemplar() {
         let mut t = TextureConfig::new("cork", "cork.png");
-        t.lattice = Some([2, 4]);
+        t.lattice = textile_core::lattice::LatticeChoice::Cells(2, 4);
         assert!(t.validate("textures[0]").is_ok());
         t.toroidal = Toroidal::False;
         let (key, msg) = t.validate("textures[0]").unwrap_err();

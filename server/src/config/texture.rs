@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 use textile_core::analysis::IndexChoice;
 use textile_core::error::clip;
+use textile_core::lattice::LatticeChoice;
 use textile_core::maps::NormalConvention;
 use textile_core::MODE_NAMES;
 
@@ -61,10 +62,11 @@ pub struct TextureConfig {
     /// where it keeps the exemplar as it is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub randomness_mask: Option<String>,
-    /// Near-regular texture: `[nx, ny]` lattice cells that tile the (rectified) exemplar; the
-    /// output keeps the exemplar's grid while the cells vary. Makes the exemplar toroidal.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub lattice: Option<[u32; 2]>,
+    /// Near-regular texture: `"auto"` (detected from the exemplar, the default), `"none"`,
+    /// `[nx, ny]` cells that tile a rectified exemplar (makes it toroidal), or explicit waves
+    /// `[{ period = P, angle = A }, …]`; the output keeps the lattice while the cells vary.
+    #[serde(default)]
+    pub lattice: LatticeChoice,
     /// Toroidal flag.
     #[serde(default = "default_toroidal")]
     pub toroidal: Toroidal,
@@ -108,7 +110,7 @@ impl TextureConfig {
             exemplar: exemplar.into(),
             exemplar_hires: None,
             randomness_mask: None,
-            lattice: None,
+            lattice: LatticeChoice::Auto,
             toroidal: Toroidal::Auto,
             candidate_search: IndexChoice::Auto,
             default_mode: default_mode(),
@@ -137,7 +139,7 @@ impl TextureConfig {
                     "\"synthesize\" remakes the exemplar, which randomness_mask could no longer follow".into(),
                 )
             }
-            _ if self.lattice.is_some() && !matches!(self.toroidal, Toroidal::Auto | Toroidal::True) => {
+            _ if self.lattice.needs_toroidal() && !matches!(self.toroidal, Toroidal::Auto | Toroidal::True) => {
                 return bad(
                     format!("{at}.toroidal"),
                     "a lattice tiles the exemplar, which therefore wraps around: use auto or true".into(),

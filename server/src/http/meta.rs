@@ -142,12 +142,13 @@ pub async fn texture_meta(
             "crop_side": prep.crop_side, "toroidal_forced": prep.toroidal_forced,
             "toroidal_synthesized": prep.toroidal_synthesized,
             "randomness_mask": ex.randomness_mask.is_some(),
-            "lattice": ex.lattice.map(|l| [l.nx, l.ny]),
+            "lattice": ex.lattice.as_ref().map(|l| l.summary()),
         },
         "analysis": analysis,
         "maps": maps(&t),
         "prepared": prepared(&t),
         "modes": MODE_NAMES,
+        "declined_modes": declined_modes(&t),
         "default_mode": t.defaults.mode,
         "mode_info": mode_info(),
         "native_zoom": t.native_zoom(),
@@ -166,6 +167,14 @@ pub async fn texture_meta(
         "settings": settings(&t),
         "parameters": parameters(&t),
     })))
+}
+
+/// The modes that do not serve this texture, each with its reason (requests of them answer
+/// 422 `mode_declines_texture` with the same reason).
+fn declined_modes(t: &Texture) -> Value {
+    let src = t.source();
+    let each = t.defaults.params.iter().filter_map(|p| Some((p.name().to_string(), json!(p.declines(&src)?))));
+    Value::Object(each.collect())
 }
 
 /// Each mode's version, summary, needs and cost.

@@ -63,7 +63,7 @@ pub fn prepare_texture(
     log: &dyn Fn(String),
 ) -> Result<Texture, LoadError> {
     // A lattice tiles the exemplar, which therefore wraps around.
-    let toroidal = if t.lattice.is_some() { Some(true) } else { t.toroidal.as_option() };
+    let toroidal = if t.lattice.needs_toroidal() { Some(true) } else { t.toroidal.as_option() };
     let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal };
     let core = |source| LoadError::Core { id: t.id.clone(), source };
     let mut ex = Exemplar::from_bytes(bytes, &opts).map_err(core)?;
@@ -87,9 +87,7 @@ pub fn prepare_texture(
             started.elapsed().as_secs_f64()
         ));
     }
-    if let Some([nx, ny]) = t.lattice {
-        ex = ex.with_lattice(nx, ny).map_err(core)?;
-    }
+    ex = ex.with_lattice_choice(&t.lattice).map_err(core)?;
     if let Some(mask) = &mask {
         ex = ex.with_randomness_mask(mask).map_err(core)?;
     }

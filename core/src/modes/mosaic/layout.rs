@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use crate::geom::Rect;
 use crate::hash::{hash_keyed, key};
+use crate::lattice::{Lattice, LevelLattice};
 
 use super::params::MosaicParams;
 
@@ -36,11 +37,13 @@ pub(super) struct Layout {
     cat: [u64; 4], // A^iterations mod span
     keys: [u64; 2], // hash keys of block geometry and priority
     period_tiles: Option<i64>,
+    /// The exemplar's lattice: block offsets are snapped to its translations.
+    lattice: LevelLattice,
     pub(super) p: MosaicParams,
 }
 
 impl Layout {
-    pub(super) fn new(n: i64, p: &MosaicParams) -> Layout {
+    pub(super) fn new(n: i64, p: &MosaicParams, lattice: Option<&Lattice>) -> Layout {
         let period_tiles = p.period.map(|per| per / n);
         let tiles = period_tiles.map_or(SUPER, |t| t.min(SUPER));
         let span = tiles * n;
@@ -52,7 +55,8 @@ impl Layout {
             cat = [(a + b) & mask, (a + 2 * b) & mask, (c + d) & mask, (c + 2 * d) & mask];
         }
         let keys = [key(TAG_MOSAIC_BLOCK, p.seed), key(TAG_MOSAIC_PRIO, p.seed)];
-        Layout { n, tiles, span, cat, keys, period_tiles, p: p.clone() }
+        let lattice = lattice.map_or(LevelLattice::FREE, Lattice::whole);
+        Layout { n, tiles, span, cat, keys, period_tiles, lattice, p: p.clone() }
     }
 
     /// The block of tile `(a1, a2)` of super-tile `(s1, s2)`: absolute tile
@@ -104,7 +108,16 @@ impl Layout {
         let s = (a.wrapping_mul(x0).wrapping_add(b.wrapping_mul(y0))) & mask;
         let t = (c.wrapping_mul(x0).wrapping_add(d.wrapping_mul(y0))) & mask;
         let (k1, k2) = (s1 * self.tiles + a1, s2 * self.tiles + a2);
-        Block { sx, sy, w, h, dx: s1 * self.span + s as i64, dy: s2 * self.span + t as i64, prio: (prio, k2, k1) }
+        let (mut s, mut t) = (s as i64, t as i64);
+        if !self.lattice.is_free() {
+            // A near-regular exemplar's block moves by a lattice translation from where the
+            // tiled exemplar shows its source, so rows and gaps continue across its border
+            // (measured within the super-tile, which the tiled exemplar repeats: a periodic
+            // world stays periodic).
+            let (tx, ty) = self.lattice.translation((s - sx, t - sy));
+            (s, t) = (sx + tx, sy + ty);
+        }
+        Block { sx, sy, w, h, dx: s1 * self.span + s, dy: s2 * self.span + t, prio: (prio, k2, k1) }
     }
 
     /// The blocks of super-tile `(s1, s2)` that meet `r`, appended to `out`. Hashes, sides and
@@ -153,9 +166,11 @@ impl Layout {
     /// far zoom-out meets 9 rows of 9 super-tiles: 20 000 blocks). A caller painting bands
     /// of rows reads only the rows whose blocks reach its band.
     pub(super) fn block_rows_meeting(&self, r: Rect) -> Vec<BlockRow> {
-        // A block lies within its super-tile or spills at most n−1 texels right/down.
-        let lo = |v: i64| (v - self.n).div_euclid(self.span);
-        let hi = |v: i64| (v - 1).div_euclid(self.span);
+        // A block lies within its super-tile or spills at most n−1 texels right/down, and a
+        // lattice's snap moves it at most `reach` texels either way.
+        let reach = self.lattice.reach;
+        let lo = |v: i64| (v - self.n - reach).div_euclid(self.span);
+        let hi = |v: i64| (v - 1 + reach).div_euclid(self.span);
         let (s1s, s2s) = (lo(r.x0)..=hi(r.x1), lo(r.y0)..=hi(r.y1));
         s2s.into_par_iter()
             .map(|s2| {
@@ -197,7 +212,7 @@ mod tests {
     #[test]
     fn super_tile_passes_equal_single_blocks() {
         for period in [None, Some(512), Some(1 << 20)] {
-            let l = Layout::new(128, &MosaicParams { seed: 3, period, ..MosaicParams::default() });
+            let l = Layout::new(128, &MosaicParams { seed: 3, period, ..MosaicParams::default() }, None);
             for (s1, s2) in [(0, 0), (-3, 7), (1 << 30, -(1 << 29))] {
                 let mut out = Vec::new();
                 l.super_tile(s1, s2, Rect::new(i64::MIN / 4, i64::MIN / 4, i64::MAX / 2, i64::MAX / 2), &mut out);

@@ -70,7 +70,7 @@ pub fn render_texels(src: &Source, cache: &Pyramid, p: &MosaicParams, zoom_out: 
     let ex = src.exemplar;
     p.validate(ex.side)?;
     check_window(rect, MAX_PIXELS)?;
-    let layout = Layout::new(ex.side as i64, p);
+    let layout = Layout::new(ex.side as i64, p, ex.lattice.as_ref());
     if zoom_out == 0 {
         return Ok(native(ex, src.texels(), &layout, rect));
     }

@@ -136,7 +136,7 @@ mod tests {
     #[test]
     fn sources_equal_the_painted_sources() {
         for (seed, period) in [(0, None), (7, Some(512)), (3, Some(4096))] {
-            let layout = Layout::new(128, &MosaicParams { seed, period, ..MosaicParams::default() });
+            let layout = Layout::new(128, &MosaicParams { seed, period, ..MosaicParams::default() }, None);
             for (step, rect) in [
                 (1, Rect::new(-300, 70, 96, 64)),
                 (4, Rect::new(1000, -2000, 64, 48)),

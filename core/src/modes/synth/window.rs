@@ -15,7 +15,7 @@ use crate::analysis::features::TAPS5;
 use super::generations::{class_cols, class_layout, needed_generations};
 use crate::geom::{fl2, par, Rect};
 use crate::hash::{hash_tail, head, key, TAG_JITTER};
-use crate::lattice::round_to;
+use crate::lattice::LevelLattice;
 use crate::mask::RandomnessMask;
 use crate::modes::params::ONE_Q16;
 use crate::modes::Declared;
@@ -326,17 +326,15 @@ impl<'a> Ctx<'a> {
     }
 
     fn level_consts(&self, l: u32) -> LevelConsts {
+        let h = 1i64 << (self.levels - l);
         LevelConsts {
             l,
-            h: 1i64 << (self.levels - l),
+            h,
             mask: self.m - 1,
             rq: self.r[l as usize] as i64,
             period: self.period.map(|n| n >> (self.levels - l)),
             jitter_head: head(key(TAG_JITTER, self.seed), l as i64),
-            cells: self.an.header.lattice.map_or((1, 1), |lat| {
-                let (qx, qy) = lat.moduli(self.m as u32, 1 << (self.levels - l));
-                (qx as i64, qy as i64)
-            }),
+            lattice: self.an.header.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h, self.m as u32)),
         }
     }
 
@@ -358,34 +356,42 @@ impl<'a> Ctx<'a> {
         };
         let mut sx = (v & 0xFFFF) as i64 + off(par(x));
         let mut sy = (v >> 16) as i64 + off(par(y));
-        if c.still() {
+        if c.still() && c.lattice.is_free() {
             // Every jitter below rounds to 0 (`|hx| ≤ 2²³`, effective `r ≤ c.rq`).
             return ((sx & c.mask) | ((sy & c.mask) << 16)) as u32;
         }
-        // R_E (design note §1.9): the mask's minimum around the upsampled coordinate scales
-        // this level's randomness (0 keeps the exemplar there).
-        let rq = match self.mask {
-            Some(mk) if c.rq != 0 => (c.rq * mk.at(c.l, (sx & c.mask) as u32, (sy & c.mask) as u32) as i64 + 127) / 255,
-            _ => c.rq,
+        let (hx_, hy_) = match c.period {
+            Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
+            None => (x, y),
         };
-        // R_S: the request's modulation around the pixel (see `Modulation`).
-        let rq = rq * rs / ONE_Q16 as i64;
-        if rq != 0 {
-            let (hx_, hy_) = match c.period {
-                Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
-                None => (x, y),
+        // Nor does a jump land inside a kept part (it would show it cut).
+        let kept = |jx: i64, jy: i64| self.mask.is_some_and(|mk| mk.at(c.l, (jx & c.mask) as u32, (jy & c.mask) as u32) == 0);
+        if !c.still() {
+            // R_E (design note §1.9): the mask's minimum around the upsampled coordinate scales
+            // this level's randomness (0 keeps the exemplar there).
+            let rq = match self.mask {
+                Some(mk) if c.rq != 0 => {
+                    (c.rq * mk.at(c.l, (sx & c.mask) as u32, (sy & c.mask) as u32) as i64 + 127) / 255
+                }
+                _ => c.rq,
             };
-            let z = hash_tail(c.jitter_head, hx_, hy_);
-            let hx = ((z >> 40) as i64) - (1 << 23);
-            let hy = (((z >> 16) & 0xFF_FFFF) as i64) - (1 << 23);
-            // A lattice's coarse levels move content by whole cells (§1.9).
-            let (dx, dy) = ((h * hx * rq + (1 << 38)) >> 39, (h * hy * rq + (1 << 38)) >> 39);
-            let (jx, jy) = (sx + round_to(dx, c.cells.0), sy + round_to(dy, c.cells.1));
-            // Nor does a jump land inside a kept part (it would show it cut).
-            let lands_kept = self.mask.is_some_and(|mk| mk.at(c.l, (jx & c.mask) as u32, (jy & c.mask) as u32) == 0);
-            if !lands_kept {
-                (sx, sy) = (jx, jy);
+            // R_S: the request's modulation around the pixel (see `Modulation`).
+            let rq = rq * rs / ONE_Q16 as i64;
+            if rq != 0 {
+                let z = hash_tail(c.jitter_head, hx_, hy_);
+                let hx = ((z >> 40) as i64) - (1 << 23);
+                let hy = (((z >> 16) & 0xFF_FFFF) as i64) - (1 << 23);
+                let (dx, dy) = ((h * hx * rq + (1 << 38)) >> 39, (h * hy * rq + (1 << 38)) >> 39);
+                if !kept(sx + dx, sy + dy) {
+                    (sx, sy) = (sx + dx, sy + dy);
+                }
             }
+        }
+        // A lattice's coarse levels put every coordinate on its position's phase (§1.9):
+        // content moves by whole periods, whatever wrapping the exemplar did to it.
+        let (mx, my) = c.lattice.snap((sx, sy), (hx_ * h, hy_ * h));
+        if (mx, my) != (0, 0) && !kept(sx + mx, sy + my) {
+            (sx, sy) = (sx + mx, sy + my);
         }
 
         ((sx & c.mask) | ((sy & c.mask) << 16)) as u32
@@ -520,8 +526,8 @@ struct LevelConsts {
     period: Option<i64>,
     /// The jitter hash with its tag, seed and level applied ([`crate::hash::head`]).
     jitter_head: u64,
-    /// Lattice cell sizes jitter is rounded to at this level (1: not rounded).
-    cells: (i64, i64),
+    /// The lattice at this level: coordinates are snapped to their position's phase.
+    lattice: LevelLattice,
 }
 
 impl LevelConsts {

@@ -84,6 +84,14 @@ impl Mode for Umbrella {
     type Params = UmbrellaParams;
     type State = Extraction;
 
+    /// A near-regular exemplar: umbrellas scatter elements freely, which breaks the lattice
+    /// into a collage, so the mode says so rather than rendering one.
+    fn declines(src: &Source) -> Option<String> {
+        src.exemplar.lattice.as_ref().map(|l| {
+            format!("it is near-regular ({l}), and umbrella patches scatter elements off any lattice; synth and mosaic keep it")
+        })
+    }
+
     /// The extraction: each base umbrella magnified with its rim and centre, and modified
     /// umbrellas of it below.
     fn sheet(p: &UmbrellaParams, state: &Extraction, _: &Source) -> Option<Result<RgbWindow>> {

@@ -1,0 +1,122 @@
+//! Near-regular textures over HTTP (issue 60): the lattice detected from the exemplar alone is
+//! reported by `GET /textures/{id}` (and none for stochastic textures), synth and mosaic tiles
+//! keep it — the output's autocorrelation at the lattice's repeat stays near the exemplar's,
+//! where without the lattice it is lost — and umbrella says plainly that it does not serve it.
+
+mod common;
+
+use common::{assert_error, Server};
+
+/// Normalised autocorrelation of the luma of `img` at the integer lag `(dx, dy)`, over the
+/// pixels both ends of which lie in the image.
+fn autocorrelation(img: &image::RgbImage, dx: i64, dy: i64) -> f64 {
+    let (w, h) = (img.width() as i64, img.height() as i64);
+    let luma: Vec<f64> =
+        img.pixels().map(|p| 0.299 * p[0] as f64 + 0.587 * p[1] as f64 + 0.114 * p[2] as f64).collect();
+    let mean = luma.iter().sum::<f64>() / luma.len() as f64;
+    let g: Vec<f64> = luma.iter().map(|v| v - mean).collect();
+    let var = g.iter().map(|v| v * v).sum::<f64>() / g.len() as f64;
+    let (mut sum, mut n) = (0.0, 0usize);
+    for y in 0.max(-dy)..h.min(h - dy) {
+        for x in 0.max(-dx)..w.min(w - dx) {
+            sum += g[(y * w + x) as usize] * g[((y + dy) * w + x + dx) as usize];
+            n += 1;
+        }
+    }
+    sum / n.max(1) as f64 / var
+}
+
+/// The output's autocorrelation at the lattice's first repeat (the wave's period along its
+/// normal, best within a texel) over the exemplar's there: about 1 when the rows keep their
+/// spacing, near 0 when they drift.
+fn kept(exemplar: &image::RgbImage, output: &image::RgbImage, period: f64, angle: f64) -> f64 {
+    let (s, c) = angle.to_radians().sin_cos();
+    let (dx, dy) = ((period * c).round() as i64, (period * s).round() as i64);
+    let best = |img: &image::RgbImage| {
+        (-1..=1)
+            .flat_map(|u| (-1..=1).map(move |v| (u, v)))
+            .map(|(u, v)| autocorrelation(img, dx + u, dy + v))
+            .fold(f64::MIN, f64::max)
+    };
+    best(output) / best(exemplar)
+}
+
+#[tokio::test]
+async fn near_regular_textures_keep_their_detected_lattice_and_umbrella_declines_them() {
+    let s = Server::builder().start();
+
+    // Brick's courses, found from its pixels: one wave of about 18 texels across them.
+    let brick = s.json("/textures/brick").await;
+    let lattice = &brick["exemplar"]["lattice"];
+    assert_eq!(lattice["kind"], "stripes", "{lattice}");
+    assert_eq!(lattice["origin"], "detected", "{lattice}");
+    let wave = &lattice["waves"][0];
+    let (period, angle) = (wave["period"].as_f64().unwrap(), wave["angle"].as_f64().unwrap());
+    assert!((17.0..19.0).contains(&period) && (angle.min(180.0 - angle)) < 2.0, "{lattice}");
+    assert!(lattice["confidence"].as_f64().is_some_and(|c| c > 0.0 && c <= 1.0), "{lattice}");
+    assert!(brick["declined_modes"]["umbrella"].as_str().is_some_and(|r| r.contains("near-regular")), "{brick}");
+
+    // The configured cells of the rectified corkboard are a given grid of 64 × 32 texels.
+    let cork = &s.json("/textures/corkboard").await["exemplar"]["lattice"];
+    assert_eq!((cork["kind"].as_str(), cork["origin"].as_str()), (Some("grid"), Some("given")), "{cork}");
+    let mut periods: Vec<f64> =
+        cork["waves"].as_array().unwrap().iter().map(|w| w["period"].as_f64().unwrap()).collect();
+    periods.sort_by(f64::total_cmp);
+    assert_eq!(periods, [32.0, 64.0], "{cork}");
+
+    // Stochastic textures have none, and every mode serves them.
+    for id in ["gravel", "grass", "flagstones"] {
+        let meta = s.json(&format!("/textures/{id}")).await;
+        assert!(meta["exemplar"]["lattice"].is_null(), "{id}: {}", meta["exemplar"]);
+        assert_eq!(meta["declined_modes"], serde_json::json!({}), "{id}");
+    }
+
+    // Synth and mosaic keep the courses' spacing far from the origin; without the lattice the
+    // rows drift (the `lattice = "none"` texture of the same exemplar is the control).
+    let exemplar = s.image("/textures/brick/exemplar.png").await;
+    let window = "x=40960&y=40960&w=512&h=512";
+    for mode in ["synth", "mosaic"] {
+        let out = s.image(&format!("/windows/brick.png?{window}&mode={mode}")).await;
+        let k = kept(&exemplar, &out, period, angle);
+        eprintln!("brick {mode}: lattice kept {k:.3}");
+        assert!(k > 0.7, "{mode}: the courses drift (kept {k:.3}; measured 0.997 synth, 0.888 mosaic)");
+    }
+    // The same window from `textile render`: the same bytes with the detected lattice, and the
+    // courses lost without one.
+    let dir = tempfile::tempdir().unwrap();
+    let ex_path = format!("{}/../config/exemplars/brick.png", env!("CARGO_MANIFEST_DIR"));
+    let served = s.image(&format!("/windows/brick.png?{window}&mode=synth")).await;
+    for lattice in ["auto", "none"] {
+        let out = dir.path().join(format!("{lattice}.png"));
+        let done = std::process::Command::new(common::binary())
+            .args(["render", "--exemplar", &ex_path, "--lattice", lattice, "--mode", "synth", "--param", "kappa=0.5"])
+            .args(["--window", "40960,40960,512,512", "-o"])
+            .arg(&out)
+            .output()
+            .expect("render");
+        assert!(done.status.success(), "{}", String::from_utf8_lossy(&done.stderr));
+        let img = image::open(&out).unwrap().to_rgb8();
+        let k = kept(&exemplar, &img, period, angle);
+        eprintln!("brick synth, textile render --lattice {lattice}: kept {k:.3}");
+        if lattice == "auto" {
+            assert!(img == served, "textile render --lattice auto renders what the server serves");
+        } else {
+            assert!(k < 0.6, "without the lattice the courses were expected to drift (kept {k:.3}; measured 0.450)");
+        }
+    }
+
+    // Umbrella answers 422 naming the reason, on every route that renders.
+    for path in [
+        "/tiles/brick/7/0/0.png?mode=umbrella",
+        "/windows/brick.png?x=0&y=0&w=64&h=64&mode=umbrella",
+        "/tiles/corkboard/7/3/-2.webp?mode=umbrella&seed=4",
+    ] {
+        assert_error(&s, path, 422, "mode_declines_texture").await;
+    }
+    let r = s.get("/tiles/brick/7/0/0.png?mode=umbrella").await;
+    let body: serde_json::Value = r.json().await.unwrap();
+    assert!(body["message"].as_str().is_some_and(|m| m.contains("umbrella") && m.contains("near-regular")), "{body}");
+    let (status, _, _) =
+        s.post("/samples/brick?mode=umbrella", "application/json", br#"{"points":[[1,2,7]]}"#.to_vec()).await;
+    assert_eq!(status, 422, "samples of a declined mode");
+}
