@@ -55,6 +55,7 @@ fn analyze_detects_a_lattice_and_info_prints_it() {
     let (code, info, err) = run(&["info", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert!(info.contains("lattice:           stripes every (18.") && info.contains("detected"), "{info}");
+    assert!(info.contains("structure:         lattice, 1-D: basis [dy, dx] [0.0, 18."), "{info}");
     // Turned off, and given as waves.
     let (code, stdout, err) =
         run(&["analyze", &exemplar("brick.png"), "--lattice", "none", "-o", out.to_str().unwrap()]);
@@ -66,7 +67,13 @@ fn analyze_detects_a_lattice_and_info_prints_it() {
     assert!(stdout.contains("stripes every (18.50, 0.00) texels, given"), "{stdout}");
     // Gravel has none; a bad spelling is a clear error that writes nothing.
     let (_, stdout, _) = run(&["analyze", &exemplar("gravel.png"), "-o", out.to_str().unwrap()]);
-    assert!(stdout.contains("lattice: none, stochastic"), "{stdout}");
+    assert!(stdout.contains("structure: none (stochastic)") && stdout.contains("lattice: none"), "{stdout}");
+    // The rectified corkboard is its 64 × 32 cell repeated: exact, and `info` says so.
+    let (code, stdout, err) = run(&["analyze", &exemplar("corkboard.png"), "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("structure: exact: a 64×32 tile repeated (copies [dy, dx] [32, 0] × [0, 64]"), "{stdout}");
+    let (_, info, _) = run(&["info", out.to_str().unwrap()]);
+    assert!(info.contains("structure:         exact: a 64×32 tile repeated"), "{info}");
     let bad = dir.path().join("bad.tex");
     for spelling in ["sometimes", "1@0,1@1", "20@0,20@5", "3,4"] {
         let (code, _, err) =

@@ -153,6 +153,8 @@ async fn refused_uploads_leave_nothing_behind() {
         ("?id=Bad%20Id", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope&toroidal=sometimes", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope&synth.kappa=9", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&lattice=sometimes", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&lattice=20@0,20@5", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope&colour=red", "image/png", brick(), 400, "invalid_upload"),
         ("?name=no-id", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope", "text/plain", brick(), 415, "unsupported_media_type"),
@@ -198,6 +200,8 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     let meta = until_ready(&s, &location).await;
     assert_eq!((meta["name"].as_str(), meta["uploaded"].as_bool()), (Some("My brick"), Some(true)));
     assert_eq!(meta["exemplar"]["lattice"]["kind"], "stripes", "uploads detect the lattice: {}", meta["exemplar"]);
+    assert_eq!(meta["structure"]["class"], "lattice", "and report their structure: {}", meta["structure"]);
+    assert_eq!(meta["structure"]["dimensions"], 1, "{}", meta["structure"]);
     let (status, tile) = s.get_bytes("/tiles/mine/7/1/2.png?seed=3").await;
     assert_eq!(status, 200);
     let out = tempfile::tempdir().unwrap();

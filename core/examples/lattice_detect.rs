@@ -31,7 +31,12 @@ fn main() {
             .iter()
             .map(|r| format!("{:.1}°/{:.2}px v {:.3} c {:.3}", r.angle, r.period, r.value, r.contrast))
             .collect();
+        let repeat = d.repeat.as_ref().map_or(String::new(), |r| {
+            let b: Vec<String> = r.basis.iter().map(|v| format!("({}, {})", v[0], v[1])).collect();
+            format!(" copies {} ({:.3}),", b.join(" × "), r.score as f64 / 1000.0)
+        });
+        let class = d.class().name();
         let found = d.lattice.map_or("none".to_string(), |l| l.to_string());
-        println!("{path} ({}²): {found} | ridges {} | {ms:.0} ms", ex.side, ridges.join("; "));
+        println!("{path} ({}²): {class}:{repeat} {found} | ridges {} | {ms:.0} ms", ex.side, ridges.join("; "));
     }
 }

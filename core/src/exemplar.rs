@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
-use crate::lattice::{Lattice, LatticeChoice};
+use crate::lattice::{Lattice, LatticeChoice, Repeat};
 use crate::maps::{MaterialMap, NormalConvention};
 use crate::mask::RandomnessMask;
 
@@ -76,6 +76,12 @@ pub struct Exemplar {
     pub randomness_mask: Option<RandomnessMask>,
     /// The lattice of a near-regular exemplar ([`Exemplar::with_lattice`]).
     pub lattice: Option<Lattice>,
+    /// The exact repeat of an exemplar that is a tile repeated (found with the lattice,
+    /// [`Exemplar::with_lattice_choice`]): a texel's copies are never its second candidate.
+    pub repeat: Option<Repeat>,
+    /// What structure detection found ([`crate::lattice::Detection::summary`]), for reports;
+    /// `None` when it did not run (`lattice = "none"`).
+    pub structure: Option<serde_json::Value>,
     /// Its co-registered material maps ([`Exemplar::with_map`]); not part of
     /// [`Exemplar::hash_content`]: each map's tiles are keyed by the map's own hash.
     pub maps: Vec<MaterialMap>,
@@ -133,6 +139,8 @@ impl Exemplar {
             hires: None,
             randomness_mask: None,
             lattice: None,
+            repeat: None,
+            structure: None,
             maps: Vec::new(),
         }
     }
@@ -177,6 +185,9 @@ impl Exemplar {
         if let Some(l) = &self.lattice {
             l.hash_into(h);
         }
+        if let Some(r) = &self.repeat {
+            r.hash_into(h);
+        }
         if let Some(hires) = &self.hires {
             h.update(b"hires");
             h.update(hires.as_flattened());
@@ -206,6 +217,8 @@ impl Exemplar {
             hires: Some(hires.pixels),
             randomness_mask: None,
             lattice: None,
+            repeat: None,
+            structure: None,
             maps: Vec::new(),
         })
     }
@@ -294,12 +307,22 @@ impl Exemplar {
     }
 
     /// This exemplar with the lattice `choice` gives it: detected from its pixels (`auto`),
-    /// none, cells ([`Exemplar::with_lattice`]) or given waves.
+    /// none, cells ([`Exemplar::with_lattice`]) or given waves. Except with `none`, its
+    /// structure is detected ([`crate::lattice::detect`]): reported, and an exact repeat kept
+    /// so that copies are not candidates, whichever lattice the modes hold.
     pub fn with_lattice_choice(mut self, choice: &LatticeChoice) -> Result<Exemplar> {
-        if let LatticeChoice::Cells(nx, ny) = *choice {
-            return self.with_lattice(nx, ny);
+        if *choice == LatticeChoice::None {
+            (self.lattice, self.repeat, self.structure) = (None, None, None);
+            return Ok(self);
         }
-        self.lattice = choice.resolve(&self.pixels, self.side)?;
+        let found = crate::lattice::detect(&self.pixels, self.side);
+        self = match *choice {
+            LatticeChoice::Cells(nx, ny) => self.with_lattice(nx, ny)?,
+            LatticeChoice::Auto => Exemplar { lattice: found.lattice.clone(), ..self },
+            _ => Exemplar { lattice: choice.resolve(&self.pixels, self.side)?, ..self },
+        };
+        self.structure = Some(found.summary());
+        self.repeat = found.repeat;
         Ok(self)
     }
 }

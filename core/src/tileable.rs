@@ -297,6 +297,8 @@ pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
         hires: None,
         randomness_mask: None,
         lattice: None,
+        repeat: None,
+        structure: None,
         maps: Vec::new(),
     })
 }

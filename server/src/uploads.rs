@@ -65,7 +65,7 @@ pub fn map_file(id: &str, name: &str, ext: &str) -> String {
 
 /// A texture configuration from an upload's fields (query pairs or multipart fields): `id`
 /// (required), `name`, `toroidal` (`auto|true|false|synthesize`), `index`
-/// (`auto|exact|coherent`), `default_mode`, `default_seed`,
+/// (`auto|exact|coherent`), `lattice` (`auto|none|NX,NY|P@A[,P@A]`), `default_mode`, `default_seed`,
 /// `attribution`, `normal_convention` (with a normal map), and `MODE.KEY` for a per-mode
 /// setting (`synth.kappa=0.5`); and its material `maps`, `(name, file extension)` (their
 /// images are parts of a multipart form, `map.NAME`). Checked as a configured texture is, so an
@@ -99,6 +99,7 @@ pub fn texture_config(fields: &[(String, String)], maps: &[(String, &str)]) -> R
                 t.toroidal = serde_json::from_value(serde_json::json!(v)).map_err(|e| bad(format!("toroidal: {e}")))?
             }
             "index" => t.candidate_search = IndexChoice::parse(v).map_err(|e| bad(e.to_string()))?,
+            "lattice" => t.lattice = v.parse().map_err(bad)?,
             NORMAL_CONVENTION => {
                 t.maps.insert(NORMAL_CONVENTION.into(), v.clone());
             }

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use crate::analysis::features::SEARCH_DIMS;
 use crate::analysis::kdtree::KdTree;
 use crate::error::{CoreError, Result};
-use crate::lattice::LevelLattice;
+use crate::lattice::{LevelLattice, Repeat};
 
 /// Geometry of one level's candidate problem.
 pub struct CandidateRules {
@@ -24,6 +24,8 @@ pub struct CandidateRules {
     /// The lattice at this level (design note §1.9, near-regular textures): `C_2(u)` only
     /// among texels on `u`'s phase; free without a lattice.
     pub phase: LevelLattice,
+    /// The exemplar's exact repeat, where its copies may not be second candidates.
+    pub copies: Option<Repeat>,
     /// Work budget: k-d tree leaves opened per texel, on average ([`LEAVES_PER_TEXEL`]).
     pub leaves_per_texel: u64,
 }
@@ -36,6 +38,7 @@ impl CandidateRules {
             toroidal,
             separation: (m * 5).div_ceil(100),
             phase: LevelLattice::FREE,
+            copies: None,
             leaves_per_texel: LEAVES_PER_TEXEL,
         }
     }
@@ -46,10 +49,44 @@ impl CandidateRules {
         self
     }
 
-    /// Whether `v` may be the second candidate of `u`: far enough from it, on its lattice phase.
+    /// These rules with the copies of an exemplar that is a tile repeated refused as second
+    /// candidates: a copy offers the same content again. Set after [`CandidateRules::with_phase`]:
+    /// where the level holds a grid whose every translation is a copy (a rectified exemplar
+    /// that is its cell repeated, such as the embedded corkboard's `[2, 4]`), the only places on
+    /// a texel's phase are its copies, and the phase wins — the lattice was asked for, and
+    /// without a same-phase candidate the coarse grid would break — so copies stay allowed there.
+    pub fn without_copies(mut self, repeat: Option<&Repeat>) -> Self {
+        let phase_is_copies =
+            |r: &Repeat| self.phase.grid_translations().is_some_and(|[a, b]| r.is_copy(a) && r.is_copy(b));
+        self.copies = repeat.filter(|r| !phase_is_copies(r)).cloned();
+        self
+    }
+
+    /// Whether `v` may be the second candidate of `u`: far enough from it, on its lattice
+    /// phase, not its copy.
     fn allowed(&self, v: usize, u: usize) -> bool {
         let d = ((v % self.m) as i64 - (u % self.m) as i64, (v / self.m) as i64 - (u / self.m) as i64);
-        self.phase.same_phase(d) && self.far_enough(v, u)
+        self.phase.same_phase(d) && !self.is_copy(d) && self.far_enough(v, u)
+    }
+
+    /// Whether the lag `d` between two texels is a copy (on a toroidal exemplar, also once
+    /// wrapped around).
+    fn is_copy(&self, d: (i64, i64)) -> bool {
+        let Some(r) = &self.copies else { return false };
+        if r.is_copy(d) {
+            return true;
+        }
+        let m = self.m as i64;
+        let wrap = |v: i64| {
+            if v > m / 2 {
+                v - m
+            } else if v < -m / 2 {
+                v + m
+            } else {
+                v
+            }
+        };
+        self.toroidal && r.is_copy((wrap(d.0), wrap(d.1)))
     }
 
     /// Texel `c` moved by `(dx, dy)` (wrapping when toroidal), unless that leaves the exemplar.

@@ -24,7 +24,7 @@ use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::{Exemplar, Preparation};
 use crate::image::box_stack;
-use crate::lattice::{Lattice, LevelLattice};
+use crate::lattice::{Lattice, LevelLattice, Repeat};
 use crate::mask::RandomnessMask;
 use crate::stack::{build_stack, to_u8};
 
@@ -181,6 +181,14 @@ pub struct AnalysisHeader {
     /// synthesis rounds coarse jitter to whole cells.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lattice: Option<Lattice>,
+    /// The exact repeat of an exemplar that is a tile repeated: no texel's copy is its second
+    /// candidate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeat: Option<Repeat>,
+    /// What structure detection found (class, basis, scores; see
+    /// [`crate::lattice::Detection::summary`]), for `textile info`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub structure: Option<serde_json::Value>,
 }
 
 /// A complete exemplar analysis.
@@ -249,7 +257,7 @@ impl Analysis {
             };
             let h = 1 << (levels - l);
             let phase = ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, m as u32));
-            let rules = CandidateRules::new(m, ex.toroidal).with_phase(phase);
+            let rules = CandidateRules::new(m, ex.toroidal).with_phase(phase).without_copies(ex.repeat.as_ref());
             corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search, &between)?);
         }
         progress.step(total, total, "done");
@@ -263,6 +271,8 @@ impl Analysis {
             index: search,
             randomness_mask: ex.randomness_mask.as_ref().map(|m| m.hash.clone()),
             lattice: ex.lattice.clone(),
+            repeat: ex.repeat.clone(),
+            structure: ex.structure.clone(),
         };
         let randomness_mask = ex.randomness_mask.clone();
         Ok(Analysis {
@@ -294,6 +304,8 @@ impl Analysis {
             hires: None,
             randomness_mask: None,
             lattice: h.lattice.clone(),
+            repeat: h.repeat.clone(),
+            structure: h.structure.clone(),
             maps: Vec::new(),
         }
     }

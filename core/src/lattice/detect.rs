@@ -22,6 +22,7 @@
 use rustfft::num_complex::Complex;
 use rustfft::FftPlannerScalar;
 
+use super::exact::{self, Repeat};
 use super::{Lattice, Origin, Wave, MIN_ANGLE};
 
 /// Least ridge value (mean autocorrelation along the ridge) of a detected wave.
@@ -39,6 +40,9 @@ const AXIS_SNAP: f64 = 1.0;
 /// Share of the fitted ridge's value the axis must keep to be taken instead.
 const AXIS_SNAP_VALUE: f64 = 0.97;
 
+/// Side from which [`RIDGE_MIN_VALUE`] holds as it is.
+const SMALL_SIDE: usize = 128;
+
 /// Largest side analysed at full resolution; larger exemplars are box-reduced first.
 const DETECT_SIDE: usize = 256;
 
@@ -55,18 +59,137 @@ pub struct Ridge {
     pub contrast: f64,
 }
 
-/// What detection found: the lattice, if the rule accepts one, and the strongest ridges it
-/// weighed (for `textile info` and the benchmark).
+/// What detection found: the exemplar's class ([`Detection::class`]), its exact repeat if it is
+/// a tile repeated, the lattice the modes keep (for a tiling, the structure found *inside* one
+/// tile), and the strongest ridges it weighed (its scores).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Detection {
-    /// The lattice, or `None` for a stochastic exemplar.
+    /// The translations that map the image onto itself, if it is a tile repeated.
+    pub repeat: Option<Repeat>,
+    /// The lattice, or `None` for a stochastic exemplar (or a tiling of stochastic content).
     pub lattice: Option<Lattice>,
     /// The lattice's waves as ridges (found, or for a rejected exemplar the strongest ridge and
     /// the strongest at least 20° from it: how close it came).
     pub ridges: Vec<Ridge>,
 }
 
-/// Detect the lattice of the `side × side` exemplar `pixels` (see the module comment).
+/// An exemplar's structure class.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Class {
+    /// A tile repeated pixel for pixel.
+    Exact,
+    /// A near-regular lattice (1-D or 2-D).
+    Lattice,
+    /// Stochastic.
+    None,
+}
+
+impl Class {
+    /// `exact`, `lattice` or `none`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Class::Exact => "exact",
+            Class::Lattice => "lattice",
+            Class::None => "none",
+        }
+    }
+}
+
+impl Detection {
+    /// Exact if the image is a tile repeated, else lattice if one was found, else none.
+    pub fn class(&self) -> Class {
+        match (&self.repeat, &self.lattice) {
+            (Some(_), _) => Class::Exact,
+            (None, Some(_)) => Class::Lattice,
+            (None, None) => Class::None,
+        }
+    }
+
+    /// The structure as `GET /textures/{id}` and `textile info --json` report it: `class`,
+    /// `basis` (vectors `[dy, dx]` in exemplar texels: the copies for `exact`, the lattice's
+    /// translations for `lattice`), `dimensions`, `scores`, and for `exact` the `tile` (its
+    /// size when axis-aligned, its area) and the structure `inner` to one tile.
+    pub fn summary(&self) -> serde_json::Value {
+        let r = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+        let ridges: Vec<serde_json::Value> = self
+            .ridges
+            .iter()
+            .map(|q| serde_json::json!({"period": r(q.period), "angle": r(q.angle), "value": r(q.value), "contrast": r(q.contrast)}))
+            .collect();
+        let lattice_part = |l: &Option<Lattice>| match l {
+            Some(l) => serde_json::json!({
+                "class": "lattice",
+                "dimensions": l.waves.len(),
+                "basis": l.basis().iter().map(|v| [r(v[1]), r(v[0])]).collect::<Vec<_>>(),
+                "confidence": l.confidence as f64 / 1000.0,
+            }),
+            None => serde_json::json!({"class": "none", "dimensions": 0, "basis": []}),
+        };
+        let thresholds = serde_json::json!({
+            "repeat": super::exact::COPY_MIN, "ridge_value": RIDGE_MIN_VALUE, "ridge_contrast": RIDGE_MIN_CONTRAST,
+        });
+        match &self.repeat {
+            Some(rep) => {
+                let (w, h) = rep.axis_size().unwrap_or((None, None));
+                serde_json::json!({
+                    "class": "exact",
+                    "dimensions": rep.basis.len(),
+                    "basis": rep.basis.iter().map(|v| [v[1], v[0]]).collect::<Vec<_>>(),
+                    "tile": {"width": w, "height": h, "area": rep.area()},
+                    "scores": {"repeat": rep.score as f64 / 1000.0, "ridges": ridges, "thresholds": thresholds},
+                    "inner": lattice_part(&self.lattice),
+                })
+            }
+            None => {
+                let mut v = lattice_part(&self.lattice);
+                v["scores"] = serde_json::json!({"repeat": null, "ridges": ridges, "thresholds": thresholds});
+                v
+            }
+        }
+    }
+}
+
+/// One line saying what a structure summary ([`Detection::summary`]) holds, for `textile info`
+/// and `textile analyze`: `exact: a 64×32 tile repeated (copies [dy, dx] [32, 0] × [0, 64],
+/// score 1.000); inside: none`, `lattice, 1-D: basis [dy, dx] [0, 18.03] (confidence 0.69)`,
+/// `none (stochastic)`.
+pub fn describe(summary: &serde_json::Value) -> String {
+    let vecs = |v: &serde_json::Value| {
+        let each: Vec<String> = v.as_array().into_iter().flatten().map(|b| b.to_string().replace(',', ", ")).collect();
+        each.join(" × ")
+    };
+    let lattice = |v: &serde_json::Value| match v["class"].as_str() {
+        Some("lattice") => format!(
+            "lattice, {}-D: basis [dy, dx] {} (confidence {})",
+            v["dimensions"],
+            vecs(&v["basis"]),
+            v["confidence"]
+        ),
+        _ => "none".to_string(),
+    };
+    match summary["class"].as_str() {
+        Some("exact") => {
+            let t = &summary["tile"];
+            let tile = match (t["width"].as_i64(), t["height"].as_i64()) {
+                (Some(w), Some(h)) => format!("a {w}×{h} tile repeated"),
+                (Some(w), None) => format!("repeated every {w} texels across"),
+                (None, Some(h)) => format!("repeated every {h} texels down"),
+                _ => "a tile repeated".to_string(),
+            };
+            format!(
+                "exact: {tile} (copies [dy, dx] {}, score {}); inside: {}",
+                vecs(&summary["basis"]),
+                summary["scores"]["repeat"],
+                lattice(&summary["inner"])
+            )
+        }
+        Some("lattice") => lattice(summary),
+        _ => "none (stochastic)".to_string(),
+    }
+}
+
+/// Detect the structure of the `side × side` exemplar `pixels` (see the module comment): its
+/// exact repeat first, then the lattice, inside one tile for a tiling.
 pub fn detect(pixels: &[[u8; 3]], side: u32) -> Detection {
     let mut m = side as usize;
     let mut luma: Vec<f64> =
@@ -78,23 +201,38 @@ pub fn detect(pixels: &[[u8; 3]], side: u32) -> Detection {
         scale *= 2.0;
     }
     let a = Autocorrelation::new(&luma, m);
+    let repeat = exact::find(pixels, side as usize, &a, scale as usize);
+    // A tiling's own period is no lattice: inside one tile, a wave must repeat at least twice.
+    let inside = |r: &Ridge| {
+        repeat.as_ref().is_none_or(|rep| {
+            let (s, c) = r.angle.to_radians().sin_cos();
+            rep.period_along([c, s]).is_none_or(|p| r.period * scale <= 0.5 * p + 0.5)
+        })
+    };
     let scan = a.scan();
-    let Some(first) = scan.iter().copied().filter(accepted).max_by(|x, y| x.contrast.total_cmp(&y.contrast)) else {
-        return Detection { lattice: None, ridges: strongest(&scan) };
+    let Some(first) =
+        scan.iter().copied().filter(|r| accepted(r, m) && inside(r)).max_by(|x, y| x.contrast.total_cmp(&y.contrast))
+    else {
+        return Detection { repeat, lattice: None, ridges: strongest(&scan) };
     };
     let first = a.refine(a.fundamental(first));
     let mut ridges = vec![first];
-    if let Some(s) = a.along_crests(first) {
+    if let Some(s) = a.along_crests(first).filter(|r| inside(r)) {
         ridges.push(s);
     }
     let waves = ridges.iter().map(|r| Wave::new(r.period * scale, r.angle)).collect();
     let confidence = (first.contrast.clamp(0.0, 1.0) * 1000.0).round() as u32;
-    Detection { lattice: Some(Lattice { waves, origin: Origin::Detected, confidence }), ridges }
+    Detection { repeat, lattice: Some(Lattice { waves, origin: Origin::Detected, confidence }), ridges }
 }
 
 /// Whether a ridge passes the rule.
-fn accepted(r: &Ridge) -> bool {
-    r.value >= RIDGE_MIN_VALUE && r.contrast >= RIDGE_MIN_CONTRAST
+///
+/// The value threshold holds from a 128² image up; a smaller image's chance peaks are higher
+/// (their noise falls as one over the side), so below it the threshold rises in proportion:
+/// the 64² bark tile's strongest ridge (0.195) and the 32² leaves tile's (0.170) are chance.
+fn accepted(r: &Ridge, m: usize) -> bool {
+    let noise = (SMALL_SIDE as f64 / m.max(1) as f64).max(1.0);
+    r.value >= RIDGE_MIN_VALUE * noise && r.contrast >= RIDGE_MIN_CONTRAST
 }
 
 /// The strongest ridge, and the strongest at least [`MIN_ANGLE`] from it (what a rejected
@@ -127,16 +265,17 @@ fn halve(v: &[f64], m: usize) -> Vec<f64> {
 }
 
 /// The normalised autocorrelation of an image, at lags in `(-n/2, n/2)` (stored wrapped).
-struct Autocorrelation {
+pub(super) struct Autocorrelation {
     /// Exemplar side.
-    m: usize,
+    pub(super) m: usize,
     /// Padded side (`2m`).
-    n: usize,
-    a: Vec<f64>,
+    pub(super) n: usize,
+    /// Values at integer lags, row-major, negative lags wrapped.
+    pub(super) a: Vec<f64>,
 }
 
 impl Autocorrelation {
-    fn new(luma: &[f64], m: usize) -> Autocorrelation {
+    pub(super) fn new(luma: &[f64], m: usize) -> Autocorrelation {
         let n = 2 * m;
         let mean = luma.iter().sum::<f64>() / luma.len().max(1) as f64;
         let hann: Vec<f64> =
@@ -226,7 +365,7 @@ impl Autocorrelation {
             }
             let value = self.ridge(r.angle, t);
             let sub = Ridge { angle: r.angle, period: t, value, contrast: value - self.ridge(r.angle, t / 2.0) };
-            if accepted(&sub) && value >= 0.8 * r.value {
+            if accepted(&sub, self.m) && value >= 0.8 * r.value {
                 return sub;
             }
         }
@@ -282,12 +421,10 @@ impl Autocorrelation {
             t >= MIN_PERIOD
                 && profile[i] >= profile[i - 1]
                 && profile[i] >= profile[i + 1]
-                && accepted(&Ridge {
-                    angle: 0.0,
-                    period: t,
-                    value: profile[i],
-                    contrast: profile[i] - crest(0.0, t / 2.0),
-                })
+                && accepted(
+                    &Ridge { angle: 0.0, period: t, value: profile[i], contrast: profile[i] - crest(0.0, t / 2.0) },
+                    self.m,
+                )
         })?;
         let big_p = parabola_peak(peak as f64 * 0.5, 0.5, |s| crest(0.0, s));
         // Its harmonics within half the side refine it.

@@ -12,9 +12,11 @@
 
 mod choice;
 mod detect;
+mod exact;
 
 pub use choice::{LatticeChoice, SYNTAX};
-pub use detect::{detect, Detection, Ridge, RIDGE_MIN_CONTRAST, RIDGE_MIN_VALUE};
+pub use detect::{describe, detect, Class, Detection, Ridge, RIDGE_MIN_CONTRAST, RIDGE_MIN_VALUE};
+pub use exact::{Repeat, COPY_MIN, HALF_MAX};
 
 use serde::{Deserialize, Serialize};
 
@@ -269,6 +271,18 @@ impl LevelLattice {
             }
             _ => LevelLattice::FREE,
         }
+    }
+
+    /// A grid's two basis translations in whole texels, when the level holds a grid whose
+    /// translations are whole (a rectified lattice of cells); `None` otherwise.
+    pub fn grid_translations(&self) -> Option<[(i64, i64); 2]> {
+        if self.count != 2 {
+            return None;
+        }
+        let whole = |x: f64| (x - x.round()).abs() < 1e-6;
+        let (a, b) = ((self.solve[0][0], self.solve[1][0]), (self.solve[0][1], self.solve[1][1]));
+        (whole(a.0) && whole(a.1) && whole(b.0) && whole(b.1))
+            .then(|| [(a.0.round() as i64, a.1.round() as i64), (b.0.round() as i64, b.1.round() as i64)])
     }
 
     /// Whether this level is free of the lattice.

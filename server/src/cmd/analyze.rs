@@ -35,9 +35,12 @@ pub fn run(a: AnalyzeArgs) -> CliResult {
             return Err(format!("{}: {e}", beside.display()).into());
         }
     }
+    if let Some(s) = &ex.structure {
+        println!("structure: {} ({:.0} ms)", textile_core::lattice::describe(s), 1000.0 * lattice_secs);
+    }
     match &ex.lattice {
-        Some(l) => println!("lattice: {l} ({:.0} ms)", 1000.0 * lattice_secs),
-        None => println!("lattice: none, stochastic ({:.0} ms)", 1000.0 * lattice_secs),
+        Some(l) => println!("lattice: {l}"),
+        None => println!("lattice: none"),
     }
     println!(
         "analysed {} ({}x{} → {}x{}, toroidal {}, {} search) in {:.2}s → {} (id {})",

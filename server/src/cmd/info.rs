@@ -58,9 +58,13 @@ pub fn run(a: InfoArgs) -> CliResult {
         println!("{:<18} {}", format!("{}:", step.what()), fields.join(", "));
         println!("{:<18} {from}", format!("{} source:", step.what()));
     }
+    match &h.structure {
+        Some(s) => println!("structure:         {}", textile_core::lattice::describe(s)),
+        None => println!("structure:         not detected (lattice = none)"),
+    }
     match &h.lattice {
-        Some(l) => println!("lattice:           {l} (near-regular)"),
-        None => println!("lattice:           none (stochastic)"),
+        Some(l) => println!("lattice:           {l} (kept by the modes)"),
+        None => println!("lattice:           none (the modes keep none)"),
     }
     Ok(())
 }

@@ -240,6 +240,13 @@ pub const DEFAULT_SEED: ParamSpec = ParamSpec {
     scope: Scope::Texture,
     help: "seed of requests that name none",
 };
+/// `lattice`: the lattice of a near-regular exemplar.
+pub const LATTICE: ParamSpec = ParamSpec {
+    name: "lattice",
+    kind: FieldKind::Text { max_len: 100 },
+    scope: Scope::Texture,
+    help: "lattice of a near-regular exemplar: auto (detected, the default), none (no detection), NX,NY cells of a rectified exemplar, or PERIOD@ANGLE[,PERIOD@ANGLE] waves",
+};
 /// `attribution`: shown in TileJSON.
 pub const ATTRIBUTION: ParamSpec = ParamSpec {
     name: "attribution",
@@ -249,7 +256,7 @@ pub const ATTRIBUTION: ParamSpec = ParamSpec {
 };
 
 /// The texture keys an upload may set (besides `MODE.KEY` per-mode settings).
-pub const TEXTURE_FIELDS: &[ParamSpec] = &[ID, NAME, TOROIDAL, INDEX, DEFAULT_MODE, DEFAULT_SEED, ATTRIBUTION];
+pub const TEXTURE_FIELDS: &[ParamSpec] = &[ID, NAME, TOROIDAL, INDEX, LATTICE, DEFAULT_MODE, DEFAULT_SEED, ATTRIBUTION];
 
 #[cfg(test)]
 mod tests {

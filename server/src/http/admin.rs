@@ -151,7 +151,7 @@ fn status_body(tex: &crate::textures::Texture) -> serde_json::Value {
 
 /// Add a texture from an uploaded exemplar.
 #[utoipa::path(post, path = "/admin/textures", tag = "admin",
-    request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields (id, required; name, toroidal, index, default_mode, default_seed, attribution) in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). Material maps are image parts named `map.NAME` (`map.normal`, `map.height`, …; the exemplar's size), a normal map with the field `normal_convention` (opengl or directx). At most max_upload_mib MiB; each side at most max_exemplar_side.",
+    request_body(description = "The exemplar as image/png, image/jpeg or image/webp, with the fields (id, required; name, toroidal, index, lattice, default_mode, default_seed, attribution) in the query; or multipart/form-data with an `image` part and one part per field. Per-mode settings are fields named MODE.KEY (`synth.kappa=0.5`). Material maps are image parts named `map.NAME` (`map.normal`, `map.height`, …; the exemplar's size), a normal map with the field `normal_convention` (opengl or directx). At most max_upload_mib MiB; each side at most max_exemplar_side.",
         content(("image/png"), ("image/jpeg"), ("image/webp"), ("multipart/form-data"))),
     responses((status = 202, description = "accepted: decoded and stored; analysing (Location: the texture's status)"),
               (status = 400, description = "a field is invalid, the image is corrupt or of another format, or it is flat (code flat_image); a map is corrupt, mis-sized or misnamed (code invalid_map)"),

@@ -144,6 +144,7 @@ pub async fn texture_meta(
             "randomness_mask": ex.randomness_mask.is_some(),
             "lattice": ex.lattice.as_ref().map(|l| l.summary()),
         },
+        "structure": ex.structure,
         "analysis": analysis,
         "maps": maps(&t),
         "prepared": prepared(&t),
