@@ -40,6 +40,11 @@ const AXIS_SNAP: f64 = 1.0;
 /// Share of the fitted ridge's value the axis must keep to be taken instead.
 const AXIS_SNAP_VALUE: f64 = 0.97;
 
+/// Share of a ridge's value a sub-multiple must reach to be taken as the fundamental: the
+/// unbiased autocorrelation is noisier at long lags, where a multiple can come out higher
+/// (boards every 19.3 with random fill: 0.45 at 19.3, 0.59 at 58).
+const FUNDAMENTAL_SHARE: f64 = 0.7;
+
 /// Side from which [`RIDGE_MIN_VALUE`] holds as it is.
 const SMALL_SIDE: usize = 128;
 
@@ -217,7 +222,7 @@ pub fn detect(pixels: &[[u8; 3]], side: u32) -> Detection {
     };
     let first = a.refine(a.fundamental(first));
     let mut ridges = vec![first];
-    if let Some(s) = a.along_crests(first).filter(|r| inside(r)) {
+    if let Some(s) = a.along_crests(first).map(|r| a.refine_second(r)).filter(|r| inside(r)) {
         ridges.push(s);
     }
     let waves = ridges.iter().map(|r| Wave::new(r.period * scale, r.angle)).collect();
@@ -359,13 +364,18 @@ impl Autocorrelation {
     /// opposite phase too).
     fn fundamental(&self, r: Ridge) -> Ridge {
         for k in (2..=5).rev() {
-            let t = r.period / k as f64;
+            // The sub-multiple's own peak, within a texel of `t / k` (a narrow joint's peak
+            // falls between the samples of `r`'s half-texel scan).
+            let t = (-4..=4)
+                .map(|i| r.period / k as f64 + i as f64 * 0.25)
+                .max_by(|a, b| self.ridge(r.angle, *a).total_cmp(&self.ridge(r.angle, *b)))
+                .unwrap_or(r.period / k as f64);
             if t < MIN_PERIOD {
                 continue;
             }
             let value = self.ridge(r.angle, t);
             let sub = Ridge { angle: r.angle, period: t, value, contrast: value - self.ridge(r.angle, t / 2.0) };
-            if accepted(&sub, self.m) && value >= 0.8 * r.value {
+            if accepted(&sub, self.m) && value >= FUNDAMENTAL_SHARE * r.value {
                 return sub;
             }
         }
@@ -460,6 +470,22 @@ impl Autocorrelation {
         }
         let value = profile[peak];
         Some(Ridge { angle, period: 1.0 / len, value, contrast: value - crest(0.0, big_p / 2.0) })
+    }
+
+    /// The second wave, as read off the crests, refined on its own ridge ([`Autocorrelation::refine`])
+    /// where that ridge is at least as strong: a stagger read off one crest is off by a few
+    /// tenths of a texel, the wave's own harmonics pin it (a diagonal tread: 24.16 at 43.8° from
+    /// the crest, 24.75 at 45.0° refined). The refined wave stays within a texel and two degrees
+    /// of the crest's, or the crest's is kept.
+    fn refine_second(&self, r: Ridge) -> Ridge {
+        let refined = self.refine(r);
+        let turn = (refined.angle - r.angle).rem_euclid(180.0);
+        let close = turn.min(180.0 - turn) <= 2.0 && (refined.period - r.period).abs() <= 1.0;
+        if close && refined.value >= self.ridge(r.angle, r.period) {
+            Ridge { contrast: r.contrast, ..refined }
+        } else {
+            r
+        }
     }
 
     /// A ridge's angle to a tenth of a degree and its period to a fraction of a texel: the
