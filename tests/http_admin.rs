@@ -492,3 +492,35 @@ async fn a_stalled_body_is_answered_within_the_header_deadline() {
     }
     assert!(!data.path().join("uploads").join("slow.toml").exists());
 }
+
+#[tokio::test]
+async fn uploads_report_their_structure_and_take_a_lattice_field() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[]);
+    let smallstone = std::fs::read(exemplar_path("test/smallstone.png")).expect("smallstone.png");
+    // The development set's smallstone crop is its 64 px tile repeated 2 × 2: exact.
+    let (status, headers, body) = upload(&s, "?id=stones", "image/png", smallstone.clone(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let location = headers.get("location").unwrap().to_str().unwrap().to_string();
+    let meta = until_ready(&s, &location).await;
+    let st = &meta["structure"];
+    assert_eq!(st["class"], "exact", "{st}");
+    assert_eq!(st["basis"], serde_json::json!([[0, 64], [64, 0]]), "{st}");
+    assert_eq!((st["tile"]["width"].as_i64(), st["tile"]["height"].as_i64()), (Some(64), Some(64)), "{st}");
+    assert_eq!(st["scores"]["repeat"], 1.0, "{st}");
+    assert_eq!(st["inner"]["class"], "none", "{st}");
+    // `lattice=none` turns detection off: no structure, and the bytes of an exemplar whose
+    // copies were never looked for (its copies change the analysis, so its id differs).
+    let (status, headers, body) = upload(&s, "?id=stones-off&lattice=none", "image/png", smallstone, Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let off = until_ready(&s, headers.get("location").unwrap().to_str().unwrap()).await;
+    assert!(off["structure"].is_null(), "{}", off["structure"]);
+    assert!(off["exemplar"]["lattice"].is_null(), "{}", off["exemplar"]);
+    assert_ne!(off["analysis"]["id"], meta["analysis"]["id"], "copies refused as candidates are part of the analysis");
+    // A given lattice is kept, and detection still reports what it found.
+    let (status, headers, body) = upload(&s, "?id=brick-waves&lattice=18.5@0", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let given = until_ready(&s, headers.get("location").unwrap().to_str().unwrap()).await;
+    assert_eq!(given["exemplar"]["lattice"]["origin"], "given", "{}", given["exemplar"]);
+    assert_eq!(given["structure"]["class"], "lattice", "{}", given["structure"]);
+}

@@ -64,9 +64,23 @@ async fn near_regular_textures_keep_their_detected_lattice_and_umbrella_declines
     periods.sort_by(f64::total_cmp);
     assert_eq!(periods, [32.0, 64.0], "{cork}");
 
+    // Its structure: a 1-D lattice, its basis [dy, dx] across the columns, with its scores.
+    let st = &brick["structure"];
+    assert_eq!((st["class"].as_str(), st["dimensions"].as_u64()), (Some("lattice"), Some(1)), "{st}");
+    let b = &st["basis"][0];
+    assert!(b[0].as_f64() == Some(0.0) && b[1].as_f64().is_some_and(|dx| (17.0..19.0).contains(&dx)), "{st}");
+    let ridge = &st["scores"]["ridges"][0];
+    assert!(ridge["value"].as_f64() >= st["scores"]["thresholds"]["ridge_value"].as_f64(), "{st}");
+    // The rectified corkboard is its 64 × 32 cell repeated: exact, the copies its basis.
+    let st = &s.json("/textures/corkboard").await["structure"];
+    assert_eq!(st["class"], "exact", "{st}");
+    assert_eq!(st["basis"], serde_json::json!([[32, 0], [0, 64]]), "{st}");
+    assert_eq!((st["tile"]["width"].as_i64(), st["tile"]["height"].as_i64()), (Some(64), Some(32)), "{st}");
+
     // Stochastic textures have none, and every mode serves them.
     for id in ["gravel", "grass", "flagstones"] {
         let meta = s.json(&format!("/textures/{id}")).await;
+        assert_eq!(meta["structure"]["class"], "none", "{id}: {}", meta["structure"]);
         assert!(meta["exemplar"]["lattice"].is_null(), "{id}: {}", meta["exemplar"]);
         assert_eq!(meta["declined_modes"], serde_json::json!({}), "{id}");
     }

@@ -286,6 +286,7 @@ async function selectTexture(id, keepView) {
   buildMapPicker();
   buildControls();
   showLatticeRow();
+  showStructure();
   map.setMinZoom(meta.minzoom);
   map.setMaxZoom(meta.maxzoom + 2);
   if (layer) { map.removeLayer(layer); layer = null; }
@@ -340,6 +341,71 @@ function latticeLines(canvas, c) {
     }
     ctx.stroke();
   }
+}
+
+// The exemplar's structure over its thumbnail (GET /textures/{id} `structure`): for a tile
+// repeated, the copies' lattice (yellow: each parallelogram is one tile); for a near-regular
+// exemplar, its lattice lines (cyan; for a tile repeated, the lattice inside it). The line
+// under the thumbnail says what was found.
+function latticeFamily(ctx, side, k, a, b) {
+  // Lines along `b` through every multiple of `a` ([dy, dx] texels), across the exemplar.
+  const len = Math.hypot(a[0], a[1]);
+  if (len < 1) return;
+  const reach = Math.ceil((2 * side) / Math.max(1, Math.abs(a[1] * b[0] - a[0] * b[1]) / Math.hypot(b[0], b[1]))) + 1;
+  const bl = Math.hypot(b[0], b[1]) || 1, ux = b[1] / bl, uy = b[0] / bl;
+  ctx.beginPath();
+  for (let i = -reach; i <= reach; i++) {
+    const x = i * a[1], y = i * a[0];
+    ctx.moveTo((x - 3 * side * ux) * k, (y - 3 * side * uy) * k);
+    ctx.lineTo((x + 3 * side * ux) * k, (y + 3 * side * uy) * k);
+  }
+  ctx.stroke();
+}
+
+function drawLatticeOn(ctx, side, k, lat) {
+  const basis = lat.basis;
+  if (basis.length === 1) {
+    const a = basis[0];
+    latticeFamily(ctx, side, k, a, [a[1], -a[0]]); // lines across the one translation
+  } else if (basis.length === 2) {
+    latticeFamily(ctx, side, k, basis[0], basis[1]);
+    latticeFamily(ctx, side, k, basis[1], basis[0]);
+  }
+}
+
+function showStructure() {
+  const canvas = $('thumblattice');
+  const ctx = canvas.getContext('2d');
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  const st = meta && meta.structure;
+  const side = meta ? meta.exemplar.width : 1;
+  const k = canvas.width / side;
+  ctx.lineWidth = 2;
+  let text = '';
+  if (!st) {
+    text = 'Structure not detected (lattice = none).';
+  } else if (st.class === 'exact') {
+    ctx.strokeStyle = 'rgba(255, 220, 0, 0.95)';
+    drawLatticeOn(ctx, side, k, st);
+    const t = st.tile;
+    const size = t.width && t.height ? `a ${t.width}×${t.height} px tile` : `a tile of ${t.area || '?'} px²`;
+    text = `Exact repeat: ${size} repeated (copies ${st.basis.map((v) => `[${v.join(', ')}]`).join(' × ')}, score ${st.scores.repeat.toFixed(3)}).`;
+    if (st.inner && st.inner.class === 'lattice') {
+      ctx.strokeStyle = 'rgba(0, 255, 255, 0.85)';
+      ctx.lineWidth = 1;
+      drawLatticeOn(ctx, side, k, st.inner);
+      text += ` Inside it: a ${st.inner.dimensions}-D lattice.`;
+    }
+  } else if (st.class === 'lattice') {
+    ctx.strokeStyle = 'rgba(0, 255, 255, 0.95)';
+    drawLatticeOn(ctx, side, k, st);
+    const vs = st.basis.map((v) => `[${v.map((c) => c.toFixed(1)).join(', ')}]`).join(' × ');
+    text = `Near-regular: a ${st.dimensions}-D lattice, basis [dy, dx] ${vs} px (confidence ${st.confidence}).`;
+  } else {
+    text = 'No lattice: stochastic.';
+  }
+  canvas.dataset.structure = st ? st.class : 'off';
+  $('structureinfo').textContent = text;
 }
 
 function showLatticeRow() {

@@ -415,6 +415,44 @@ test('a near-regular texture shows its lattice, overlays it, and greys out the m
   await page.close();
 });
 
+// Pixels of the thumbnail's structure overlay in a colour: cyan (lattice) or yellow (copies).
+const overlayPixels = (page, colour) => page.$eval('#thumblattice', (c, colour) => {
+  const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+  let n = 0;
+  for (let i = 0; i < d.length; i += 4) {
+    if (d[i + 3] < 100) continue;
+    const cyan = d[i] < 80 && d[i + 1] > 200 && d[i + 2] > 200;
+    const yellow = d[i] > 200 && d[i + 1] > 180 && d[i + 2] < 80;
+    if ((colour === 'cyan' && cyan) || (colour === 'yellow' && yellow)) n++;
+  }
+  return n;
+}, colour);
+
+test('the exemplar thumbnail shows its detected structure: lattice, tile repeated, or none', async () => {
+  const { page, errors } = await open('/#t=brick&z=7&x=0&y=0');
+  await settled(page);
+  // Brick: its columns, drawn over the thumbnail (about 7 lines across 128 texels) and named.
+  await page.waitForFunction(() => document.querySelector('#thumblattice').dataset.structure === 'lattice');
+  assert.match(await page.$eval('#structureinfo', (p) => p.textContent), /^Near-regular: a 1-D lattice, basis \[dy, dx\] \[0\.0, 18\.0\]/);
+  const brickLines = await overlayPixels(page, 'cyan');
+  assert.ok(brickLines > 128 * 2 * 5, `brick's lattice lines: ${brickLines} cyan pixels`);
+  assert.equal(await overlayPixels(page, 'yellow'), 0);
+  // The embedded corkboard is its 64 × 32 cell repeated: the tiles are outlined and the size said.
+  await page.selectOption('#texture', 'corkboard');
+  await page.waitForFunction(() => document.querySelector('#thumblattice').dataset.structure === 'exact');
+  assert.match(await page.$eval('#structureinfo', (p) => p.textContent), /^Exact repeat: a 64×32 px tile repeated/);
+  const tiles = await overlayPixels(page, 'yellow');
+  assert.ok(tiles > 128 * 2 * 4, `corkboard's tile outlines: ${tiles} yellow pixels`);
+  await page.screenshot({ path: process.env.TEXTILE_SCREENSHOT.replace(/\.png$/, '-structure.png'), clip: { x: 0, y: 0, width: 300, height: 260 } });
+  // Gravel: nothing drawn, and said so.
+  await page.selectOption('#texture', 'gravel');
+  await page.waitForFunction(() => document.querySelector('#thumblattice').dataset.structure === 'none');
+  assert.equal(await page.$eval('#structureinfo', (p) => p.textContent), 'No lattice: stochastic.');
+  assert.equal(await overlayPixels(page, 'cyan') + await overlayPixels(page, 'yellow'), 0);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('readable on a phone-sized viewport', async () => {
   const { page, errors } = await open('/', { width: 390, height: 844 });
   await settled(page, 1);
