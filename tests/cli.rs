@@ -75,7 +75,13 @@ fn analyze_detects_a_lattice_and_info_prints_it() {
     let (_, info, _) = run(&["info", out.to_str().unwrap()]);
     assert!(info.contains("structure:         exact: a 64×32 tile repeated"), "{info}");
     let bad = dir.path().join("bad.tex");
-    for spelling in ["sometimes", "1@0,1@1", "20@0,20@5", "3,4"] {
+    // Basis vectors [dy, dx]: brick's columns with the half-brick stagger, given.
+    let (code, stdout, err) =
+        run(&["analyze", &exemplar("brick.png"), "--lattice", "[[16,18],[-16,18]]", "-o", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("lattice: grid of") && stdout.contains("given"), "{stdout}");
+    for spelling in ["sometimes", "1@0,1@1", "20@0,20@5", "3,4", "[[0,0]]", "[[10,10],[20,21]]", "[[0,500]]", "[[1,x]]"]
+    {
         let (code, _, err) =
             run(&["analyze", &exemplar("brick.png"), "--lattice", spelling, "-o", bad.to_str().unwrap()]);
         assert_ne!(code, 0, "{spelling}");

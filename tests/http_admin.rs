@@ -155,6 +155,9 @@ async fn refused_uploads_leave_nothing_behind() {
         ("?id=nope&synth.kappa=9", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope&lattice=sometimes", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope&lattice=20@0,20@5", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&lattice=%5B%5B0,0%5D%5D", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&lattice=%5B%5B10,10%5D,%5B20,21%5D%5D", "image/png", brick(), 400, "invalid_upload"),
+        ("?id=nope&lattice=%5B%5B0,500%5D%5D", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope&colour=red", "image/png", brick(), 400, "invalid_upload"),
         ("?name=no-id", "image/png", brick(), 400, "invalid_upload"),
         ("?id=nope", "text/plain", brick(), 415, "unsupported_media_type"),
@@ -523,4 +526,27 @@ async fn uploads_report_their_structure_and_take_a_lattice_field() {
     let given = until_ready(&s, headers.get("location").unwrap().to_str().unwrap()).await;
     assert_eq!(given["exemplar"]["lattice"]["origin"], "given", "{}", given["exemplar"]);
     assert_eq!(given["structure"]["class"], "lattice", "{}", given["structure"]);
+    // Basis vectors [dy, dx]: a staggered grid, kept as given.
+    let (status, headers, body) =
+        upload(&s, "?id=brick-bond&lattice=%5B%5B16,18%5D,%5B-16,18%5D%5D", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let bond = until_ready(&s, headers.get("location").unwrap().to_str().unwrap()).await;
+    let lattice = &bond["exemplar"]["lattice"];
+    assert_eq!((lattice["kind"].as_str(), lattice["origin"].as_str()), (Some("grid"), Some("given")), "{lattice}");
+    // Its reduced basis is the given one, up to sign and order (as [x, y]).
+    let mut basis: Vec<[i64; 2]> = lattice["basis"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| {
+            let (x, y) = (v[0].as_f64().unwrap().round() as i64, v[1].as_f64().unwrap().round() as i64);
+            if y < 0 || (y == 0 && x < 0) {
+                [-x, -y]
+            } else {
+                [x, y]
+            }
+        })
+        .collect();
+    basis.sort();
+    assert_eq!(basis, [[-18, 16], [18, 16]], "{lattice}");
 }

@@ -1,14 +1,16 @@
 //! How a texture says which lattice it has: `auto` (detected, the default), `none`, `[nx, ny]`
-//! cells of a rectified exemplar, or explicit waves (`{ period, angle }`, one or two). One
-//! spelling in configuration files (serde) and on the command line ([`std::str::FromStr`]).
+//! cells of a rectified exemplar, explicit basis vectors (`[[dy, dx], [dy, dx]]` or `[[dy, dx]]`,
+//! exemplar texels) or explicit waves (`{ period, angle }`, one or two). One spelling in
+//! configuration files (serde), and on the command line and in upload fields
+//! ([`std::str::FromStr`]: the vectors as the same JSON text).
 
 use std::fmt;
 use std::str::FromStr;
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use super::{Lattice, Wave};
-use crate::error::Result;
+use super::{Lattice, Wave, MIN_ANGLE};
+use crate::error::{CoreError, Result};
 
 /// A texture's lattice setting.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -22,6 +24,9 @@ pub enum LatticeChoice {
     Cells(u32, u32),
     /// Explicit waves: `(period in texels, angle of the normal in degrees)`, one or two.
     Waves(Vec<(f64, f64)>),
+    /// Explicit basis vectors `[dy, dx]` in exemplar texels: two for a grid (any angle: square,
+    /// staggered, diagonal), one for stripes (the translation across them; free along them).
+    Vectors(Vec<[f64; 2]>),
 }
 
 impl LatticeChoice {
@@ -37,7 +42,52 @@ impl LatticeChoice {
             LatticeChoice::None => None,
             LatticeChoice::Cells(nx, ny) => Some(Lattice::cells(*nx, *ny, side)?),
             LatticeChoice::Waves(w) => Some(Lattice::given(w.iter().map(|&(p, a)| Wave::new(p, a)).collect(), side)?),
+            LatticeChoice::Vectors(v) => Some(Lattice::given(waves_of(v, side)?, side)?),
         })
+    }
+}
+
+/// The waves of basis vectors `[dy, dx]`: for one vector `t`, the wave along it of period
+/// `|t|`; for two, the reciprocal vectors `kᵢ` (`kᵢ·tⱼ = δᵢⱼ`), each a wave of period `1/|kᵢ|`
+/// along it. Zero, too long (beyond the exemplar's side) and collinear vectors (less than
+/// [`MIN_ANGLE`] apart) are refused, named.
+pub fn waves_of(vectors: &[[f64; 2]], side: u32) -> Result<Vec<Wave>> {
+    let bad = |message: String| Err(CoreError::Param { name: "lattice", message });
+    let show = |v: &[f64; 2]| format!("[{}, {}]", v[0], v[1]);
+    if vectors.is_empty() || vectors.len() > 2 {
+        return bad(format!("{} basis vectors: give one [dy, dx] (stripes) or two (a grid)", vectors.len()));
+    }
+    for v in vectors {
+        let len = v[0].hypot(v[1]);
+        if !len.is_finite() || len < 2.0 {
+            return bad(format!("basis vector {} is zero or shorter than 2 texels", show(v)));
+        }
+        if len > side as f64 {
+            return bad(format!("basis vector {} is longer than the {side}-texel exemplar", show(v)));
+        }
+    }
+    let xy = |v: &[f64; 2]| [v[1], v[0]];
+    match vectors {
+        [t] => {
+            let [x, y] = xy(t);
+            Ok(vec![Wave::new(x.hypot(y), y.atan2(x).to_degrees())])
+        }
+        [a, b] => {
+            let ([ax, ay], [bx, by]) = (xy(a), xy(b));
+            let det = ax * by - ay * bx;
+            let sin = det.abs() / (ax.hypot(ay) * bx.hypot(by));
+            if sin < MIN_ANGLE.to_radians().sin() {
+                return bad(format!(
+                    "basis vectors {} and {} are collinear (less than {MIN_ANGLE}° apart)",
+                    show(a),
+                    show(b)
+                ));
+            }
+            // Rows of B⁻¹ (B's columns a, b): k₁ = (by, −bx)/det, k₂ = (−ay, ax)/det.
+            let wave = |k: [f64; 2]| Wave::new(1.0 / k[0].hypot(k[1]), k[1].atan2(k[0]).to_degrees());
+            Ok(vec![wave([by / det, -bx / det]), wave([-ay / det, ax / det])])
+        }
+        _ => unreachable!("one or two vectors, checked above"),
     }
 }
 
@@ -51,13 +101,17 @@ impl fmt::Display for LatticeChoice {
                 let parts: Vec<String> = w.iter().map(|(p, a)| format!("{p}@{a}")).collect();
                 f.write_str(&parts.join(","))
             }
+            LatticeChoice::Vectors(v) => {
+                let parts: Vec<String> = v.iter().map(|[dy, dx]| format!("[{dy},{dx}]")).collect();
+                write!(f, "[{}]", parts.join(","))
+            }
         }
     }
 }
 
 /// The command-line spelling's grammar, for errors.
-pub const SYNTAX: &str =
-    "auto, none, NX,NY (cells of a rectified exemplar) or PERIOD@ANGLE[,PERIOD@ANGLE] (texels, degrees)";
+pub const SYNTAX: &str = "auto, none, NX,NY (cells of a rectified exemplar), [[DY,DX],[DY,DX]] or [[DY,DX]] \
+     (basis vectors in texels) or PERIOD@ANGLE[,PERIOD@ANGLE] (texels, degrees)";
 
 impl FromStr for LatticeChoice {
     type Err = String;
@@ -70,6 +124,13 @@ impl FromStr for LatticeChoice {
             "auto" => return Ok(LatticeChoice::Auto),
             "none" => return Ok(LatticeChoice::None),
             _ => {}
+        }
+        if s.starts_with('[') {
+            let v: Vec<[f64; 2]> = serde_json::from_str(s).map_err(|_| bad())?;
+            if v.iter().flatten().any(|c| !c.is_finite()) {
+                return Err(bad());
+            }
+            return Ok(LatticeChoice::Vectors(v));
         }
         let parts: Vec<&str> = s.split(',').map(str::trim).collect();
         if parts.iter().all(|p| p.contains('@')) {
@@ -108,6 +169,7 @@ struct WaveSpec {
 enum Spelling {
     Word(String),
     Cells([u32; 2]),
+    Vectors(Vec<[f64; 2]>),
     Waves(Vec<WaveSpec>),
 }
 
@@ -120,6 +182,7 @@ impl Serialize for LatticeChoice {
             LatticeChoice::Waves(w) => {
                 Spelling::Waves(w.iter().map(|&(period, angle)| WaveSpec { period, angle }).collect())
             }
+            LatticeChoice::Vectors(v) => Spelling::Vectors(v.clone()),
         }
         .serialize(s)
     }
@@ -128,7 +191,9 @@ impl Serialize for LatticeChoice {
 impl<'de> Deserialize<'de> for LatticeChoice {
     fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
         let bad = || {
-            serde::de::Error::custom("lattice: expected \"auto\", \"none\", [nx, ny] or [{ period = P, angle = A }, …]")
+            serde::de::Error::custom(
+                "lattice: expected \"auto\", \"none\", [nx, ny], [[dy, dx], [dy, dx]] or [{ period = P, angle = A }, …]",
+            )
         };
         match Spelling::deserialize(d).map_err(|_| bad())? {
             Spelling::Word(w) if w == "auto" => Ok(LatticeChoice::Auto),
@@ -136,6 +201,7 @@ impl<'de> Deserialize<'de> for LatticeChoice {
             Spelling::Word(_) => Err(bad()),
             Spelling::Cells([nx, ny]) => Ok(LatticeChoice::Cells(nx, ny)),
             Spelling::Waves(w) => Ok(LatticeChoice::Waves(w.into_iter().map(|w| (w.period, w.angle)).collect())),
+            Spelling::Vectors(v) => Ok(LatticeChoice::Vectors(v)),
         }
     }
 }
@@ -159,6 +225,43 @@ mod tests {
         {
             assert_eq!(c.to_string().parse(), Ok(c));
         }
+    }
+
+    #[test]
+    fn basis_vectors_become_the_same_lattice() {
+        assert_eq!("[[28.4, 30.65], [0, 61.3]]".parse(), Ok(LatticeChoice::Vectors(vec![[28.4, 30.65], [0.0, 61.3]])));
+        assert_eq!(read_json("[[19.3, 0]]"), LatticeChoice::Vectors(vec![[19.3, 0.0]]));
+        // A running bond's basis comes back (as [x, y] translations) from its waves.
+        let lat = LatticeChoice::Vectors(vec![[28.4, 30.65], [0.0, 61.3]]).resolve(&[], 256).unwrap().unwrap();
+        let want = [[30.65, 28.4], [61.3, 0.0]];
+        for t in lat.basis() {
+            let k: Vec<f64> = lat.waves.iter().map(|w| w.vector()).map(|k| k[0] * t[0] + k[1] * t[1]).collect();
+            assert!(k.iter().all(|p| (p - p.round()).abs() < 1e-3), "{t:?}: {k:?}");
+        }
+        for t in want {
+            for w in &lat.waves {
+                let p = w.vector()[0] * t[0] + w.vector()[1] * t[1];
+                assert!((p - p.round()).abs() < 1e-3, "{t:?} off the lattice");
+            }
+        }
+        // Stripes: one vector, across them.
+        let one = LatticeChoice::Vectors(vec![[0.0, 19.3]]).resolve(&[], 128).unwrap().unwrap();
+        assert!((one.waves[0].period() - 19.3).abs() < 1e-3 && one.waves[0].angle_deg().abs() < 1e-3);
+        // Zero, too long, collinear: refused, naming the vectors.
+        for (v, says) in [
+            (vec![[0.0, 0.0]], "[0, 0]"),
+            (vec![[0.0, 300.0]], "longer than"),
+            (vec![[10.0, 10.0], [20.0, 21.0]], "collinear"),
+            (vec![[1.0, 1.0], [2.0, 2.0], [3.0, 0.0]], "3 basis vectors"),
+        ] {
+            let e = LatticeChoice::Vectors(v).resolve(&[], 256).unwrap_err().to_string();
+            assert!(e.contains(says) && e.contains("lattice"), "{e}");
+        }
+        assert!("[[1, x]]".parse::<LatticeChoice>().unwrap_err().contains("expected"));
+    }
+
+    fn read_json(s: &str) -> LatticeChoice {
+        serde_json::from_str(s).unwrap()
     }
 
     #[test]
