@@ -134,3 +134,44 @@ async fn near_regular_textures_keep_their_detected_lattice_and_umbrella_declines
         s.post("/samples/brick?mode=umbrella", "application/json", br#"{"points":[[1,2,7]]}"#.to_vec()).await;
     assert_eq!(status, 422, "samples of a declined mode");
 }
+
+/// `lattice = "none"` is the code before lattices were detected, byte for byte: brick's tiles
+/// with it are the ones pinned in tests/http_golden.rs before (digests of the PNG bodies), and
+/// a near-regular texture is the same bytes across processes, worker counts and orders.
+#[tokio::test]
+async fn lattice_none_is_the_earlier_bytes_and_near_regular_tiles_are_deterministic() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("textile.toml");
+    let brick = |id: &str, lattice: &str| {
+        format!(
+            "[[textures]]\nid = \"{id}\"\nexemplar = \"embedded:brick.png\"\n{lattice}\n[textures.synth]\nkappa = 0.5\n\n"
+        )
+    };
+    std::fs::write(&cfg, brick("plain", "lattice = \"none\"") + &brick("kept", "")).unwrap();
+    let one = Server::builder().args(&["--config", cfg.to_str().unwrap(), "--workers", "1"]).start();
+    let two = Server::builder().args(&["--config", cfg.to_str().unwrap(), "--workers", "2"]).start();
+    // Pinned before issue 60 (tests/http_golden.rs at ff4a539), for the configured brick.
+    for (path, digest) in [
+        ("/tiles/plain/7/-2/3@2x.png", "ce2ad8fe16e55fa8"),
+        ("/tiles/plain/6/1/1@2x.webp?world=4", "1a9b1c4ce435ea59"),
+        ("/tiles/plain/3/0/0.png?mode=mosaic&iterations=3&block_area=0.3,0.6&smoothing=1", "e7a29d63ca05241c"),
+    ] {
+        let (status, body) = one.get_bytes(path).await;
+        assert_eq!(status, 200, "{path}");
+        assert_eq!(&blake3::hash(&body).to_hex()[..16], digest, "{path}: lattice = \"none\" changed the bytes");
+    }
+    assert!(one.json("/textures/plain").await["structure"].is_null());
+    // The detected lattice: the same bytes from both processes, in opposite orders.
+    let paths: Vec<String> = [(7, 0, 0), (7, -3, 12), (6, 1, -1), (9, 5, -7)]
+        .iter()
+        .flat_map(|&(z, x, y)| ["synth", "mosaic"].map(|m| format!("/tiles/kept/{z}/{x}/{y}.png?mode={m}&seed=2")))
+        .collect();
+    let mut first = Vec::new();
+    for p in &paths {
+        first.push(one.get_bytes(p).await);
+    }
+    for (p, want) in paths.iter().zip(&first).rev() {
+        assert_eq!(want.0, 200, "{p}");
+        assert!(&two.get_bytes(p).await == want, "{p} differs between processes and worker counts");
+    }
+}
