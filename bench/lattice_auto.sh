@@ -35,7 +35,8 @@ echo "| exemplar | mode | lattice | zoom | texq lattice | nn_err | nn_ref | copy
 echo "|---|---|---|---|---|---|---|---|---|" >> "$OUT/scores.md"
 for pair in "planks:$M/planks/albedo.png" "cobblestones:$M/cobblestones/albedo.png" \
   "brick:$SHARED/exemplars/brick.png" "tiles:$OUT/made/tiles.png" "grating:$OUT/made/grating.png" \
-  "bond:$OUT/made/bond.png" "plank floor:$OUT/made/planks.png"; do
+  "bond:$OUT/made/bond.png" "plank floor:$OUT/made/planks.png" "tread:$OUT/made/tread.png" \
+  "brick 256:$SHARED/exemplars/brick_256.png"; do
   name=${pair%%:*}; ex=${pair#*:}
   side=$(python3 -c "from PIL import Image; print(Image.open('$ex').size[0])")
   native=$(python3 -c "import math; print(int(math.log2($side)))")

@@ -5,6 +5,8 @@ cells are filled with real texture from the development set (../shared/exemplars
   grating  bars every 16 texels over gravel
   bond     a running bond: courses 16 high, bricks 32 long, each course shifted by half a brick
   planks   a 1-D plank floor, spacing 256/6 = 42.67 texels (non-integer), grain along the planks
+  tread    a diagonal tread plate: lugs along alternate diagonals on the lattice (17.5, ±17.5),
+           over the gravel material (issue 70)
 
 Usage: python3 bench/lattice_exemplars.py SHARED_DIR OUT_DIR"""
 import sys
@@ -50,3 +52,15 @@ img = k * tint[plank] * np.array([1.0, 0.85, 0.65])
 gap = (yy % (S / 6)) < 4
 img[gap] = 12
 save('planks', img)
+# Diagonal tread: lugs (bright ellipses along a diagonal) on the lattice a = (p, p), b = (p, -p),
+# p = 17.5 (non-integer), over the gravel material.
+m = np.asarray(Image.open(E + 'materials/gravel/albedo.png').convert('RGB')).astype(float)
+p = 17.5
+u, v = ((xx + 0.5) / p + (yy + 0.5) / p) / 2, ((xx + 0.5) / p - (yy + 0.5) / p) / 2
+fu, fv = u - np.round(u), v - np.round(v)
+dx, dy = p * (fu + fv), p * (fu - fv)
+along, across = (dx + dy) / np.sqrt(2), (dx - dy) / np.sqrt(2)
+lug = (along / (0.45 * p)) ** 2 + (across / (0.15 * p)) ** 2 <= 1
+img = m * 0.7
+img[lug] = np.minimum(m[lug] + 90, 255)
+save('tread', img)
