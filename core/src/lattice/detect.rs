@@ -206,7 +206,8 @@ pub fn detect(pixels: &[[u8; 3]], side: u32) -> Detection {
         scale *= 2.0;
     }
     let a = Autocorrelation::new(&luma, m);
-    let repeat = exact::find(pixels, side as usize, &a, scale as usize);
+    let lags = exact::Lags { m: a.m, n: a.n, a: &a.a };
+    let repeat = exact::find(pixels, side as usize, &lags, scale as usize);
     // A tiling's own period is no lattice: inside one tile, a wave must repeat at least twice.
     let inside = |r: &Ridge| {
         repeat.as_ref().is_none_or(|rep| {
@@ -270,17 +271,17 @@ fn halve(v: &[f64], m: usize) -> Vec<f64> {
 }
 
 /// The normalised autocorrelation of an image, at lags in `(-n/2, n/2)` (stored wrapped).
-pub(super) struct Autocorrelation {
+struct Autocorrelation {
     /// Exemplar side.
-    pub(super) m: usize,
+    m: usize,
     /// Padded side (`2m`).
-    pub(super) n: usize,
+    n: usize,
     /// Values at integer lags, row-major, negative lags wrapped.
-    pub(super) a: Vec<f64>,
+    a: Vec<f64>,
 }
 
 impl Autocorrelation {
-    pub(super) fn new(luma: &[f64], m: usize) -> Autocorrelation {
+    fn new(luma: &[f64], m: usize) -> Autocorrelation {
         let n = 2 * m;
         let mean = luma.iter().sum::<f64>() / luma.len().max(1) as f64;
         let hann: Vec<f64> =

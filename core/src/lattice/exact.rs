@@ -10,8 +10,6 @@
 //! What it is for: a texel's copy is the same content, so it must not be its second coherence
 //! candidate ([`Repeat::is_copy`]), and the tile's size is what a user should be told.
 
-use super::detect::Autocorrelation;
-
 /// Least Laplacian correlation of a copy. Tilings score 1.000; the best non-tiling measured in
 /// the design note scored 0.93 (a grating whose artist reused its halves).
 pub const COPY_MIN: f64 = 0.95;
@@ -162,9 +160,20 @@ fn correlation(lap: &[f64], m: usize, (dx, dy): (i64, i64)) -> Option<f64> {
     Some(cov / (va * vb).sqrt())
 }
 
+/// A luma autocorrelation as [`find`] reads it: the values at integer lags of an image of side
+/// `m`, zero-padded to `n`, row-major with negative lags wrapped.
+pub(super) struct Lags<'a> {
+    /// The image's side.
+    pub m: usize,
+    /// The padded side.
+    pub n: usize,
+    /// The values.
+    pub a: &'a [f64],
+}
+
 /// The exact repeat of the `m × m` exemplar `pixels`, whose luma autocorrelation (possibly of
 /// the image reduced by `scale`) is `a`; `None` if it is no tiling.
-pub(super) fn find(pixels: &[[u8; 3]], m: usize, a: &Autocorrelation, scale: usize) -> Option<Repeat> {
+pub(super) fn find(pixels: &[[u8; 3]], m: usize, a: &Lags, scale: usize) -> Option<Repeat> {
     let lap = laplacian(pixels, m);
     // Proposals: local maxima of the autocorrelation in the half plane, highest first.
     let (ma, n) = (a.m as i64, a.n as i64);
