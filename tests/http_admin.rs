@@ -550,3 +550,28 @@ async fn uploads_report_their_structure_and_take_a_lattice_field() {
     basis.sort();
     assert_eq!(basis, [[-18, 16], [18, 16]], "{lattice}");
 }
+
+/// Issue 71, item 4: flatness is judged on the image as it was sent. A 1-px checkerboard
+/// larger than the largest side used shrinks to grey, but it was not sent flat: it is accepted;
+/// an image that is flat as sent is still refused.
+#[tokio::test]
+async fn an_upload_is_judged_flat_as_it_was_sent_not_as_shrunk() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[]);
+    let png = |f: &dyn Fn(u32, u32) -> u8| {
+        let img = image::RgbImage::from_fn(600, 600, |x, y| {
+            let v = f(x, y);
+            image::Rgb([v, v, v])
+        });
+        let mut out = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+        out.into_inner()
+    };
+    let checkerboard = png(&|x, y| if (x + y) % 2 == 0 { 30 } else { 220 });
+    let (status, _, body) = upload(&s, "?id=checker", "image/png", checkerboard, Some(TOKEN)).await;
+    assert_eq!(status, 202, "a 600² 1-px checkerboard is not flat as sent: {body}");
+    let meta = s.json("/textures/checker").await;
+    assert_eq!(meta["exemplar"]["input_width"], 600, "{meta}");
+    let (status, _, body) = upload(&s, "?id=grey", "image/png", png(&|_, _| 128), Some(TOKEN)).await;
+    assert_eq!((status, body["error"].as_str()), (400, Some("flat_image")), "{body}");
+}

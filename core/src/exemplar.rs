@@ -74,6 +74,10 @@ pub struct Exemplar {
     /// The randomness mask over the exemplar (`R_E`), when the texture has one
     /// ([`Exemplar::with_randomness_mask`]).
     pub randomness_mask: Option<RandomnessMask>,
+    /// The colour variation of the image as it was given (its square crop, before any
+    /// resampling; [`Exemplar::spread`]), when it was resampled: flatness is judged on the
+    /// image as sent, not on what shrinking made of it.
+    pub input_spread: Option<f64>,
     /// The lattice of a near-regular exemplar ([`Exemplar::with_lattice`]).
     pub lattice: Option<Lattice>,
     /// The exact repeat of an exemplar that is a tile repeated (found with the lattice,
@@ -120,6 +124,7 @@ impl Exemplar {
             square.extend_from_slice(&rgb[row..row + s]);
         }
         let side = target_side(crop_side);
+        let input_spread = (side != crop_side).then(|| spread_of(&square));
         let pixels = if side == crop_side { square } else { area_resample(&square, s, side as usize) };
         let seam_ratio = seam_ratio(&pixels, side as usize);
         let toroidal = opts.toroidal.unwrap_or(seam_ratio <= 1.5);
@@ -138,6 +143,7 @@ impl Exemplar {
             },
             hires: None,
             randomness_mask: None,
+            input_spread,
             lattice: None,
             repeat: None,
             structure: None,
@@ -148,22 +154,14 @@ impl Exemplar {
     /// The colour variation of the prepared pixels: the standard deviation, in 8-bit levels,
     /// of the most varied channel.
     pub fn spread(&self) -> f64 {
-        let n = self.pixels.len().max(1) as f64;
-        (0..3)
-            .map(|c| {
-                let (s, s2) = self.pixels.iter().fold((0u64, 0u64), |(s, s2), p| {
-                    let v = p[c] as u64;
-                    (s + v, s2 + v * v)
-                });
-                let mean = s as f64 / n;
-                (s2 as f64 / n - mean * mean).max(0.0).sqrt()
-            })
-            .fold(0.0, f64::max)
+        spread_of(&self.pixels)
     }
 
-    /// Refuse a flat exemplar ([`MIN_SPREAD`]): [`CoreError::FlatExemplar`].
+    /// Refuse a flat exemplar ([`MIN_SPREAD`]): [`CoreError::FlatExemplar`]. Judged on the
+    /// image as it was given where it was resampled (a 1-px checkerboard larger than the
+    /// largest side shrinks to grey, but was not sent flat).
     pub fn check_not_flat(&self) -> Result<()> {
-        let spread = self.spread();
+        let spread = self.spread().max(self.input_spread.unwrap_or(0.0));
         if spread < MIN_SPREAD {
             return Err(CoreError::FlatExemplar { spread, min: MIN_SPREAD });
         }
@@ -216,6 +214,7 @@ impl Exemplar {
             preparation,
             hires: Some(hires.pixels),
             randomness_mask: None,
+            input_spread: hires.input_spread,
             lattice: None,
             repeat: None,
             structure: None,
@@ -325,6 +324,22 @@ impl Exemplar {
         self.repeat = found.repeat;
         Ok(self)
     }
+}
+
+/// The colour variation of `pixels`: the standard deviation, in 8-bit levels, of the most
+/// varied channel.
+fn spread_of(pixels: &[[u8; 3]]) -> f64 {
+    let n = pixels.len().max(1) as f64;
+    (0..3)
+        .map(|c| {
+            let (s, s2) = pixels.iter().fold((0u64, 0u64), |(s, s2), p| {
+                let v = p[c] as u64;
+                (s + v, s2 + v * v)
+            });
+            let mean = s as f64 / n;
+            (s2 as f64 / n - mean * mean).max(0.0).sqrt()
+        })
+        .fold(0.0, f64::max)
 }
 
 fn check_size(w: u32, h: u32, max: u32) -> Result<()> {

@@ -296,6 +296,7 @@ pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
         preparation,
         hires: None,
         randomness_mask: None,
+        input_spread: ex.input_spread,
         lattice: None,
         repeat: None,
         structure: None,

@@ -303,6 +303,7 @@ impl Analysis {
             preparation: h.preparation.clone(),
             hires: None,
             randomness_mask: None,
+            input_spread: None,
             lattice: h.lattice.clone(),
             repeat: h.repeat.clone(),
             structure: h.structure.clone(),
