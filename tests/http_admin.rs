@@ -277,6 +277,8 @@ async fn uploads_are_served_like_rendered_exemplars_and_survive_restarts() {
     // A restart serves the uploads that were kept, with the same bytes.
     let s = admin_server(data.path(), &[]);
     assert_eq!(catalog_ids(&s).await, ["gravel", "grass", "brick", "corkboard", "flagstones", "mine", "race"]);
+    // Uploads are loaded after readiness (issue 71): wait for this one.
+    until_ready(&s, "/textures/mine").await;
     let (status, again) = s.get_bytes("/tiles/mine/7/1/2.png?seed=3").await;
     assert_eq!((status, again), (200, tile));
     assert!(s.log_text().contains("texture 'mine': loaded analysis"), "the analysis was kept, not recomputed");
@@ -574,4 +576,41 @@ async fn an_upload_is_judged_flat_as_it_was_sent_not_as_shrunk() {
     assert_eq!(meta["exemplar"]["input_width"], 600, "{meta}");
     let (status, _, body) = upload(&s, "?id=grey", "image/png", png(&|_, _| 128), Some(TOKEN)).await;
     assert_eq!((status, body["error"].as_str()), (400, Some("flat_image")), "{body}");
+}
+
+/// Issue 71, item 5: `/ready` is the configured textures', not the stored uploads'. An upload's
+/// stored analysis is replaced by a named pipe that nobody writes: reading it blocks until the
+/// test writes the file's bytes into it. The restarted server is ready all the same, serves its
+/// configured textures and shows the upload `analysing`; once the bytes arrive, the upload is
+/// ready with the analysis it had (loaded, not recomputed).
+#[tokio::test]
+async fn ready_does_not_wait_for_stored_uploads() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[]);
+    let (status, headers, body) = upload(&s, "?id=later", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    let before = until_ready(&s, headers.get("location").unwrap().to_str().unwrap()).await;
+    drop(s);
+    let stored = data.path().join("later.tex");
+    let bytes = std::fs::read(&stored).expect("the upload's stored analysis");
+    std::fs::remove_file(&stored).unwrap();
+    let made = std::process::Command::new("mkfifo").arg(&stored).status().expect("mkfifo");
+    assert!(made.success());
+
+    let s = admin_server(data.path(), &[]);
+    let (status, _) = s.get_bytes("/ready").await;
+    assert_eq!(status, 200, "ready while an upload's analysis is still being read");
+    let (status, _) = s.get_bytes("/tiles/gravel/7/0/0.png").await;
+    assert_eq!(status, 200);
+    assert_eq!(s.json("/textures/later").await["status"], "analysing");
+    // Feed the pipe: the upload comes in with the analysis it had.
+    let writer = std::thread::spawn(move || {
+        use std::io::Write;
+        let mut pipe = std::fs::OpenOptions::new().write(true).open(&stored).expect("open the pipe");
+        let _ = pipe.write_all(&bytes);
+    });
+    let after = until_ready(&s, "/textures/later").await;
+    writer.join().unwrap();
+    assert_eq!(after["analysis"]["id"], before["analysis"]["id"], "{after}");
+    assert!(s.log_text().contains("texture 'later': loaded analysis"), "read from the pipe, not recomputed");
 }

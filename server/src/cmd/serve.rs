@@ -15,7 +15,7 @@ use crate::cmd::args::{CliResult, ServeArgs};
 use crate::config::Config;
 use crate::http::listen::{self, Limits};
 use crate::state::AppState;
-use crate::textures::{analyse_registry, has_current_analysis, prepare_registry, LoadError, Texture};
+use crate::textures::{analyse_registry, prepare_registry, LoadError, Texture};
 
 /// Run the server until a shutdown signal.
 pub fn run(args: ServeArgs) -> CliResult {
@@ -67,9 +67,10 @@ async fn serve(cfg: Config) -> CliResult {
         });
     }
     // Exemplars first (modes that need only the exemplar serve at once), then the configured
-    // textures' analyses on the analysis pool, and the stored ones of uploads; uploads whose
-    // analysis must be computed are analysed in the background after them, like new uploads,
-    // so they never hold back readiness.
+    // textures' analyses on the analysis pool. Uploads are loaded (their stored analyses read,
+    // or computed) in the background after them, like new uploads, so they never hold back
+    // readiness: `/ready` is the configured textures' (issue 71: 11 stored uploads held it
+    // back 5.6 s); `GET /textures/{id}` says `analysing` until an upload is in.
     let loader = {
         let state = state.clone();
         tokio::task::spawn_blocking(move || {
@@ -77,7 +78,7 @@ async fn serve(cfg: Config) -> CliResult {
             let cfg = crate::uploads::with_stored(&state.config, &log);
             let reg = Arc::new(prepare_registry(&cfg, &log)?);
             state.set_registry(reg.clone());
-            let now = |t: &Texture| !t.config.uploaded || has_current_analysis(&cfg.data_dir(), t);
+            let now = |t: &Texture| !t.config.uploaded;
             state.analysis_pool.run(|| analyse_registry(&cfg, &reg, &now, &log, &state.stopping))?;
             state.loaded.store(true, std::sync::atomic::Ordering::Relaxed);
             Ok(())

@@ -55,8 +55,9 @@ pub async fn health(State(st): State<Arc<AppState>>) -> Json<Value> {
     }))
 }
 
-/// Readiness: 200 once every texture is loaded and analysed, 503 before (modes that need only
-/// the exemplar already serve while analyses are computed).
+/// Readiness: 200 once every configured texture is loaded and analysed (uploads load after, in
+/// the background), 503 before (modes that need only the exemplar already serve while analyses
+/// are computed).
 #[utoipa::path(get, path = "/ready", tag = "service",
     responses((status = 200, description = "ready"), (status = 503, description = "still loading or analysing")))]
 pub async fn ready(State(st): State<Arc<AppState>>) -> Result<Json<Value>, ApiError> {

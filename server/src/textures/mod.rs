@@ -19,7 +19,7 @@ use textile_core::modes::Prepared;
 use textile_core::{Analysis, Cancel, Defaults, Exemplar, Source};
 
 use crate::config::TextureConfig;
-pub use preparation::{analyse_registry, analyse_texture, has_current_analysis, load_registry};
+pub use preparation::{analyse_registry, analyse_texture, load_registry};
 pub use registry::{prepare_registry, prepare_texture, Registry};
 pub use storage::{embedded, exemplar_bytes, stored_extensions};
 

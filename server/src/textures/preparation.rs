@@ -70,13 +70,6 @@ fn watch_outcome(
     }
 }
 
-/// Whether `data_dir` holds an analysis of `tex` that is current (by its header: loading it
-/// still checks the whole file).
-pub fn has_current_analysis(data_dir: &std::path::Path, tex: &Texture) -> bool {
-    let path = data_dir.join(format!("{}.tex", tex.config.id));
-    Analysis::read_header(&path).is_ok_and(|h| h.id == Analysis::id_for(&tex.exemplar, tex.config.candidate_search))
-}
-
 /// How a texture's preparations are logged and where they are stored.
 struct Preparing<'a> {
     cfg: &'a Config,
