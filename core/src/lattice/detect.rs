@@ -110,7 +110,7 @@ impl Detection {
         }
     }
 
-    /// The structure as `GET /textures/{id}` and `textile info --json` report it: `class`,
+    /// The structure as `GET /textures/{id}` reports it (`structure`): `class`,
     /// `basis` (vectors `[dy, dx]` in exemplar texels: the copies for `exact`, the lattice's
     /// translations for `lattice`), `dimensions`, `scores`, and for `exact` the `tile` (its
     /// size when axis-aligned, its area) and the structure `inner` to one tile.

@@ -188,7 +188,7 @@ impl Lattice {
         LevelLattice::new(&held, longest)
     }
 
-    /// The lattice as `GET /textures/{id}` and `textile info --json` report it: `kind`
+    /// The lattice as `GET /textures/{id}` reports it (`exemplar.lattice`): `kind`
     /// (`stripes` or `grid`), `waves` (period in texels, angle of the normal in degrees),
     /// `basis` (translation vectors in texels), `confidence` (0–1), `origin`.
     pub fn summary(&self) -> serde_json::Value {
