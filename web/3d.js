@@ -188,16 +188,7 @@ async function selectTexture(id, keepView) {
   if (!r.ok) throw new Error(`texture ${id}: HTTP ${r.status}`);
   meta = await r.json();
   state.t = id;
-  const modes = $('mode');
-  modes.textContent = '';
-  const declined = meta.declined_modes || {};
-  for (const m of meta.modes) {
-    const o = new Option(declined[m] ? `${m} (declines this texture)` : m, m);
-    if (declined[m]) { o.disabled = true; o.title = declined[m]; }
-    modes.append(o);
-  }
-  if (!meta.modes.includes(state.m) || declined[state.m]) state.m = meta.default_mode;
-  modes.value = state.m;
+  state.m = window.TextileModes.fill($('mode'), meta, state.m);
   buildParams();
   $('sun').value = state.sun;
   placeSun();

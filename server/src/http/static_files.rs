@@ -12,6 +12,7 @@ use crate::error::ApiError;
 const FILES: &[(&str, &str, &[u8])] = &[
     ("app.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/app.js")),
     ("controls.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/controls.js")),
+    ("modes.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/modes.js")),
     ("world.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/world.js")),
     ("pmtiles.html", "text/html; charset=utf-8", include_bytes!("../../../web/pmtiles.html")),
     ("pmtiles.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/pmtiles.js")),
