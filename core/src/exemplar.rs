@@ -314,12 +314,15 @@ impl Exemplar {
             (self.lattice, self.repeat, self.structure) = (None, None, None);
             return Ok(self);
         }
+        // A given lattice is checked before the pixels are looked at.
+        match *choice {
+            LatticeChoice::Cells(nx, ny) => self = self.with_lattice(nx, ny)?,
+            _ => self.lattice = choice.explicit(self.side)?,
+        }
         let found = crate::lattice::detect(&self.pixels, self.side);
-        self = match *choice {
-            LatticeChoice::Cells(nx, ny) => self.with_lattice(nx, ny)?,
-            LatticeChoice::Auto => Exemplar { lattice: found.lattice.clone(), ..self },
-            _ => Exemplar { lattice: choice.resolve(&self.pixels, self.side)?, ..self },
-        };
+        if *choice == LatticeChoice::Auto {
+            self.lattice = found.lattice.clone();
+        }
         self.structure = Some(found.summary());
         self.repeat = found.repeat;
         Ok(self)

@@ -115,7 +115,7 @@ impl Detection {
     /// translations for `lattice`), `dimensions`, `scores`, and for `exact` the `tile` (its
     /// size when axis-aligned, its area) and the structure `inner` to one tile.
     pub fn summary(&self) -> serde_json::Value {
-        let r = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+        let r = super::milli;
         let ridges: Vec<serde_json::Value> = self
             .ridges
             .iter()

@@ -1,4 +1,4 @@
-//! Exact repeats (`../shared/design/lattice.md` §2.1): an exemplar that is a smaller tile
+//! Exact repeats (the lattice design note, §2.1): an exemplar that is a smaller tile
 //! repeated pixel for pixel — a "seamless" texture tiled 2×2, a crop holding 1.3 copies of a
 //! 100 px tile, a material laid as a checkerboard of two blocks. Its copies are lags `d` at which
 //! the 3×3 Laplacian of the luma correlates with itself at [`COPY_MIN`] or more over the

@@ -192,11 +192,11 @@ impl Lattice {
     /// (`stripes` or `grid`), `waves` (period in texels, angle of the normal in degrees),
     /// `basis` (translation vectors in texels), `confidence` (0–1), `origin`.
     pub fn summary(&self) -> serde_json::Value {
-        let r = |v: f64| (v * 1000.0).round() / 1000.0;
+        let r = milli;
         serde_json::json!({
             "kind": if self.is_stripes() { "stripes" } else { "grid" },
             "waves": self.waves.iter().map(|w| serde_json::json!({"period": r(w.period()), "angle": r(w.angle_deg())})).collect::<Vec<_>>(),
-            "basis": self.basis().iter().map(|v| [r(v[0]) + 0.0, r(v[1]) + 0.0]).collect::<Vec<_>>(),
+            "basis": self.basis().iter().map(|v| [r(v[0]), r(v[1])]).collect::<Vec<_>>(),
             "confidence": self.confidence as f64 / 1000.0,
             "origin": self.origin,
         })
@@ -210,6 +210,11 @@ impl Lattice {
             h.update(&w.angle.to_le_bytes());
         }
     }
+}
+
+/// `v` rounded to thousandths for reports (and never `-0`).
+pub(crate) fn milli(v: f64) -> f64 {
+    (v * 1000.0).round() / 1000.0 + 0.0
 }
 
 /// Least angle between two waves, in degrees.
