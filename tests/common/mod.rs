@@ -13,9 +13,16 @@ pub fn binary() -> &'static str {
     env!("CARGO_BIN_EXE_textile")
 }
 
-/// A data directory shared by the tests (analyses are computed once, written atomically).
+/// A data directory shared by the tests (analyses are computed once, written atomically), one
+/// per build of the binary: analyses a previous build wrote are not reused, so a local run sees
+/// what a clean clone's CI sees (an analysis file whose contents changed moves ETags).
 pub fn shared_data_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("textile-test-data")
+    let built = std::fs::metadata(binary())
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .map_or(0, |d| d.as_secs());
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("textile-test-data-{built}"))
 }
 
 /// Write `textile.toml` in `dir` serving the embedded gravel exemplar once per `(id, extra TOML
