@@ -76,7 +76,7 @@ async fn archives_hold_the_servers_tiles() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("'flagstones?map=normal'") || err.contains("map=normal"), "{err}");
-    let s = Server::builder().data_dir(&shared_data_dir()).start();
+    let s = Server::builder().start();
     for a in [&world, &mosaic, &bbox, &normal] {
         check(a, &s);
     }

@@ -10,6 +10,7 @@
 //! [`encode`] → [`http::content`] headers. `textile render` goes through the same
 //! [`pipeline::ImageJob`].
 
+pub mod access_log;
 pub mod assets;
 pub mod cache;
 pub mod cmd;

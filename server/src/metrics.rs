@@ -1,6 +1,6 @@
 //! Prometheus metrics (the `prometheus` crate): requests by route and status, latency
 //! histograms, tile-cache hits/misses/evictions/bytes, syntheses by mode, in-flight and shed
-//! syntheses, pyramidal (level) cache blocks. One registry per server; `/metrics` renders it in
+//! syntheses, pyramidal (level) cache blocks, access log lines written and dropped. One registry per server; `/metrics` renders it in
 //! the text format.
 
 use prometheus::{
@@ -57,6 +57,10 @@ pub struct Metrics {
     pub prepared_bytes: IntGauge,
     /// Bytes of caches the textures' prepared states may keep, in all.
     pub prepared_cache_limit_bytes: IntGauge,
+    /// Access log lines written.
+    pub access_log_lines: IntCounter,
+    /// Access log lines dropped because the writer was behind (its buffer full).
+    pub access_log_dropped: IntCounter,
 }
 
 fn must<T>(r: prometheus::Result<T>) -> T {
@@ -123,6 +127,11 @@ impl Metrics {
                 Opts::new("pixels_delivered_total", "pixels delivered by syntheses, by mode"),
                 &["mode"],
             )),
+            access_log_lines: must(IntCounter::new("access_log_lines_total", "access log lines written")),
+            access_log_dropped: must(IntCounter::new(
+                "access_log_dropped_total",
+                "access log lines dropped because the writer was behind (access_log_buffer full)",
+            )),
             registry,
         };
         let all: Vec<Box<dyn prometheus::core::Collector>> = vec![
@@ -147,6 +156,8 @@ impl Metrics {
             Box::new(m.level_cache_blocks.clone()),
             Box::new(m.prepared_bytes.clone()),
             Box::new(m.prepared_cache_limit_bytes.clone()),
+            Box::new(m.access_log_lines.clone()),
+            Box::new(m.access_log_dropped.clone()),
         ];
         for c in all {
             must(m.registry.register(c));

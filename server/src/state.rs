@@ -58,6 +58,8 @@ pub struct AppState {
     pub memory: Arc<Semaphore>,
     /// Prometheus metrics.
     pub metrics: Metrics,
+    /// The access log, if one is configured (`access_log`; opened by `textile serve`).
+    pub access_log: Option<crate::access_log::AccessLog>,
 }
 
 /// Working memory reserved from the budget, given back when dropped.
@@ -95,6 +97,7 @@ impl AppState {
             stopping: Cancel::default(),
             loaded: Default::default(),
             metrics,
+            access_log: None,
         })
     }
 

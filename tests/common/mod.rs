@@ -25,6 +25,56 @@ pub fn shared_data_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("textile-test-data-{built}"))
 }
 
+/// A data directory of one server's own (a server owns its data directory: a second one on it
+/// is refused), seeded with hard links to the analyses and preparations the tests have stored
+/// in [`shared_data_dir`]; [`Server`]'s drop links what it computed back there, so analyses are
+/// still computed once.
+fn private_data_dir() -> PathBuf {
+    static MADE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = MADE.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let store = shared_data_dir();
+    let own =
+        PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("textile-servers").join(format!("{}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&own);
+    std::fs::create_dir_all(&own).expect("private data dir");
+    std::fs::create_dir_all(&store).expect("shared data dir");
+    for (name, path) in stored_files(&store) {
+        let _ = std::fs::hard_link(&path, own.join(name));
+    }
+    own
+}
+
+/// The analyses and preparations a data directory holds: its regular files but temporary ones,
+/// the lock and the uploads.
+fn stored_files(dir: &Path) -> Vec<(std::ffi::OsString, PathBuf)> {
+    let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
+    entries
+        .flatten()
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .map(|e| (e.file_name(), e.path()))
+        .filter(|(name, _)| {
+            let name = name.to_string_lossy();
+            !name.starts_with('.') && name != "textile.lock"
+        })
+        .collect()
+}
+
+/// Link into the shared store what a private data directory computed that the store lacks
+/// (atomically: a link under a temporary name, renamed), then remove the private directory.
+fn give_back(own: &Path) {
+    let store = shared_data_dir();
+    for (name, path) in stored_files(own) {
+        let target = store.join(&name);
+        if !target.exists() {
+            let tmp = store.join(format!(".{}.give-{}", name.to_string_lossy(), std::process::id()));
+            if std::fs::hard_link(&path, &tmp).is_ok() && std::fs::rename(&tmp, &target).is_err() {
+                let _ = std::fs::remove_file(&tmp);
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(own);
+}
+
 /// Write `textile.toml` in `dir` serving the embedded gravel exemplar once per `(id, extra TOML
 /// lines)` entry; returns its path.
 pub fn gravel_textures_config(dir: &Path, textures: &[(&str, &str)]) -> PathBuf {
@@ -56,6 +106,8 @@ fn launch(args: &[std::ffi::OsString], env: &[(&str, &str)], stdout: Stdio) -> (
 /// A running server process.
 pub struct Server {
     child: Child,
+    /// Its data directory, when it is a private one seeded from the shared store.
+    private: Option<PathBuf>,
     /// `http://127.0.0.1:PORT`.
     pub base: String,
     /// A client with its own connection pool.
@@ -109,14 +161,16 @@ impl Builder {
     /// are analysed (the "ready" line comes only after every analysis).
     pub async fn start_loading(self) -> Server {
         let port = std::net::TcpListener::bind("127.0.0.1:0").expect("free port").local_addr().expect("addr").port();
-        let dir = self.data_dir.unwrap_or_else(shared_data_dir);
+        let private = self.data_dir.is_none().then(private_data_dir);
+        let dir = self.data_dir.or_else(|| private.clone()).expect("a data directory");
         let mut args: Vec<std::ffi::OsString> =
             vec!["serve".into(), "--bind".into(), format!("127.0.0.1:{port}").into()];
         args.extend(["--data-dir".into(), dir.into_os_string()]);
         args.extend(self.args);
         let env: Vec<(&str, &str)> = self.env.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
         let (child, log) = launch(&args, &env, Stdio::null());
-        let server = Server { child, base: format!("http://127.0.0.1:{port}"), client: reqwest::Client::new(), log };
+        let base = format!("http://127.0.0.1:{port}");
+        let server = Server { child, private, base, client: reqwest::Client::new(), log };
         for _ in 0..600 {
             if server.client.get(server.url("/health")).send().await.is_ok_and(|r| r.status() == 200) {
                 return server;
@@ -129,14 +183,15 @@ impl Builder {
     /// Start it and wait until it is ready.
     pub fn start(self) -> Server {
         let mut args: Vec<std::ffi::OsString> = Vec::new();
+        let private = (!self.bare && self.data_dir.is_none()).then(private_data_dir);
         if !self.bare {
-            let dir = self.data_dir.unwrap_or_else(shared_data_dir);
+            let dir = self.data_dir.or_else(|| private.clone()).expect("a data directory");
             args.extend(["serve".into(), "--bind".into(), "127.0.0.1:0".into(), "--data-dir".into()]);
             args.push(dir.into_os_string());
         }
         args.extend(self.args);
         let env: Vec<(&str, &str)> = self.env.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
-        Server::spawn(&args, &env)
+        Server::spawn(&args, &env, private)
     }
 }
 
@@ -146,7 +201,7 @@ impl Server {
         Builder::default()
     }
 
-    fn spawn(args: &[std::ffi::OsString], env: &[(&str, &str)]) -> Server {
+    fn spawn(args: &[std::ffi::OsString], env: &[(&str, &str)], private: Option<PathBuf>) -> Server {
         let (mut child, log) = launch(args, env, Stdio::piped());
         let stdout = child.stdout.take().expect("stdout");
         let (tx, rx) = mpsc::channel();
@@ -162,12 +217,16 @@ impl Server {
                 Ok(line) => {
                     if let Some(rest) = line.strip_prefix("textile ready: viewer at ") {
                         let url = rest.split_whitespace().next().unwrap_or_default().trim_end_matches('/');
-                        return Server { child, base: url.to_string(), client: reqwest::Client::new(), log };
+                        let base = url.to_string();
+                        return Server { child, private, base, client: reqwest::Client::new(), log };
                     }
                 }
                 Err(_) => {
                     let _ = child.kill();
                     let _ = child.wait();
+                    if let Some(own) = &private {
+                        give_back(own);
+                    }
                     let log = std::fs::read_to_string(&log).unwrap_or_default();
                     panic!("textile did not report ready within 180 s (or exited); its log:\n{log}");
                 }
@@ -234,6 +293,9 @@ impl Server {
         let _ = Command::new("kill").arg("-TERM").arg(self.child.id().to_string()).status();
         let code = self.child.wait().ok().and_then(|s| s.code());
         let _ = std::fs::remove_file(&self.log);
+        if let Some(own) = self.private.take() {
+            give_back(&own);
+        }
         std::mem::forget(self);
         code
     }
@@ -251,6 +313,9 @@ impl Drop for Server {
         let _ = std::fs::remove_file(&self.log);
         let _ = self.child.kill();
         let _ = self.child.wait();
+        if let Some(own) = self.private.take() {
+            give_back(&own);
+        }
     }
 }
 

@@ -280,8 +280,10 @@ pub struct LoadtestArgs {
     /// (uniform tiles), hot (one tile), replay (the requests of --file, cycled or --once).
     #[arg(long, default_value = "pan", value_parser = ["pan", "zoom", "random", "hot", "replay"])]
     pub pattern: String,
-    /// Requests for `--pattern replay`: one URL, /path, or nginx/Apache combined (or common)
-    /// access-log line per line; access-log lines other than GET and HEAD are left out.
+    /// Requests for `--pattern replay`: one URL, /path, nginx/Apache combined (or common)
+    /// access-log line, or line of textile's own JSON access log (`serve --access-log`) per
+    /// line; access-log lines other than GET and HEAD are left out, and a log is played in the
+    /// order of its times.
     #[arg(long, value_name = "FILE")]
     pub file: Option<PathBuf>,
     /// Replay the file once, in order, then end (by default it is cycled).

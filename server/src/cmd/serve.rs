@@ -2,7 +2,8 @@
 //! 503 elsewhere while textures load), decode the exemplars (modes that need only the exemplar
 //! serve from then on), load or compute analyses, announce the viewer URL, and drain in-flight
 //! requests on SIGINT/SIGTERM for at most `shutdown_grace_secs` (a signal during start-up stops
-//! the loading and never announces ready). Connections are accepted by [`listen`].
+//! the loading and never announces ready). Connections are accepted by [`listen`]. The access
+//! log, if configured, is opened before listening, reopened on SIGHUP and flushed at exit.
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -53,7 +54,28 @@ async fn serve(cfg: Config) -> CliResult {
         header_read_timeout: Duration::from_secs(cfg.header_read_timeout_secs),
         shutdown_grace: Duration::from_secs(cfg.shutdown_grace_secs),
     };
-    let state = Arc::new(AppState::new(cfg)?);
+    // One server per data directory, taken before anything is written there (uploads, analyses).
+    // A directory that cannot be written is not locked: nothing is stored in it (the registry
+    // says so when it loads).
+    let _owner = match crate::textures::lock::DataDirLock::acquire(&cfg.data_dir()) {
+        Ok(l) => Some(l),
+        Err(e @ crate::textures::lock::LockError::Owned { .. }) => return Err(Box::new(e)),
+        Err(e) => {
+            warn!("{e}");
+            None
+        }
+    };
+    let mut state = AppState::new(cfg)?;
+    if !state.config.access_log.is_empty() {
+        let c = &state.config;
+        let format = crate::access_log::Format::parse(&c.access_log_format).unwrap_or(crate::access_log::Format::Json);
+        let (written, dropped) = (state.metrics.access_log_lines.clone(), state.metrics.access_log_dropped.clone());
+        let log = crate::access_log::AccessLog::open(&c.access_log, format, c.access_log_buffer, written, dropped)
+            .map_err(|e| format!("cannot open the access log: {e}"))?;
+        state.access_log = Some(log);
+    }
+    let state = Arc::new(state);
+    reopen_on_sighup(state.clone());
     let app = crate::http::router(state.clone());
     info!("listening on http://{addr}/ (loading textures)");
     // One shutdown signal for everything: the accept loop, and the loading below.
@@ -110,12 +132,33 @@ async fn serve(cfg: Config) -> CliResult {
         // A signal while loading: stop at once (the analysis thread is abandoned at exit).
         _ = stopping.wait_for(|s| *s) => info!("stopped while loading textures"),
     }
-    if server.await? {
+    let drained = server.await?;
+    if let Some(log) = &state.access_log {
+        log.close(Duration::from_secs(2));
+    }
+    if drained {
         info!("shut down cleanly");
     } else {
         warn!("shut down with requests still open after the drain deadline");
     }
     Ok(())
+}
+
+/// SIGHUP: reopen the access log (after logrotate moved it away); without one, nothing.
+fn reopen_on_sighup(state: Arc<AppState>) {
+    #[cfg(unix)]
+    tokio::spawn(async move {
+        let Ok(mut hup) = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::hangup()) else { return };
+        while hup.recv().await.is_some() {
+            match &state.access_log {
+                Some(log) => {
+                    info!("SIGHUP: reopening the access log");
+                    log.reopen();
+                }
+                None => info!("SIGHUP: no access log to reopen"),
+            }
+        }
+    });
 }
 
 async fn shutdown_signal() {

@@ -103,6 +103,16 @@ pub struct Config {
     /// for room, at most `max_queue_wait_ms`, else 503); tiles are not counted: one per worker.
     #[serde(default)]
     pub memory_budget_mib: u64,
+    /// Access log: a file appended to (reopened on SIGHUP), `-` for stdout, empty for none.
+    #[serde(default)]
+    pub access_log: String,
+    /// Access log line format: `json` or `combined`.
+    #[serde(default)]
+    pub access_log_format: String,
+    /// Lines the access log holds for its writer; beyond, lines are dropped (and counted), never
+    /// waited for.
+    #[serde(default)]
+    pub access_log_buffer: usize,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
     /// Directory relative exemplar paths are resolved against (set by the loader).
@@ -195,6 +205,9 @@ impl Config {
         }
         if let Some(p) = self.trusted_proxies.iter().find(|p| p.parse::<std::net::IpAddr>().is_err()) {
             return bad("trusted_proxies", format!("'{p}' is not an IP address"));
+        }
+        if !matches!(self.access_log_format.as_str(), "json" | "combined") {
+            return bad("access_log_format", format!("'{}' is not json or combined", self.access_log_format));
         }
         if !self.admin_token.is_empty() && self.admin_token.len() < 16 {
             return bad("admin_token", "must be at least 16 characters (or empty: admin API off)".into());

@@ -138,6 +138,16 @@ pub const SERVICE: &[Setting] = &[
     int("analysis_timeout_secs", 1, 86_400, 600, "longest an analysis may take, in seconds"),
     int0("max_uploaded_textures", 100_000, 100, "uploads off", "uploaded textures kept at most"),
     int("memory_budget_mib", 64, 1 << 20, 1024, "MiB of working memory requests and analyses may reserve"),
+    text("access_log", "", "access log file, appended to and reopened on SIGHUP (\"-\": stdout; empty: off)")
+        .flag("access-log", "FILE|-"),
+    text("access_log_format", "json", "access log lines: json (one object a line) or combined (Apache/nginx)"),
+    int(
+        "access_log_buffer",
+        1,
+        1_000_000,
+        8192,
+        "access log lines waiting for the writer; beyond, dropped and counted",
+    ),
 ];
 
 /// The setting `key`.

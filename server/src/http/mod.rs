@@ -1,8 +1,10 @@
-//! The HTTP service: routes, middleware (CORS, compression of JSON, panic → 500 JSON) and the
+//! The HTTP service: routes, middleware (CORS, compression of JSON, panic → 500 JSON, the access
+//! log) and the
 //! modules behind them: errors as HTTP answers, content headers, request extraction, and the
 //! route modules (images, descriptive endpoints, 3D assets, static files, OpenAPI), which import
 //! nothing from each other. Nothing outside this folder names it: the crate root dispatches `textile serve` to [`serve`].
 
+pub mod access;
 pub mod admin;
 mod bare_errors;
 pub mod content;
@@ -121,7 +123,7 @@ pub fn router(state: Arc<AppState>) -> Router {
 }
 
 /// The service's fallbacks and middleware around a set of routes: JSON 404/405, request
-/// metrics, JSON compression, CORS, and panics turned into a 500 JSON error.
+/// metrics, JSON compression, CORS, panics turned into a 500 JSON error, and the access log.
 fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Router {
     let cors = CorsLayer::new()
         .allow_methods([Method::GET, Method::HEAD, Method::POST, Method::DELETE])
@@ -147,15 +149,22 @@ fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Route
         .layer(tower_http::timeout::RequestBodyTimeoutLayer::new(body_deadline))
         .layer(middleware::from_fn_with_state(state.clone(), track))
         .layer(middleware::from_fn(limits))
-        .with_state(state);
+        .with_state(state.clone());
     // 405s get their JSON body outside routing: the router adds a route's `Allow` header after
     // every layer of that route has run.
     let app = tower::Layer::layer(&middleware::from_fn(meta::method_not_allowed), app);
-    Router::new()
+    let logged = state.access_log.is_some();
+    let router = Router::new()
         .fallback_service(app)
         .layer(CompressionLayer::new())
         .layer(cors)
-        .layer(CatchPanicLayer::custom(|_| ApiError::internal("the request handler panicked").into_response()))
+        .layer(CatchPanicLayer::custom(|_| ApiError::internal("the request handler panicked").into_response()));
+    // Outermost, so that it logs every answer as sent; absent when there is no access log.
+    if logged {
+        router.layer(middleware::from_fn_with_state(state, access::record))
+    } else {
+        router
+    }
 }
 
 #[cfg(test)]

@@ -3,10 +3,11 @@
 //! the parts that make one: [`storage`] (where exemplars and prepared files are read and
 //! written), [`registry`] (the catalogue, decoded in one fast phase so that modes needing only
 //! the exemplar serve at once), [`preparation`] (the analysis and every mode's preparation,
-//! loaded when current, else computed in the background and stored), and [`analysing`] (the
-//! low-priority pool they run on).
+//! loaded when current, else computed in the background and stored), [`analysing`] (the
+//! low-priority pool they run on), and [`lock`] (one server per data directory).
 
 pub mod analysing;
+pub mod lock;
 pub mod preparation;
 pub mod registry;
 pub mod storage;

@@ -1,7 +1,8 @@
 //! Where a texture's files are: its exemplar (embedded in the binary or a regular file of
 //! bounded size, relative to the configuration), files its settings name, and the data
 //! directory that keeps what its preparations computed (`<texture>.<extension>`), checked
-//! writable at start, with temporary files of interrupted writes removed.
+//! writable at start (and not another process's server's: [`super::lock`]), with temporary
+//! files of interrupted writes removed.
 
 use super::LoadError;
 use crate::config::{Config, TextureConfig};
@@ -113,9 +114,17 @@ pub(crate) fn writable(dir: &std::path::Path) -> Result<(), std::io::Error> {
 }
 
 /// Whether analyses can be stored in the data directory (checked first, with stale temporary
-/// files of interrupted writes removed); if not, a warning is logged.
+/// files of interrupted writes removed); if not, a warning is logged. A directory another
+/// process's server owns ([`super::lock`]) is read, never written: not even probed.
 pub(crate) fn data_dir_storable(cfg: &Config, log: &dyn Fn(String)) -> bool {
     let data_dir = cfg.data_dir();
+    if let Err(pid) = super::lock::may_write(&data_dir) {
+        log(format!(
+            "the data directory {} belongs to the textile server of pid {pid}: reading its analyses, storing none              (what is computed here is kept in memory)",
+            data_dir.display()
+        ));
+        return false;
+    }
     match writable(&data_dir) {
         Ok(()) => {
             remove_stale_temp_files(&data_dir, log);

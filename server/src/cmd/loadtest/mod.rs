@@ -81,7 +81,7 @@ fn model(a: &LoadtestArgs, entries: &[pattern::Entry]) -> Result<Model, String> 
         };
         let times = entries.iter().map(|e| e.at.map(|t| (t - first).max(0.0) / x)).collect::<Option<Vec<f64>>>();
         let mut times = times.ok_or("--speed: every line of the file needs a timestamp (access-log lines only)")?;
-        // Out-of-order log lines (several workers writing one log) are played in file order.
+        // Lines are sorted by time when read; equal times keep file order.
         for i in 1..times.len() {
             times[i] = times[i].max(times[i - 1]);
         }

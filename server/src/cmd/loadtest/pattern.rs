@@ -155,9 +155,22 @@ fn access_log(l: &str) -> Option<(&str, &str, u16, f64)> {
     Some((method, path, status, log_time(time)?))
 }
 
-/// The entries of a replay file: one URL, `/path` or access-log line per line; blank lines and
-/// `#` comments skipped. Access-log lines other than GET or HEAD, or whose status is not in
-/// `statuses` (when given), are left out.
+/// A line of textile's own JSON access log (`access_log_format = "json"`) → (method, path,
+/// status, time): `ts` is the request's arrival in Unix milliseconds.
+fn json_log(l: &str) -> Result<(String, String, u16, f64), String> {
+    let v: serde_json::Value = serde_json::from_str(l).map_err(|e| format!("not a JSON access-log line: {e}"))?;
+    let text = |k: &str| v.get(k).and_then(|x| x.as_str()).map(str::to_owned);
+    let path = text("path").ok_or("a JSON access-log line without \"path\"")?;
+    let ts = v.get("ts").and_then(|x| x.as_f64()).ok_or("a JSON access-log line without \"ts\" (milliseconds)")?;
+    let status = v.get("status").and_then(|x| x.as_u64()).and_then(|s| u16::try_from(s).ok()).unwrap_or(200);
+    Ok((text("method").unwrap_or_else(|| "GET".into()), path, status, ts / 1000.0))
+}
+
+/// The entries of a replay file: one URL, `/path`, access-log line (nginx or Apache combined or
+/// common) or line of textile's JSON access log per line; blank lines and `#` comments skipped.
+/// Access-log lines other than GET or HEAD, or whose status is not in `statuses` (when given),
+/// are left out. A log whose every line has a time is played in the order of those times (a
+/// log is written as answers end, so its lines are not quite in arrival order).
 pub fn replay_lines(f: &Path, statuses: &[u16]) -> Result<Vec<Entry>, String> {
     let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}", f.display()))?;
     let mut v = Vec::new();
@@ -165,12 +178,17 @@ pub fn replay_lines(f: &Path, statuses: &[u16]) -> Result<Vec<Entry>, String> {
         if l.is_empty() || l.starts_with('#') {
             continue;
         }
-        if let Some((method, path, status, at)) = access_log(l) {
+        let logged = if l.starts_with('{') {
+            Some(json_log(l).map_err(|e| format!("{}:{n}: {e}", f.display()))?)
+        } else {
+            access_log(l).map(|(m, p, s, t)| (m.to_owned(), p.to_owned(), s, t))
+        };
+        if let Some((method, path, status, at)) = logged {
             if !path.starts_with('/') {
                 return Err(format!("{}:{n}: the request path '{path}' does not start with '/'", f.display()));
             }
-            if matches!(method, "GET" | "HEAD") && (statuses.is_empty() || statuses.contains(&status)) {
-                v.push(Entry { path: path.to_string(), at: Some(at) });
+            if matches!(method.as_str(), "GET" | "HEAD") && (statuses.is_empty() || statuses.contains(&status)) {
+                v.push(Entry { path, at: Some(at) });
             }
             continue;
         }
@@ -181,6 +199,9 @@ pub fn replay_lines(f: &Path, statuses: &[u16]) -> Result<Vec<Entry>, String> {
     }
     if v.is_empty() {
         return Err(format!("{}: no requests to replay", f.display()));
+    }
+    if v.iter().all(|e| e.at.is_some()) {
+        v.sort_by(|a, b| a.at.partial_cmp(&b.at).unwrap_or(std::cmp::Ordering::Equal));
     }
     Ok(v)
 }
@@ -198,5 +219,32 @@ mod tests {
         assert!(access_log("/tiles/a/7/0/0.png").is_none());
         assert_eq!(days_from_civil(1970, 1, 1), 0);
         assert_eq!(days_from_civil(2000, 3, 1), 11_017);
+    }
+
+    #[test]
+    fn textile_json_log_lines_are_read_in_arrival_order() {
+        let dir = std::env::temp_dir().join(format!("textile-replay-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("access.log");
+        std::fs::write(
+            &f,
+            concat!(
+                r#"{"ts":1000250,"method":"GET","path":"/b?x=1","status":200}"#,
+                "\n",
+                r#"{"ts":1000000,"method":"GET","path":"/a","status":200}"#,
+                "\n",
+                r#"{"ts":1000100,"method":"POST","path":"/textures","status":201}"#,
+                "\n",
+                r#"{"ts":1000300,"method":"GET","path":"/c","status":404}"#,
+                "\n",
+            ),
+        )
+        .unwrap();
+        let e = replay_lines(&f, &[200]).unwrap();
+        let got: Vec<(&str, f64)> = e.iter().map(|e| (e.path.as_str(), e.at.unwrap())).collect();
+        assert_eq!(got, [("/a", 1000.0), ("/b?x=1", 1000.25)]);
+        std::fs::write(&f, "{\"ts\":1}\n").unwrap();
+        assert!(replay_lines(&f, &[]).unwrap_err().contains(":1: a JSON access-log line without \"path\""));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
