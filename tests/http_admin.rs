@@ -370,28 +370,27 @@ async fn a_data_directory_that_cannot_store_uploads_is_a_507_naming_no_path() {
 }
 
 #[tokio::test]
-async fn two_servers_on_one_data_directory_cannot_both_store_an_id() {
+async fn a_restarted_server_serves_stored_uploads_and_never_overwrites_their_files() {
     let data = tempfile::tempdir().unwrap();
-    let (a, b) = (admin_server(data.path(), &[]), admin_server(data.path(), &[]));
+    let a = admin_server(data.path(), &[]);
     let (status, _, body) = upload(&a, "?id=shared", "image/png", brick(), Some(TOKEN)).await;
     assert_eq!(status, 202, "{body}");
-    // The other server has no 'shared' in its catalogue, but the data directory has: refused,
-    // and the first server's files are untouched.
-    let mut jpeg = std::io::Cursor::new(Vec::new());
-    image::load_from_memory(&brick()).unwrap().to_rgb8().write_to(&mut jpeg, image::ImageFormat::Jpeg).unwrap();
-    let (status, _, body) = upload(&b, "?id=shared", "image/jpeg", jpeg.into_inner(), Some(TOKEN)).await;
-    assert_eq!(status, 409, "{body}");
-    assert_eq!(body["error"], "texture_exists", "{body}");
-    assert!(body["message"].as_str().unwrap().contains("another server sharing this data directory"), "{body}");
-    common::assert_error(&b, "/textures/shared", 404, "unknown_texture").await;
-    assert_eq!(files_in(&data.path().join("uploads")), ["shared.png", "shared.toml"]);
     until_ready(&a, "/textures/shared").await;
-    // Restarted, the second serves the first's upload, byte for byte.
     let (_, from_a) = a.get_bytes("/tiles/shared/7/1/1.png").await;
-    drop(b);
+    // One owner per data directory: the next server starts once this one is gone.
+    drop(a);
     let b = admin_server(data.path(), &[]);
     until_ready(&b, "/textures/shared").await;
     assert_eq!(b.get_bytes("/tiles/shared/7/1/1.png").await, (200, from_a));
+    // Files of an id put in the directory while it runs are never overwritten by an upload.
+    let uploads = data.path().join("uploads");
+    std::fs::copy(uploads.join("shared.png"), uploads.join("placed.png")).unwrap();
+    let (status, _, body) = upload(&b, "?id=placed", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 409, "{body}");
+    assert_eq!(body["error"], "texture_exists", "{body}");
+    assert!(body["message"].as_str().unwrap().contains("does not serve"), "{body}");
+    common::assert_error(&b, "/textures/placed", 404, "unknown_texture").await;
+    assert_eq!(std::fs::read(uploads.join("placed.png")).unwrap(), std::fs::read(uploads.join("shared.png")).unwrap());
 }
 
 /// A PNG of `w × h` pixels, `colour(x, y)` each.

@@ -249,8 +249,8 @@ pub async fn upload(
                     Kind::Conflict,
                     "texture_exists",
                     format!(
-                        "another server sharing this data directory has stored an upload '{id}'; restart this \
-                         one to serve it, or DELETE it there first to replace it"
+                        "the data directory already holds files of an upload '{id}' that this server does not \
+                         serve (put there while it ran); restart it to serve them, or remove them to replace it"
                     ),
                 ))
             }
