@@ -44,8 +44,12 @@ pub enum Command {
     Render(RenderArgs),
     /// Print the header of an analysis file.
     Info(InfoArgs),
-    /// Pre-render tiles into a PMTiles or MBTiles archive (a periodic world, or a rectangle).
+    /// Pre-render tiles into a PMTiles or MBTiles archive (a periodic world, or a rectangle),
+    /// whole or as one shard of many (`--shard I/N`), resumable.
     Export(ExportArgs),
+    /// Merge the part files of an export's shards into its archive (the same bytes as one
+    /// process's export).
+    Merge(MergeArgs),
     /// Load-test a running textile server on this machine with scripted request patterns.
     Loadtest(LoadtestArgs),
 }
@@ -255,6 +259,27 @@ pub struct ExportArgs {
     /// A tile query parameter of the mode (repeatable), e.g. `-p randomness=0.5`.
     #[arg(long = "param", short = 'p', value_name = "KEY=VALUE")]
     pub params: Vec<String>,
+    /// Render only shard I of N (0 ≤ I < N: `JOB_COMPLETION_INDEX/N` in a Kubernetes Indexed
+    /// Job): a contiguous share of the archive's tiles, written to the part file -o names, to be
+    /// joined by `textile merge`. Run again with the same arguments after an interruption, it
+    /// resumes from its checkpoint.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// Threads rendering tiles (0: one per core).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub workers: usize,
+    /// Output archive: NAME.pmtiles or NAME.mbtiles; with --shard, the part file (e.g.
+    /// parts/world-3.part).
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+}
+
+/// `textile merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The part files of every shard (any order).
+    #[arg(required = true, value_name = "PART")]
+    pub parts: Vec<PathBuf>,
     /// Output archive: NAME.pmtiles or NAME.mbtiles.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,

@@ -1,12 +1,18 @@
-//! `textile export`: tiles of a configured texture into a PMTiles or MBTiles archive.
+//! `textile export`: tiles of a configured texture into a PMTiles or MBTiles archive, or one
+//! shard's part file of it; `textile merge`: parts into the archive.
 
-use super::args::{CliResult, ExportArgs};
+use super::args::{CliResult, ExportArgs, MergeArgs};
 use super::{configured_texture, param_pairs};
 use crate::encode::Format;
 use crate::export;
 
 /// `textile export`: tiles into a PMTiles or MBTiles archive.
 pub fn run(a: ExportArgs) -> CliResult {
+    let shard = a.shard.as_deref().map(export::Shard::parse).transpose()?;
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(a.workers)
+        .thread_name(|i| format!("textile-export-{i}"))
+        .build_global()?;
     let tex = configured_texture(&a.config, &a.texture)?;
     let mut pairs = param_pairs(&a.params, &a.mode, a.seed, None)?;
     if a.map != "albedo" {
@@ -36,6 +42,28 @@ pub fn run(a: ExportArgs) -> CliResult {
     };
     let format = Format::from_ext(&a.format).ok_or("--format must be png, jpg or webp")?;
     let plan = export::Plan::new(tex, pairs, a.world, bbox, zooms, format)?;
+    if let Some(shard) = shard {
+        let (start, end) = shard.range(plan.count());
+        eprintln!(
+            "exporting shard {}/{}: tiles {start}..{end} of {} of '{}{}' to {}",
+            shard.index,
+            shard.count,
+            plan.count(),
+            plan.tex.config.id,
+            plan.query_suffix(),
+            a.output.display()
+        );
+        let r = export::render_part(&plan, shard, &a.output)?;
+        println!(
+            "wrote {} ({} tiles rendered, {} bytes) in {:.1} s: {:.0} tiles/s",
+            a.output.display(),
+            r.tiles,
+            r.bytes,
+            r.secs,
+            r.tiles as f64 / r.secs.max(1e-9)
+        );
+        return Ok(());
+    }
     let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("");
     if !matches!(ext, "pmtiles" | "mbtiles") {
         return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", a.output.display()).into());
@@ -57,6 +85,25 @@ pub fn run(a: ExportArgs) -> CliResult {
         r.bytes,
         r.secs,
         r.tiles as f64 / r.secs.max(1e-9)
+    );
+    Ok(())
+}
+
+/// `textile merge PART… -o ARCHIVE`.
+pub fn merge(a: MergeArgs) -> CliResult {
+    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !matches!(ext, "pmtiles" | "mbtiles") {
+        return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", a.output.display()).into());
+    }
+    let r = export::merge::merge(&a.parts, &a.output)?;
+    println!(
+        "merged {} parts into {} ({} tiles, {} bytes) in {:.1} s: {:.0} MB/s",
+        a.parts.len(),
+        a.output.display(),
+        r.tiles,
+        r.bytes,
+        r.secs,
+        r.bytes as f64 / 1e6 / r.secs.max(1e-9)
     );
     Ok(())
 }

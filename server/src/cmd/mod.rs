@@ -1,7 +1,8 @@
 //! The commands of the `textile` binary, one file each — `serve` (the service's process:
 //! configuration, listening, loading, shutdown), `analyze` and `tileable` (with progress bars),
 //! `render` (a tile, a window or a perspective camera view, to an image file, for scripts),
-//! `export` (an archive of tiles), `info` (an analysis file and what is stored beside it) and
+//! `export` (an archive of tiles, or one shard's part of it) and `merge` (parts into the
+//! archive), `info` (an analysis file and what is stored beside it) and
 //! `loadtest` — with their arguments ([`args`]) and what they share here.
 
 pub mod analyze;
@@ -37,6 +38,7 @@ pub fn run() -> std::process::ExitCode {
         Some(args::Command::Render(a)) => render::run(a),
         Some(args::Command::Info(a)) => info::run(a),
         Some(args::Command::Export(a)) => export::run(a),
+        Some(args::Command::Merge(a)) => export::merge(a),
         Some(args::Command::Loadtest(a)) => loadtest::run(a),
     };
     match result {

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use rusqlite::{params, Connection};
 
-use super::{Entry, Plan, Sink};
+use super::Sink;
 
 /// An MBTiles archive being written.
 pub struct MbtilesSink {
@@ -18,8 +18,10 @@ fn sql(e: rusqlite::Error) -> String {
 }
 
 impl MbtilesSink {
-    /// Start an archive at `path` for a plan.
-    pub fn create(path: &Path, plan: &Plan) -> Result<Self, String> {
+    /// Start an archive at `path` with an export's metadata ([`super::Plan::metadata`]).
+    pub fn create(path: &Path, meta: &serde_json::Value) -> Result<Self, String> {
+        let [w, s, e, n] = super::meta_bounds(meta)?;
+        let (lo, hi) = super::meta_zooms(meta)?;
         let _ = std::fs::remove_file(path);
         let db = Connection::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
         db.execute_batch(
@@ -29,19 +31,18 @@ impl MbtilesSink {
              BEGIN;",
         )
         .map_err(sql)?;
-        let meta = plan.metadata();
-        let [w, s, e, n] = plan.bounds();
+        let text = |k: &str| meta[k].as_str().unwrap_or("").to_string();
         let rows = [
-            ("name", meta["name"].as_str().unwrap_or("").to_string()),
-            ("format", plan.format.ext().to_string()),
+            ("name", text("name")),
+            ("format", text("format")),
             ("bounds", format!("{w},{s},{e},{n}")),
-            ("center", format!("{},{},{}", (w + e) / 2.0, (s + n) / 2.0, plan.zooms.0)),
-            ("minzoom", plan.zooms.0.to_string()),
-            ("maxzoom", plan.zooms.1.to_string()),
+            ("center", format!("{},{},{lo}", (w + e) / 2.0, (s + n) / 2.0)),
+            ("minzoom", lo.to_string()),
+            ("maxzoom", hi.to_string()),
             ("type", "baselayer".to_string()),
-            ("description", meta["description"].as_str().unwrap_or("").to_string()),
-            ("attribution", meta["attribution"].as_str().unwrap_or("").to_string()),
-            ("version", meta["version"].as_str().unwrap_or("").to_string()),
+            ("description", text("description")),
+            ("attribution", text("attribution")),
+            ("version", text("version")),
             ("json", serde_json::json!({ "textile": meta["textile"] }).to_string()),
         ];
         for (k, v) in rows {
@@ -52,13 +53,13 @@ impl MbtilesSink {
 }
 
 impl Sink for MbtilesSink {
-    fn add(&mut self, e: &Entry, bytes: &[u8]) -> Result<(), String> {
-        let row = (1i64 << e.z) - 1 - e.y as i64;
+    fn add(&mut self, z: u8, x: u32, y: u32, bytes: &[u8]) -> Result<(), String> {
+        let row = (1i64 << z) - 1 - y as i64;
         let mut st = self
             .db
             .prepare_cached("INSERT INTO tiles (zoom_level, tile_column, tile_row, tile_data) VALUES (?1, ?2, ?3, ?4)")
             .map_err(sql)?;
-        st.execute(params![e.z, e.x, row, bytes]).map_err(sql)?;
+        st.execute(params![z, x, row, bytes]).map_err(sql)?;
         Ok(())
     }
 

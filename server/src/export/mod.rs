@@ -8,12 +8,17 @@
 //! textile's own zooms and coordinates.
 //!
 //! Tiles are made by the same [`ImageJob`] as served tiles (an exported tile's bytes equal the
-//! server's answer for the same URL), rendered in parallel in chunks and written in ascending
-//! Hilbert tile id by one writer (the order PMTiles needs to be clustered), with a progress bar
-//! and bounded memory; the archive is written under a temporary name and renamed when complete,
-//! so an interrupted export never leaves a half-written file under the target name.
+//! server's answer for the same URL), rendered in parallel in chunks, in ascending Hilbert tile
+//! id (the order PMTiles needs to be clustered), with progress and bounded memory, into a
+//! [`part`] file with a checkpoint after every chunk (an interrupted export resumes); [`merge`]
+//! then lays parts into the archive, written under a temporary name and renamed when complete,
+//! so an interrupted export never leaves a half-written file under the target name. A
+//! [`Shard`] renders a contiguous range of the tiles into a part of its own: parts of every
+//! shard merge into the bytes of a single process's export.
 
 pub mod mbtiles_sink;
+pub mod merge;
+pub mod part;
 pub mod pmtiles_sink;
 
 use std::path::Path;
@@ -92,10 +97,33 @@ pub struct Entry {
 
 /// Where tiles go: an archive format.
 pub trait Sink {
-    /// Add a tile (called in ascending PMTiles tile id).
-    fn add(&mut self, e: &Entry, bytes: &[u8]) -> Result<(), String>;
+    /// Add archive tile `z/x/y` (called in ascending PMTiles tile id).
+    fn add(&mut self, z: u8, x: u32, y: u32, bytes: &[u8]) -> Result<(), String>;
     /// Complete the archive.
     fn finish(self: Box<Self>) -> Result<(), String>;
+}
+
+/// The archive `output` names (by its extension), written at `tmp`, with an export's metadata.
+pub(crate) fn open_sink(output: &Path, tmp: &Path, meta: &serde_json::Value) -> Result<Box<dyn Sink>, String> {
+    let ext = output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    Ok(match ext.as_str() {
+        "pmtiles" => Box::new(pmtiles_sink::PmtilesSink::create(tmp, meta)?),
+        "mbtiles" => Box::new(mbtiles_sink::MbtilesSink::create(tmp, meta)?),
+        _ => return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", output.display())),
+    })
+}
+
+/// `[west, south, east, north]` of an export's metadata.
+pub(crate) fn meta_bounds(meta: &serde_json::Value) -> Result<[f64; 4], String> {
+    let b: Vec<f64> =
+        meta["bounds"].as_array().map(|a| a.iter().filter_map(|v| v.as_f64()).collect()).unwrap_or_default();
+    b.try_into().map_err(|_| format!("export metadata without bounds: {}", meta["bounds"]))
+}
+
+/// `(min, max)` archive zooms of an export's metadata.
+pub(crate) fn meta_zooms(meta: &serde_json::Value) -> Result<(u8, u8), String> {
+    let z = |k: &str| meta[k].as_u64().and_then(|v| u8::try_from(v).ok());
+    z("minzoom").zip(z("maxzoom")).ok_or_else(|| "export metadata without zooms".to_string())
 }
 
 impl Plan {
@@ -260,41 +288,81 @@ pub struct Report {
     pub secs: f64,
 }
 
-/// Run an export to `output` (`.pmtiles` or `.mbtiles`).
-pub fn run(plan: &Plan, output: &Path) -> Result<Report, String> {
-    let tmp = textile_core::files::temp_path(output);
-    let started = std::time::Instant::now();
-    let result = write(plan, output, &tmp);
-    match result {
-        Ok(tiles) => {
-            std::fs::rename(&tmp, output).map_err(|e| format!("{}: {e}", output.display()))?;
-            let bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
-            Ok(Report { tiles, bytes, secs: started.elapsed().as_secs_f64() })
+/// Which share of an export's tiles a process renders: shard `index` of `count` (0-based), a
+/// contiguous range of the tiles in ascending tile id (the Hilbert order within each zoom), so
+/// that the parts concatenate into the archive's sequence.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// This shard, `0..count`.
+    pub index: u64,
+    /// Shards in all.
+    pub count: u64,
+}
+
+impl Shard {
+    /// Parse `I/N` (`0 ≤ I < N`, as Kubernetes' `JOB_COMPLETION_INDEX` counts).
+    pub fn parse(s: &str) -> Result<Shard, String> {
+        let bad = || format!("--shard '{s}' must be I/N with 0 ≤ I < N (0-based, like JOB_COMPLETION_INDEX)");
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (i.trim().parse::<u64>().map_err(|_| bad())?, n.trim().parse::<u64>().map_err(|_| bad())?);
+        if count == 0 || index >= count || count > 1 << 20 {
+            return Err(bad());
         }
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
+        Ok(Shard { index, count })
+    }
+
+    /// Its range of `total` tiles: `[index·total/count, (index+1)·total/count)`.
+    pub fn range(self, total: u64) -> (u64, u64) {
+        let at = |i: u64| ((i as u128 * total as u128) / self.count as u128) as u64;
+        (at(self.index), at(self.index + 1))
     }
 }
 
-fn write(plan: &Plan, output: &Path, tmp: &Path) -> Result<u64, String> {
+/// The hidden part file a whole export renders into beside its archive (kept across an
+/// interruption: the export resumes from it).
+fn own_part(output: &Path) -> std::path::PathBuf {
+    let name = output.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    output.with_file_name(format!(".{name}.part"))
+}
+
+/// Run an export to `output` (`.pmtiles` or `.mbtiles`): its tiles rendered into a part file
+/// beside it (resumed if an earlier run was interrupted), then laid into the archive.
+pub fn run(plan: &Plan, output: &Path) -> Result<Report, String> {
+    let started = std::time::Instant::now();
     let ext = output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
-    let mut sink: Box<dyn Sink> = match ext.as_str() {
-        "pmtiles" => Box::new(pmtiles_sink::PmtilesSink::create(tmp, plan)?),
-        "mbtiles" => Box::new(mbtiles_sink::MbtilesSink::create(tmp, plan)?),
-        _ => return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", output.display())),
-    };
-    let entries = plan.entries();
-    let bar = ProgressBar::new(entries.len() as u64);
-    if let Ok(s) =
-        ProgressStyle::with_template("{spinner} exporting [{bar:30}] {pos}/{len} tiles ({per_sec}, {eta} left)")
-    {
-        bar.set_style(s.progress_chars("=> "));
+    if !matches!(ext.as_str(), "pmtiles" | "mbtiles") {
+        return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", output.display()));
     }
+    let part = own_part(output);
+    render_part(plan, Shard { index: 0, count: 1 }, &part)?;
+    let r = merge::merge(std::slice::from_ref(&part), output)?;
+    let _ = std::fs::remove_file(&part);
+    Ok(Report { secs: started.elapsed().as_secs_f64(), ..r })
+}
+
+/// Render shard `shard` of an export into the part file `output` (resumed from its checkpoint
+/// if an earlier run with the same arguments was interrupted; nothing to do if it is complete).
+pub fn render_part(plan: &Plan, shard: Shard, output: &Path) -> Result<Report, String> {
+    let started = std::time::Instant::now();
+    let entries = plan.entries();
+    let total = entries.len() as u64;
+    let (start, end) = shard.range(total);
+    let header =
+        part::Header { archive: plan.metadata(), total, shard: (shard.index, shard.count), range: (start, end) };
+    let Some(mut w) = part::Writer::open(output, &header)? else {
+        eprintln!("{}: already complete", output.display());
+        return Ok(Report { tiles: 0, bytes: 0, secs: 0.0 });
+    };
+    let mine = &entries[start as usize..end as usize];
+    let done = w.done() as usize;
+    if done > 0 {
+        eprintln!("{}: resuming after {done} of {} tiles", output.display(), mine.len());
+    }
+    let label = if shard.count > 1 { format!("shard {}/{}", shard.index, shard.count) } else { "export".into() };
+    let progress = Progress::new(&label, mine.len() as u64, done as u64);
     let pyramid = Pyramid::new(LEVEL_CACHE);
     let chunk = CHUNK_PER_THREAD * rayon::current_num_threads().max(1);
-    for part in entries.chunks(chunk) {
+    for part in mine[done..].chunks(chunk) {
         let bytes: Vec<Result<Vec<u8>, String>> = part
             .par_iter()
             .map(|e| {
@@ -308,11 +376,79 @@ fn write(plan: &Plan, output: &Path, tmp: &Path) -> Result<u64, String> {
             })
             .collect();
         for (e, b) in part.iter().zip(bytes) {
-            sink.add(e, &b?)?;
+            w.add(e, &b?)?;
         }
-        bar.inc(part.len() as u64);
+        w.checkpoint()?;
+        progress.advance(part.len() as u64);
     }
-    bar.finish_and_clear();
-    sink.finish()?;
-    Ok(entries.len() as u64)
+    progress.finish();
+    w.finish()?;
+    let bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
+    Ok(Report { tiles: (mine.len() - done) as u64, bytes, secs: started.elapsed().as_secs_f64() })
+}
+
+/// Progress of a rendering: a bar on a terminal; elsewhere (a container's log) a line every
+/// [`Progress::EVERY`] with tiles done of total, rate and time left.
+struct Progress {
+    bar: ProgressBar,
+    label: String,
+    total: u64,
+    first: u64,
+    done: std::sync::atomic::AtomicU64,
+    started: std::time::Instant,
+    last_line: std::sync::Mutex<std::time::Instant>,
+    lines: bool,
+}
+
+impl Progress {
+    const EVERY: std::time::Duration = std::time::Duration::from_secs(10);
+
+    fn new(label: &str, total: u64, done: u64) -> Progress {
+        let lines = !std::io::IsTerminal::is_terminal(&std::io::stderr());
+        let bar = if lines { ProgressBar::hidden() } else { ProgressBar::new(total) };
+        let template = format!("{{spinner}} {label} [{{bar:30}}] {{pos}}/{{len}} tiles ({{per_sec}}, {{eta}} left)");
+        if let Ok(s) = ProgressStyle::with_template(&template) {
+            bar.set_style(s.progress_chars("=> "));
+        }
+        bar.set_position(done);
+        let now = std::time::Instant::now();
+        Progress {
+            bar,
+            label: label.to_string(),
+            total,
+            first: done,
+            done: done.into(),
+            started: now,
+            last_line: std::sync::Mutex::new(now),
+            lines,
+        }
+    }
+
+    fn line(&self) -> String {
+        let done = self.done.load(std::sync::atomic::Ordering::Relaxed);
+        let secs = self.started.elapsed().as_secs_f64().max(1e-9);
+        let rate = (done - self.first) as f64 / secs;
+        let eta = if rate > 0.0 { format!("{:.0} s left", (self.total - done) as f64 / rate) } else { "-".into() };
+        let pct = 100.0 * done as f64 / self.total.max(1) as f64;
+        format!("{}: {done}/{} tiles ({pct:.1} %), {rate:.1} tiles/s, {eta}", self.label, self.total)
+    }
+
+    fn advance(&self, n: u64) {
+        self.done.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+        self.bar.inc(n);
+        if self.lines {
+            let mut last = self.last_line.lock().unwrap_or_else(|e| e.into_inner());
+            if last.elapsed() >= Self::EVERY {
+                *last = std::time::Instant::now();
+                eprintln!("{}", self.line());
+            }
+        }
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+        if self.lines {
+            eprintln!("{}", self.line());
+        }
+    }
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use pmtiles::{PmTilesStreamWriter, PmTilesWriter, TileCoord, TileId, TileType};
 
-use super::{Entry, Plan, Sink};
+use super::Sink;
 use crate::encode::Format;
 
 /// The PMTiles tile id of archive tile `z/x/y` (zoom, then Hilbert order).
@@ -21,23 +21,24 @@ pub struct PmtilesSink {
 }
 
 impl PmtilesSink {
-    /// Start an archive at `path` for a plan.
-    pub fn create(path: &Path, plan: &Plan) -> Result<Self, String> {
-        let kind = match plan.format {
-            Format::Png => TileType::Png,
-            Format::Jpeg => TileType::Jpeg,
-            Format::Webp => TileType::Webp,
+    /// Start an archive at `path` with an export's metadata ([`super::Plan::metadata`]).
+    pub fn create(path: &Path, meta: &serde_json::Value) -> Result<Self, String> {
+        let kind = match Format::from_ext(meta["format"].as_str().unwrap_or("")) {
+            Some(Format::Png) => TileType::Png,
+            Some(Format::Jpeg) => TileType::Jpeg,
+            Some(Format::Webp) => TileType::Webp,
+            None => return Err(format!("an archive of tiles in format {}", meta["format"])),
         };
-        let [w, s, e, n] = plan.bounds();
-        let (lo, hi) = plan.zooms;
+        let [w, s, e, n] = super::meta_bounds(meta)?;
+        let (lo, hi) = super::meta_zooms(meta)?;
         let file = File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let writer = PmTilesWriter::new(kind)
-            .min_zoom(lo as u8)
-            .max_zoom(hi as u8)
+            .min_zoom(lo)
+            .max_zoom(hi)
             .bounds(w, s, e, n)
-            .center_zoom(lo as u8)
+            .center_zoom(lo)
             .center((w + e) / 2.0, (s + n) / 2.0)
-            .metadata(plan.metadata().to_string())
+            .metadata(meta.to_string())
             .create(file)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(PmtilesSink { writer })
@@ -45,9 +46,9 @@ impl PmtilesSink {
 }
 
 impl Sink for PmtilesSink {
-    fn add(&mut self, e: &Entry, bytes: &[u8]) -> Result<(), String> {
-        let coord = TileCoord::new(e.z, e.x, e.y).map_err(|err| format!("tile {}/{}/{}: {err}", e.z, e.x, e.y))?;
-        self.writer.add_tile(coord, bytes).map_err(|err| format!("writing tile {}/{}/{}: {err}", e.z, e.x, e.y))
+    fn add(&mut self, z: u8, x: u32, y: u32, bytes: &[u8]) -> Result<(), String> {
+        let coord = TileCoord::new(z, x, y).map_err(|err| format!("tile {z}/{x}/{y}: {err}"))?;
+        self.writer.add_tile(coord, bytes).map_err(|err| format!("writing tile {z}/{x}/{y}: {err}"))
     }
 
     fn finish(self: Box<Self>) -> Result<(), String> {

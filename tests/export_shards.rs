@@ -1,0 +1,207 @@
+//! Sharded export through the real binary: a `--world 16` export rendered by 1, 3 and 8 shard
+//! processes at once (`--shard I/N --workers 1`) and merged is byte-identical to one process's
+//! archive, in PMTiles and MBTiles, and the independent readers read every tile back; a shard
+//! killed with SIGKILL at three moments resumes and the merge is still identical; merge names a
+//! missing shard, a doubled one, and parts of another world; bad `--shard` values are refused;
+//! the Kubernetes manifests validate against the Kubernetes schema.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use common::{binary, shared_data_dir, skip, Server};
+
+fn textile(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(binary()).args(args).output().expect("run textile");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The arguments of an export of gravel's 16-tile world (341 tiles, archive zooms 0..4).
+fn export_args(world: &str, out: &Path) -> Vec<String> {
+    let data = shared_data_dir();
+    ["export", "--texture", "gravel", "--world", world, "--data-dir", data.to_str().unwrap(), "-o"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([out.to_str().unwrap().to_string()])
+        .collect()
+}
+
+fn run_ok(args: &[String]) -> String {
+    let a: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, out, err) = textile(&a);
+    assert_eq!(code, 0, "{args:?}: {err}");
+    out + &err
+}
+
+fn shard(world: &str, i: usize, n: usize, dir: &Path) -> (Vec<String>, PathBuf) {
+    let part = dir.join(format!("w{world}-{i}of{n}.part"));
+    let mut args = export_args(world, &part);
+    args.extend(["--shard".into(), format!("{i}/{n}"), "--workers".into(), "1".into()]);
+    (args, part)
+}
+
+/// Run the N shards of an export as N processes at once; their part files.
+fn shards(world: &str, n: usize, dir: &Path) -> Vec<PathBuf> {
+    let started: Vec<(Child, PathBuf, Vec<String>)> = (0..n)
+        .map(|i| {
+            let (args, part) = shard(world, i, n, dir);
+            let child =
+                Command::new(binary()).args(&args).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+            (child, part, args)
+        })
+        .collect();
+    started
+        .into_iter()
+        .map(|(c, part, args)| {
+            let out = c.wait_with_output().unwrap();
+            assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+            part
+        })
+        .collect()
+}
+
+fn merge(parts: &[PathBuf], out: &Path) -> (i32, String) {
+    let mut args: Vec<&str> = vec!["merge"];
+    args.extend(parts.iter().map(|p| p.to_str().unwrap()));
+    args.extend(["-o", out.to_str().unwrap()]);
+    let (code, stdout, err) = textile(&args);
+    (code, stdout + &err)
+}
+
+fn merged(parts: &[PathBuf], out: &Path) -> Vec<u8> {
+    let (code, text) = merge(parts, out);
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("MB/s"), "{text}");
+    std::fs::read(out).unwrap()
+}
+
+fn reader_available() -> bool {
+    Command::new("python3").args(["-c", "import pmtiles.reader"]).output().is_ok_and(|o| o.status.success())
+}
+
+/// The independent readers (PyPI pmtiles, sqlite3) read every tile back, equal to the server's.
+fn check(archive: &Path, s: &Server) {
+    let script = format!("{}/../tests/export/check_archive.py", env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new("python3").args([&script, archive.to_str().unwrap(), &s.base]).output().expect("python3");
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}: {report}{}", archive.display(), String::from_utf8_lossy(&out.stderr));
+    assert!(report.contains("\"problems\": []"), "{report}");
+}
+
+#[test]
+fn shards_merge_into_the_single_process_archive_and_resume_after_sigkill() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (single_pm, single_mb) = (d.join("single.pmtiles"), d.join("single.mbtiles"));
+    run_ok(&export_args("16", &single_pm));
+    run_ok(&export_args("16", &single_mb));
+    let (want_pm, want_mb) = (std::fs::read(&single_pm).unwrap(), std::fs::read(&single_mb).unwrap());
+
+    let one = shards("16", 1, d);
+    assert_eq!(merged(&one, &d.join("m1.pmtiles")), want_pm, "1 shard");
+    let three = shards("16", 3, d);
+    assert_eq!(merged(&three, &d.join("m3.pmtiles")), want_pm, "3 shards, PMTiles");
+    assert_eq!(merged(&three, &d.join("m3.mbtiles")), want_mb, "3 shards, MBTiles");
+    let mut eight = shards("16", 8, d);
+    eight.reverse(); // any order
+    assert_eq!(merged(&eight, &d.join("m8.pmtiles")), want_pm, "8 shards");
+    // Nothing but the parts and archives is left: no partial files, no checkpoints.
+    let stray: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("partial") || n.starts_with('.'))
+        .collect();
+    assert!(stray.is_empty(), "{stray:?}");
+
+    // Shard 1 of 3 again, killed with SIGKILL at three moments, then run to the end.
+    let again = d.join("again");
+    std::fs::create_dir(&again).unwrap();
+    let (args, part) = shard("16", 1, 3, &again);
+    let checkpoint = again.join("w16-1of3.part.partial.checkpoint");
+    let tiles_done = || -> u64 {
+        let text = std::fs::read_to_string(&checkpoint).unwrap_or_default();
+        serde_json::from_str::<serde_json::Value>(&text).ok().and_then(|v| v["tiles"].as_u64()).unwrap_or(0)
+    };
+    let mut resumed = 0;
+    for extra_ms in [0u64, 170, 430] {
+        let before = tiles_done();
+        let mut c = Command::new(binary()).args(&args).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+        // Killed a while after its next checkpoint: mid-chunk, at a different point each time.
+        for _ in 0..3000 {
+            if tiles_done() > before || c.try_wait().unwrap().is_some() {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        std::thread::sleep(Duration::from_millis(extra_ms));
+        let _ = c.kill();
+        let out = c.wait_with_output().unwrap();
+        resumed += usize::from(String::from_utf8_lossy(&out.stderr).contains("resuming after"));
+        if !out.status.success() {
+            assert!(!part.exists(), "a killed shard never leaves a part under its name");
+        }
+    }
+    assert!(resumed >= 2, "the shard resumed from its checkpoint after each kill");
+    run_ok(&args);
+    let mixed = vec![three[0].clone(), part.clone(), three[2].clone()];
+    assert_eq!(merged(&mixed, &d.join("resumed.pmtiles")), want_pm, "resumed after SIGKILL");
+    // Run once more with the same arguments: nothing to do.
+    assert!(run_ok(&args).contains("already complete"));
+
+    // Bad merges name the problem.
+    let (code, text) = merge(&[three[0].clone(), three[2].clone()], &d.join("gap.pmtiles"));
+    assert_ne!(code, 0);
+    assert!(text.contains("are in no part") && text.contains("a shard is missing"), "{text}");
+    let (code, text) =
+        merge(&[three[0].clone(), three[1].clone(), three[2].clone(), eight[0].clone()], &d.join("x.pmtiles"));
+    assert_ne!(code, 0);
+    assert!(text.contains("both hold tiles"), "{text}");
+    let other = shards("8", 1, d);
+    let (code, text) = merge(&[three[0].clone(), three[1].clone(), other[0].clone()], &d.join("y.pmtiles"));
+    assert_ne!(code, 0);
+    assert!(text.contains("a part of another export") && text.contains("world 8 against 16"), "{text}");
+    for bad in ["3/2", "0/0", "1", "2/2", "a/b"] {
+        let mut a = export_args("16", &d.join("bad.part"));
+        a.extend(["--shard".into(), bad.into()]);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let (code, _, err) = textile(&a);
+        assert_ne!(code, 0, "--shard {bad}");
+        assert!(err.contains("must be I/N with 0 ≤ I < N"), "--shard {bad}: {err}");
+    }
+    for p in ["gap.pmtiles", "x.pmtiles", "y.pmtiles", "bad.part"] {
+        assert!(!d.join(p).exists(), "{p} was not written");
+    }
+
+    if !reader_available() {
+        return skip("shards_merge_into_the_single_process_archive (readers)", "python3 with the pmtiles package");
+    }
+    let s = Server::builder().start();
+    check(&d.join("m8.pmtiles"), &s);
+    check(&d.join("m3.mbtiles"), &s);
+}
+
+#[test]
+fn kubernetes_manifests_validate_against_the_schema() {
+    let ok = Command::new("kubernetes-validate").arg("--version").output().is_ok_and(|o| o.status.success());
+    if !ok {
+        return skip(
+            "kubernetes_manifests_validate_against_the_schema",
+            "kubernetes-validate (pip install -r tests/export/requirements.txt)",
+        );
+    }
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../deploy/kubernetes");
+    let files: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    assert!(files.len() >= 3, "{files:?}");
+    let out = Command::new("kubernetes-validate").args(["--strict", "-k", "1.30.0"]).args(&files).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{text}");
+    assert!(text.matches("passed").count() >= 3, "{text}");
+    let job = std::fs::read_to_string(dir.join("export-job.yaml")).unwrap();
+    assert!(job.contains("completionMode: Indexed") && job.contains("--shard \"${JOB_COMPLETION_INDEX}/8\""));
+}
