@@ -107,7 +107,7 @@ function loadTiles() {
   tiles = new TilesRenderer(url);
   tiles.registerPlugin(new ImplicitTilingPlugin());
   // A few requests at a time: a burst of hundreds would only queue (or be shed) at the server.
-  tiles.downloadQueue.maxJobs = 4;
+  tiles.downloadQueue.maxJobsPerOrigin = 4;
   tiles.group.rotation.x = -Math.PI / 2;
   tiles.setCamera(camera);
   tiles.setResolutionFromRenderer(camera, renderer);
@@ -139,8 +139,9 @@ function changed() {
   debounce = setTimeout(loadTiles, 250);
 }
 
-/** A control for one request parameter of the mode: numbers and integers as sliders, choices
- * as a select; other kinds (per-level lists, intervals, controls) are the 2D viewer's. */
+/** A control for one request parameter of the mode: numbers and integers as sliders, a
+ * per-level list as one slider for every level (the server takes one number for all), choices
+ * as a select; other kinds (intervals, controls) are the 2D viewer's. */
 function control(name, spec) {
   const row = document.createElement('div');
   row.className = 'slider';
@@ -152,16 +153,19 @@ function control(name, spec) {
   if (spec.type === 'choice') {
     input = document.createElement('select');
     for (const v of spec.values) input.append(new Option(v, v));
-  } else if (spec.type === 'number' || spec.type === 'integer') {
+  } else if (spec.type === 'number' || spec.type === 'integer' || spec.type === 'levels') {
     input = document.createElement('input');
     Object.assign(input, { type: 'range', min: spec.min, max: spec.max, step: spec.type === 'integer' ? 1 : (spec.max - spec.min) / 100 });
+    if (spec.type === 'levels') label.textContent = `${name} (all levels)`;
   } else {
     return null;
   }
   input.id = `p-${name}`;
-  input.value = state.p[name] ?? spec.default;
+  // A per-level default (a schedule, not one number) shows as "default" until the slider moves.
+  const initial = state.p[name] ?? (typeof spec.default === 'object' ? undefined : spec.default);
+  if (initial !== undefined && initial !== null) input.value = initial;
   const out = document.createElement('output');
-  out.textContent = input.value;
+  out.textContent = initial ?? 'default';
   input.addEventListener('input', () => {
     out.textContent = input.value;
     state.p[name] = spec.type === 'choice' ? input.value : num(input.value);

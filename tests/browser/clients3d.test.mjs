@@ -232,7 +232,8 @@ async function settled3d(page, timeout = 180000) {
 test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the camera', async () => {
   const page = await browser.newPage({ viewport: { width: 1000, height: 640 } });
   const errors = [];
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  const warnings = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); if (m.type() === 'warning') warnings.push(m.text()); });
   page.on('pageerror', (e) => errors.push(String(e)));
   const failed = [];
   page.on('response', (r) => { if (r.url().includes('/3dtiles/') && r.status() !== 200) failed.push(`${r.status()} ${r.url()}`); });
@@ -266,6 +267,12 @@ test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the ca
   assert.deepEqual(errors, []);
   // The permalink holds the view.
   assert.match(page.url(), /cam=16384,40000,56384,16384,0,16384/);
+  // The mode's parameters are offered (synth: its randomness, one value for every level), and
+  // moving one reloads the tileset with it.
+  assert.ok(await page.$('#p-randomness'), `synth's parameters on the 3D page: ${await page.innerText('#controls')}`);
+  await page.evaluate(() => { const s = document.querySelector('#p-randomness'); s.value = '0.5'; s.dispatchEvent(new Event('input')); });
+  await page.waitForFunction(() => document.querySelector('#tilesetlink').href.includes('randomness=0.5'), null, { timeout: 5000 });
+  assert.deepEqual(warnings.filter((w) => /maxJobs|deprecat/i.test(w)), [], 'no deprecation warnings');
   await page.close();
 });
 
