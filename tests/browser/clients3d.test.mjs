@@ -328,6 +328,10 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
       homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
       infoBox: false, selectionIndicator: false, terrainProvider: new Cesium.EllipsoidTerrainProvider(),
     });
+    // CesiumJS lights the scene by the real sun at the clock's time: the README's recipe sets
+    // midday at the anchor (Paris: solar noon about 11:50 UTC), else a night view is dark.
+    viewer.clock.currentTime = Cesium.JulianDate.fromIso8601('2026-06-21T11:50:00Z');
+    viewer.clock.shouldAnimate = false;
     const failures = [];
     const tileset = await Cesium.Cesium3DTileset.fromUrl(`${base}/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=4`);
     tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
@@ -351,6 +355,23 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
   }, BASE);
   const png = (await page.screenshot()).toString('base64');
   save('cesium.png', `data:image/png;base64,${png}`);
+  // The middle of the view is the texture, lit by day: about as bright as the tile itself (a
+  // night-time clock gave 45–66 against the tile's 130).
+  const lit = await page.evaluate(async (src) => {
+    const img = new Image();
+    img.src = src;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width; c.height = img.height;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(img.width * 3 / 8, img.height * 3 / 8, img.width / 4, img.height / 4).data;
+    let sum = 0;
+    for (let i = 0; i < d.length; i += 4) sum += (d[i] + d[i + 1] + d[i + 2]) / 3;
+    return sum / (d.length / 4);
+  }, `data:image/png;base64,${png}`);
+  console.log(`CesiumJS: the middle of the view at midday has mean luminance ${lit.toFixed(1)}`);
+  assert.ok(lit > 85, `the texture is lit by day: mean ${lit}`);
   const levels = [...content].sort((a, b) => a - b);
   console.log(`CesiumJS: tileset loaded ${r.loaded}, content levels requested [${levels}], bounding sphere at ` +
     `${r.lon.toFixed(4)}°, ${r.lat.toFixed(4)}°; root transform ${r.anchor.toFixed(3)} m from the anchor`);
