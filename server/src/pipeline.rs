@@ -5,6 +5,7 @@
 //! less at twice the size, or each texel as 2×2 pixels at native zoom) and encodes it, and whose
 //! [`produce`] runs that through the tile cache (single flight) on the synthesis pool.
 
+use std::fmt::Write as _;
 use std::sync::Arc;
 
 use axum::body::Bytes;
@@ -20,8 +21,9 @@ use crate::textures::Texture;
 
 /// Version of everything besides the analysis and the mode that determines bytes (each mode's
 /// version is part of its parameters' canonical text).
-pub fn engine_version() -> String {
-    format!("textile/{}/enc{ENCODER_VERSION}", env!("CARGO_PKG_VERSION"))
+pub fn engine_version() -> &'static str {
+    static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    VERSION.get_or_init(|| format!("textile/{}/enc{ENCODER_VERSION}", env!("CARGO_PKG_VERSION")))
 }
 
 /// The strong ETag (quoted) for a cache key.
@@ -41,8 +43,13 @@ pub fn cache_key(tex: &Texture, p: &ModeParams, what: std::fmt::Arguments) -> St
     // Empty unless the state says otherwise, so that the keys of every other texture and mode
     // stay as they were.
     let prepared = tex.prepared.etag(p.name());
-    let prepared = if prepared.is_empty() { String::new() } else { format!("{prepared}|") };
-    format!("{}|{}|{source}|{prepared}{}|{what}", engine_version(), tex.config.id, p.canonical())
+    let sep = if prepared.is_empty() { "" } else { "|" };
+    let canonical = p.canonical();
+    // Sized once: a key grown by formatting reallocated several times per request.
+    let mut key = String::with_capacity(128 + canonical.len() + prepared.len());
+    let id = &tex.config.id;
+    let _ = write!(key, "{}|{id}|{source}|{prepared}{sep}{canonical}|{what}", engine_version());
+    key
 }
 
 /// What part of the texture an image shows.

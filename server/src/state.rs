@@ -58,6 +58,8 @@ pub struct AppState {
     pub memory: Arc<Semaphore>,
     /// Prometheus metrics.
     pub metrics: Metrics,
+    /// `Cache-Control` of tiles (`cache_control`), parsed once.
+    pub cache_control: axum::http::HeaderValue,
     /// The access log, if one is configured (`access_log`; opened by `textile serve`).
     pub access_log: Option<crate::access_log::AccessLog>,
 }
@@ -91,6 +93,9 @@ impl AppState {
             big_windows: Arc::new(Semaphore::new(rayon::current_num_threads().saturating_sub(1).max(1))),
             analyses: Arc::new(Semaphore::new(config.max_concurrent_analyses)),
             memory: Arc::new(Semaphore::new((config.memory_budget_mib - prepared_share_mib(&config)) as usize)),
+            // Checked as a header value when the configuration is loaded.
+            cache_control: axum::http::HeaderValue::from_str(&config.cache_control)
+                .unwrap_or_else(|_| axum::http::HeaderValue::from_static("no-cache")),
             config,
             registry: RwLock::new(None),
             catalogue_writer: tokio::sync::Mutex::new(()),

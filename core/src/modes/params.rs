@@ -300,6 +300,12 @@ impl ParamReader {
 
     /// Take a key the caller itself knows (e.g. the server's `v`).
     pub fn take(&mut self, key: &str) -> Option<String> {
+        // The keys asked for only name the allowed ones when a value is left over; values only
+        // go, so once none is left none ever will be, and the asking need not be kept (a request
+        // without a query then reads its parameters without allocating).
+        if self.values.is_empty() {
+            return None;
+        }
         self.asked.insert(key.to_string());
         self.values.remove(key)
     }

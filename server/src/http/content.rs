@@ -26,24 +26,22 @@ pub fn if_none_match(headers: &HeaderMap, etag: &str) -> bool {
     })
 }
 
-fn common(h: &mut HeaderMap, etag: &str, cache_control: &str) {
+fn common(h: &mut HeaderMap, etag: &str, cache_control: &HeaderValue) {
     if let Ok(v) = HeaderValue::from_str(etag) {
         h.insert(header::ETAG, v);
     }
-    if let Ok(v) = HeaderValue::from_str(cache_control) {
-        h.insert(header::CACHE_CONTROL, v);
-    }
+    h.insert(header::CACHE_CONTROL, cache_control.clone());
 }
 
 /// 304 Not Modified with the validators.
-pub fn not_modified(etag: &str, cache_control: &str) -> Response {
+pub fn not_modified(etag: &str, cache_control: &HeaderValue) -> Response {
     let mut r = StatusCode::NOT_MODIFIED.into_response();
     common(r.headers_mut(), etag, cache_control);
     r
 }
 
 /// 200 with an encoded image or model of the given content type.
-pub fn image(bytes: Bytes, content_type: &'static str, etag: &str, cache_control: &str, hit: bool) -> Response {
+pub fn image(bytes: Bytes, content_type: &'static str, etag: &str, cache_control: &HeaderValue, hit: bool) -> Response {
     let mut r = bytes.into_response();
     let h = r.headers_mut();
     h.insert(header::CONTENT_TYPE, HeaderValue::from_static(content_type));
@@ -55,7 +53,7 @@ pub fn image(bytes: Bytes, content_type: &'static str, etag: &str, cache_control
 /// An output's answer: `304` when the client has it, else its bytes (through the tile cache
 /// where it keeps them) with its ETag and content type.
 pub async fn answer(st: &Arc<AppState>, headers: &HeaderMap, out: Output) -> Result<Response, ApiError> {
-    let cc = &st.config.cache_control;
+    let cc = &st.cache_control;
     let etag = out.etag();
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));

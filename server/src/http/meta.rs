@@ -293,7 +293,7 @@ pub async fn map_image(
     })?;
     // Keyed by the map's own hash; encoded once (off the async workers) into the tile cache.
     let etag = etag_for(&format!("map-image|{}|{}", engine_version(), map.hash));
-    let cc = &st.config.cache_control;
+    let cc = &st.cache_control;
     if if_none_match(&headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
@@ -407,7 +407,8 @@ pub async fn not_found(uri: Uri) -> ApiError {
 /// file service) answers a known route asked with another method with its `Allow` header, which
 /// this turns into the message, keeping the header.
 pub async fn method_not_allowed(req: axum::extract::Request, next: axum::middleware::Next) -> Response {
-    let (method, path) = (req.method().clone(), req.uri().path().to_string());
+    // Kept for the message of a 405 only: the URI shares its bytes (no copy per request).
+    let (method, uri) = (req.method().clone(), req.uri().clone());
     let resp = next.run(req).await;
     if resp.status() != axum::http::StatusCode::METHOD_NOT_ALLOWED {
         return resp;
@@ -423,7 +424,7 @@ pub async fn method_not_allowed(req: axum::extract::Request, next: axum::middlew
         [one] => format!("; use {one}"),
         [rest @ .., last] => format!("; use {} or {last}", rest.join(", ")),
     };
-    let message = format!("{method} is not allowed on '{}'{hint}", textile_core::error::clip(&path));
+    let message = format!("{method} is not allowed on '{}'{hint}", textile_core::error::clip(uri.path()));
     let mut fixed = ApiError::new(Kind::MethodNotAllowed, "method_not_allowed", message).into_response();
     if let Some(v) = allow {
         fixed.headers_mut().insert(header::ALLOW, v);

@@ -103,7 +103,7 @@ pub async fn tileset_json(
     // Sorted: one URI (and cache entry) per set of parameters, however they were ordered.
     let query = query_string(&pairs.into_iter().collect::<std::collections::BTreeMap<_, _>>());
     let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset|{query}|{transform:?}")));
-    let cc = &st.config.cache_control;
+    let cc = &st.cache_control;
     if if_none_match(&headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
@@ -136,7 +136,7 @@ pub async fn subtree_file(
         ));
     }
     let etag = etag_for(&format!("subtree|{}|{}|{level}", tree.native, tree.levels));
-    let cc = &st.config.cache_control;
+    let cc = &st.cache_control;
     if if_none_match(&headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
