@@ -9,7 +9,7 @@ use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use common::{binary, shared_data_dir, skip, Server};
+use common::{binary, check_archive as check, reader_available, shared_data_dir, skip, Server};
 
 fn textile(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(binary()).args(args).output().expect("run textile");
@@ -28,19 +28,6 @@ fn export(args: &[&str], out: &Path) {
     let (code, stdout, err) = textile(&all);
     assert_eq!(code, 0, "export {args:?}: {err}");
     assert!(stdout.contains("tiles/s"), "{stdout}");
-}
-
-/// The independent reader: Python with the `pmtiles` package (installed by `.ci/run`).
-fn reader_available() -> bool {
-    Command::new("python3").args(["-c", "import pmtiles.reader"]).output().is_ok_and(|o| o.status.success())
-}
-
-fn check(archive: &Path, s: &Server) {
-    let script = format!("{}/../tests/export/check_archive.py", env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("python3").args([&script, archive.to_str().unwrap(), &s.base]).output().expect("python3");
-    let report = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{}: {report}{}", archive.display(), String::from_utf8_lossy(&out.stderr));
-    assert!(report.contains("\"problems\": []"), "{report}");
 }
 
 #[tokio::test]
@@ -124,8 +111,14 @@ fn an_interrupted_export_leaves_no_file_under_the_target_name() {
         .spawn()
         .expect("start export");
     let started = Instant::now();
-    let temp =
-        || std::fs::read_dir(dir.path()).unwrap().any(|e| e.unwrap().file_name().to_string_lossy().contains(".tmp-"));
+    // Tiles go to a part file beside the target (`.big.pmtiles.part.partial`, kept for resuming),
+    // then into the archive under a temporary name.
+    let temp = || {
+        std::fs::read_dir(dir.path()).unwrap().any(|e| {
+            let name = e.unwrap().file_name().to_string_lossy().into_owned();
+            name.ends_with(".partial") || name.contains(".tmp-")
+        })
+    };
     while !temp() && started.elapsed() < Duration::from_secs(120) {
         std::thread::sleep(Duration::from_millis(50));
     }

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-use common::{binary, shared_data_dir, skip, Server};
+use common::{binary, check_archive as check, reader_available, shared_data_dir, skip, Server};
 
 fn textile(args: &[&str]) -> (i32, String, String) {
     let out = Command::new(binary()).args(args).output().expect("run textile");
@@ -79,19 +79,6 @@ fn merged(parts: &[PathBuf], out: &Path) -> Vec<u8> {
     assert_eq!(code, 0, "{text}");
     assert!(text.contains("MB/s"), "{text}");
     std::fs::read(out).unwrap()
-}
-
-fn reader_available() -> bool {
-    Command::new("python3").args(["-c", "import pmtiles.reader"]).output().is_ok_and(|o| o.status.success())
-}
-
-/// The independent readers (PyPI pmtiles, sqlite3) read every tile back, equal to the server's.
-fn check(archive: &Path, s: &Server) {
-    let script = format!("{}/../tests/export/check_archive.py", env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("python3").args([&script, archive.to_str().unwrap(), &s.base]).output().expect("python3");
-    let report = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{}: {report}{}", archive.display(), String::from_utf8_lossy(&out.stderr));
-    assert!(report.contains("\"problems\": []"), "{report}");
 }
 
 #[test]

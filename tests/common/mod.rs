@@ -418,3 +418,19 @@ pub fn rough_metal_config(dir: &Path) -> PathBuf {
     std::fs::write(&cfg, text).expect("write rough.toml");
     cfg
 }
+
+/// Whether the independent archive readers are here: Python with the `pmtiles` package
+/// (installed by `.ci/run` from `tests/export/requirements.txt`).
+pub fn reader_available() -> bool {
+    Command::new("python3").args(["-c", "import pmtiles.reader"]).output().is_ok_and(|o| o.status.success())
+}
+
+/// The independent readers (PyPI pmtiles, Python's sqlite3: `tests/export/check_archive.py`)
+/// read every tile of an archive back, equal to the running server's answer for its URL.
+pub fn check_archive(archive: &Path, s: &Server) {
+    let script = format!("{}/../tests/export/check_archive.py", env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new("python3").args([&script, archive.to_str().unwrap(), &s.base]).output().expect("python3");
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}: {report}{}", archive.display(), String::from_utf8_lossy(&out.stderr));
+    assert!(report.contains("\"problems\": []"), "{report}");
+}

@@ -53,15 +53,7 @@ pub fn run(a: ExportArgs) -> CliResult {
             plan.query_suffix(),
             a.output.display()
         );
-        let r = export::render_part(&plan, shard, &a.output)?;
-        println!(
-            "wrote {} ({} tiles rendered, {} bytes) in {:.1} s: {:.0} tiles/s",
-            a.output.display(),
-            r.tiles,
-            r.bytes,
-            r.secs,
-            r.tiles as f64 / r.secs.max(1e-9)
-        );
+        wrote(&a.output, "tiles rendered", &export::render_part(&plan, shard, &a.output)?);
         return Ok(());
     }
     let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("");
@@ -77,16 +69,20 @@ pub fn run(a: ExportArgs) -> CliResult {
         plan.zooms.1,
         a.output.display()
     );
-    let r = export::run(&plan, &a.output)?;
+    wrote(&a.output, "tiles", &export::run(&plan, &a.output)?);
+    Ok(())
+}
+
+/// The line saying what an export or a shard wrote: `what` counts `r.tiles`.
+fn wrote(output: &std::path::Path, what: &str, r: &export::Report) {
     println!(
-        "wrote {} ({} tiles, {} bytes) in {:.1} s: {:.0} tiles/s",
-        a.output.display(),
+        "wrote {} ({} {what}, {} bytes) in {:.1} s: {:.0} tiles/s",
+        output.display(),
         r.tiles,
         r.bytes,
         r.secs,
         r.tiles as f64 / r.secs.max(1e-9)
     );
-    Ok(())
 }
 
 /// `textile merge PART… -o ARCHIVE`.
