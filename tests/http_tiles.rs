@@ -394,11 +394,13 @@ async fn a_users_texture_beside_the_built_ins() {
     let meta = s.json("/textures/mine").await;
     assert_eq!(meta["name"], "mine", "name defaults to the id");
     let e = &meta["exemplar"];
+    // Used at its own size: no crop, no resample.
     assert_eq!(
-        (e["input_width"].as_u64(), e["input_height"].as_u64(), e["crop_side"].as_u64()),
-        (Some(300), Some(200), Some(200))
+        [&e["input_width"], &e["input_height"], &e["width"], &e["height"]].map(|v| v.as_u64()),
+        [Some(300), Some(200), Some(300), Some(200)]
     );
-    assert_eq!(s.image("/tiles/mine/7/0/0.png").await.dimensions(), (256, 256));
+    assert_eq!(meta["native_zoom"], 9, "⌈log2 300⌉");
+    assert_eq!(s.image("/tiles/mine/9/0/0.png").await.dimensions(), (256, 256));
 }
 
 #[tokio::test]

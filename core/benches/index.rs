@@ -26,7 +26,7 @@ fn exemplar(name: &str, side: u32) -> Option<Exemplar> {
 
 /// Fraction of candidates `k` of `b` within one texel (toroidal distance) of those of `a`.
 fn recall(a: &Analysis, b: &Analysis, level: usize, k: usize) -> f64 {
-    let m = a.side() as i64;
+    let m = a.width() as i64;
     let (ca, cb) = (&a.corrected[level].cands, &b.corrected[level].cands);
     let near = |p: u32, q: u32| {
         let d = |u: i64, v: i64| (u - v).abs().min(m - (u - v).abs());

@@ -24,7 +24,7 @@ fn main() {
             }
         };
         let started = Instant::now();
-        let d = textile_core::lattice::detect(&ex.pixels, ex.side);
+        let d = textile_core::lattice::detect(&ex.pixels, ex.width, ex.height);
         let ms = started.elapsed().as_secs_f64() * 1000.0;
         let ridges: Vec<String> = d
             .ridges
@@ -37,6 +37,6 @@ fn main() {
         });
         let class = d.class().name();
         let found = d.lattice.map_or("none".to_string(), |l| l.to_string());
-        println!("{path} ({}²): {class}:{repeat} {found} | ridges {} | {ms:.0} ms", ex.side, ridges.join("; "));
+        println!("{path} ({}x{}): {class}:{repeat} {found} | ridges {} | {ms:.0} ms", ex.width, ex.height, ridges.join("; "));
     }
 }

@@ -1,6 +1,7 @@
 //! Exemplar preparation (design note §1.1): decode with bounded resources, composite alpha,
-//! crop to the centred square, bring the side to a power of two with an exact integer area
-//! filter, and decide whether the exemplar wraps around seamlessly (toroidal).
+//! keep the image at its own width and height (only an image larger than [`MAX_SIDE`] is
+//! shrunk, keeping its shape, with an exact integer area filter), and decide whether the
+//! exemplar wraps around seamlessly (toroidal) at its own period.
 
 use serde::{Deserialize, Serialize};
 
@@ -9,12 +10,17 @@ use crate::lattice::{Lattice, LatticeChoice, Repeat};
 use crate::maps::{MaterialMap, NormalConvention};
 use crate::mask::RandomnessMask;
 
-/// Smallest exemplar side accepted on input.
+/// Smallest exemplar side accepted on input (and so the smallest prepared side).
 pub const MIN_INPUT_SIDE: u32 = 16;
-/// Smallest and largest prepared exemplar side (a power of two).
-pub const MIN_SIDE: u32 = 32;
-/// Largest prepared exemplar side.
+/// Largest prepared exemplar side: a larger image is scaled down to it, keeping its shape.
 pub const MAX_SIDE: u32 = 512;
+
+/// Synthesis levels of a `w × h` exemplar: `L = ⌈log2 max(w, h)⌉`, so that one pixel of level
+/// 0 covers the whole exemplar (for a power-of-two square of side `m`, `log2 m`).
+pub fn levels_for(w: u32, h: u32) -> u32 {
+    let m = w.max(h).max(1);
+    32 - (m - 1).leading_zeros()
+}
 
 /// Least colour variation of a synthesizable exemplar: the standard deviation, in 8-bit levels,
 /// of its most varied channel. Below it the image is flat (one colour, or noise of a level or
@@ -37,17 +43,20 @@ impl Default for ExemplarOptions {
     }
 }
 
-/// What was done to the input to make it a power-of-two square.
+/// What was done to the input to prepare it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Preparation {
     /// Input width.
     pub input_width: u32,
     /// Input height.
     pub input_height: u32,
-    /// Side of the centred square crop.
-    pub crop_side: u32,
-    /// Prepared side `m` (area-resampled from `crop_side` when they differ).
-    pub side: u32,
+    /// Prepared width (the input's, unless it was scaled down to [`MAX_SIDE`]). Analyses
+    /// written before exemplars kept their shape call it `side` (they were square).
+    #[serde(alias = "side")]
+    pub width: u32,
+    /// Prepared height (0 in analyses written before exemplars kept their shape: the width).
+    #[serde(default)]
+    pub height: u32,
     /// Whether the toroidal flag was detected (false) or forced by the caller (true).
     pub toroidal_forced: bool,
     /// Seam energy ÷ interior gradient energy (≤ 1.5 means toroidal when detected).
@@ -57,25 +66,27 @@ pub struct Preparation {
     pub toroidal_synthesized: bool,
 }
 
-/// A prepared exemplar: `side × side` RGB8 pixels, `side` a power of two.
+/// A prepared exemplar: `width × height` RGB8 pixels, each side from [`MIN_INPUT_SIDE`] to
+/// [`MAX_SIDE`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Exemplar {
-    /// Side `m` in pixels.
-    pub side: u32,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
     /// Row-major RGB pixels.
     pub pixels: Vec<[u8; 3]>,
     /// Whether synthesis may wrap around the exemplar edges.
     pub toroidal: bool,
     /// What preparation did.
     pub preparation: Preparation,
-    /// The image the exemplar was reduced from, twice as wide (`2·side` squared), when it was
-    /// given ([`Exemplar::from_hires`]): magnified zooms sample their detail from it.
+    /// The image the exemplar was reduced from, twice as wide and high, when it was given ([`Exemplar::from_hires`]): magnified zooms sample their detail from it.
     pub hires: Option<Vec<[u8; 3]>>,
     /// The randomness mask over the exemplar (`R_E`), when the texture has one
     /// ([`Exemplar::with_randomness_mask`]).
     pub randomness_mask: Option<RandomnessMask>,
-    /// The colour variation of the image as it was given (its square crop, before any
-    /// resampling; [`Exemplar::spread`]), when it was resampled: flatness is judged on the
+    /// The colour variation of the image as it was given (before any resampling;
+    /// [`Exemplar::spread`]), when it was resampled: flatness is judged on the
     /// image as sent, not on what shrinking made of it.
     pub input_spread: Option<f64>,
     /// The lattice of a near-regular exemplar ([`Exemplar::with_lattice`]).
@@ -114,29 +125,25 @@ impl Exemplar {
     /// valid (see [`Exemplar::from_bytes`]).
     pub fn from_rgba(w: u32, h: u32, px: &[[u8; 4]], opts: &ExemplarOptions) -> Exemplar {
         let rgb = composite_over_mean(px);
-        let crop_side = w.min(h);
-        let ox = ((w - crop_side) / 2) as usize;
-        let oy = ((h - crop_side) / 2) as usize;
-        let s = crop_side as usize;
-        let mut square = Vec::with_capacity(s * s);
-        for y in 0..s {
-            let row = (oy + y) * w as usize + ox;
-            square.extend_from_slice(&rgb[row..row + s]);
-        }
-        let side = target_side(crop_side);
-        let input_spread = (side != crop_side).then(|| spread_of(&square));
-        let pixels = if side == crop_side { square } else { area_resample(&square, s, side as usize) };
-        let seam_ratio = seam_ratio(&pixels, side as usize);
+        let (width, height) = prepared_size(w, h);
+        let input_spread = ((width, height) != (w, h)).then(|| spread_of(&rgb));
+        let pixels = if (width, height) == (w, h) {
+            rgb
+        } else {
+            area_resample(&rgb, (w as usize, h as usize), (width as usize, height as usize))
+        };
+        let seam_ratio = seam_ratio(&pixels, width as usize, height as usize);
         let toroidal = opts.toroidal.unwrap_or(seam_ratio <= 1.5);
         Exemplar {
-            side,
+            width,
+            height,
             pixels,
             toroidal,
             preparation: Preparation {
                 input_width: w,
                 input_height: h,
-                crop_side,
-                side,
+                width,
+                height,
                 toroidal_forced: opts.toroidal.is_some(),
                 seam_ratio,
                 toroidal_synthesized: false,
@@ -149,6 +156,16 @@ impl Exemplar {
             structure: None,
             maps: Vec::new(),
         }
+    }
+
+    /// Synthesis levels of this exemplar ([`levels_for`]).
+    pub fn levels(&self) -> u32 {
+        levels_for(self.width, self.height)
+    }
+
+    /// Its size as `(width, height)` in `usize`, for indexing.
+    pub fn dims(&self) -> (usize, usize) {
+        (self.width as usize, self.height as usize)
     }
 
     /// The colour variation of the prepared pixels: the standard deviation, in 8-bit levels,
@@ -168,11 +185,15 @@ impl Exemplar {
         Ok(())
     }
 
-    /// Feed everything that determines this exemplar's pixels in every mode to `h`: side,
-    /// toroidal flag, pixels, and its randomness mask, lattice and high-resolution image when it has them
+    /// Feed everything that determines this exemplar's pixels in every mode to `h`: size (the
+    /// width alone for a square, as when exemplars were all square), toroidal flag, pixels, and its randomness mask, lattice and high-resolution image when it has them
     /// (only then, so the hashes of exemplars without them never change).
     pub fn hash_content(&self, h: &mut blake3::Hasher) {
-        h.update(&self.side.to_le_bytes());
+        h.update(&self.width.to_le_bytes());
+        if self.height != self.width {
+            h.update(b"height");
+            h.update(&self.height.to_le_bytes());
+        }
         h.update(&[self.toroidal as u8]);
         // One update for all the pixels (the same bytes as one per pixel, hashed faster).
         h.update(self.pixels.as_flattened());
@@ -192,27 +213,36 @@ impl Exemplar {
         }
     }
 
-    /// The exemplar of a high-resolution image: `hires` (prepared, side `2m`) reduced by the
-    /// exact 2×2 box average to side `m`, keeping `hires` for magnified zooms (design note
-    /// §1.8: magnified tiles then show the image's own detail, not interpolation). The toroidal
-    /// flag is `hires`'s when forced, else detected on the reduced exemplar.
+    /// The exemplar of a high-resolution image: `hires` (prepared, `2w × 2h`; an odd last row
+    /// or column is dropped) reduced by the exact 2×2 box average to `w × h`, keeping `hires`
+    /// for magnified zooms (design note §1.8: magnified tiles then show the image's own
+    /// detail, not interpolation). The toroidal flag is `hires`'s when forced, else detected on
+    /// the reduced exemplar.
     pub fn from_hires(hires: Exemplar) -> Result<Exemplar> {
-        let big = hires.side;
-        if big < 2 * MIN_SIDE {
-            return Err(CoreError::ExemplarSize { width: big, height: big, min: 2 * MIN_SIDE, max: MAX_SIDE });
+        let (big_w, big_h) = (hires.width, hires.height);
+        if big_w.min(big_h) < 2 * MIN_INPUT_SIDE {
+            return Err(CoreError::ExemplarSize {
+                width: big_w,
+                height: big_h,
+                min: 2 * MIN_INPUT_SIDE,
+                max: MAX_SIDE,
+            });
         }
-        let side = big / 2;
-        let pixels = area_resample(&hires.pixels, big as usize, side as usize);
-        let seam_ratio = seam_ratio(&pixels, side as usize);
+        let (width, height) = (big_w / 2, big_h / 2);
+        let (bw, bh) = (2 * width as usize, 2 * height as usize);
+        let big: Vec<[u8; 3]> = (0..bh).flat_map(|y| &hires.pixels[y * big_w as usize..][..bw]).copied().collect();
+        let pixels = area_resample(&big, (bw, bh), (width as usize, height as usize));
+        let seam_ratio = seam_ratio(&pixels, width as usize, height as usize);
         let forced = hires.preparation.toroidal_forced;
         let toroidal = if forced { hires.toroidal } else { seam_ratio <= 1.5 };
-        let preparation = Preparation { side, seam_ratio, ..hires.preparation };
+        let preparation = Preparation { width, height, seam_ratio, ..hires.preparation };
         Ok(Exemplar {
-            side,
+            width,
+            height,
             pixels,
             toroidal,
             preparation,
-            hires: Some(hires.pixels),
+            hires: Some(big),
             randomness_mask: None,
             input_spread: hires.input_spread,
             lattice: None,
@@ -223,7 +253,7 @@ impl Exemplar {
     }
 
     /// This exemplar with a randomness mask (design note §1.9, `R_E`): `mask` is the mask
-    /// image prepared like the exemplar's own image (same input size, so the same crop and
+    /// image prepared like the exemplar's own image (same input size, so the same
     /// resampling; for an exemplar reduced from `exemplar_hires`, the size of that image), its
     /// luma the mask values (white: free, black: kept as in the exemplar).
     pub fn with_randomness_mask(mut self, mask: &Exemplar) -> Result<Exemplar> {
@@ -237,21 +267,21 @@ impl Exemplar {
                 ),
             });
         }
-        let pixels = if mask.side == self.side {
+        let pixels = if mask.dims() == self.dims() {
             mask.pixels.clone()
         } else {
-            area_resample(&mask.pixels, mask.side as usize, self.side as usize)
+            area_resample(&mask.pixels, mask.dims(), self.dims())
         };
         let luma = pixels
             .iter()
             .map(|c| ((299 * c[0] as u32 + 587 * c[1] as u32 + 114 * c[2] as u32 + 500) / 1000) as u8)
             .collect();
-        self.randomness_mask = Some(RandomnessMask::new(self.side, luma, self.toroidal)?);
+        self.randomness_mask = Some(RandomnessMask::new(self.width, self.height, luma, self.toroidal)?);
         Ok(self)
     }
 
     /// This exemplar with material map `name` ([`MaterialMap::new`]): `image` is the map
-    /// prepared like the exemplar's own image (same input size, hence the same crop and
+    /// prepared like the exemplar's own image (same input size, hence the same
     /// resampling; for an exemplar reduced from a high-resolution image, that image's size). A
     /// map of the same name is replaced.
     pub fn with_map(mut self, name: &str, image: &Exemplar, convention: Option<NormalConvention>) -> Result<Exemplar> {
@@ -267,8 +297,8 @@ impl Exemplar {
         }
         let (texels, hires) = match &self.hires {
             Some(_) => {
-                let big = image.side as usize;
-                (area_resample(&image.pixels, big, big / 2), Some(image.pixels.clone()))
+                let reduced = Exemplar::from_hires(image.clone())?;
+                (reduced.pixels, reduced.hires)
             }
             None => (image.pixels.clone(), None),
         };
@@ -278,7 +308,7 @@ impl Exemplar {
                 message: format!("prepares to {} texels, the exemplar to {}", texels.len(), self.pixels.len()),
             });
         }
-        let map = MaterialMap::new(name, texels, hires, convention)?;
+        let map = MaterialMap::new(name, (self.width, self.height), texels, hires, convention)?;
         self.maps.retain(|m| m.name != name);
         self.maps.push(map);
         Ok(self)
@@ -293,7 +323,7 @@ impl Exemplar {
     /// lattice of `nx × ny` cells tiles. Synthesis moves its coarse content by whole cells and
     /// keeps coarse candidates on the same lattice phase, so the grid survives while the cells
     /// vary. The exemplar must be toroidal (a lattice that tiles it wraps around it; force
-    /// `toroidal` when preparing it) and the counts must divide its side.
+    /// `toroidal` when preparing it) and the counts must divide its width and height.
     pub fn with_lattice(mut self, nx: u32, ny: u32) -> Result<Exemplar> {
         if !self.toroidal {
             return Err(CoreError::Param {
@@ -301,7 +331,7 @@ impl Exemplar {
                 message: "needs a toroidal exemplar (the lattice tiles it, so it wraps around): set toroidal".into(),
             });
         }
-        self.lattice = Some(Lattice::cells(nx, ny, self.side)?);
+        self.lattice = Some(Lattice::cells(nx, ny, self.width, self.height)?);
         Ok(self)
     }
 
@@ -317,9 +347,9 @@ impl Exemplar {
         // A given lattice is checked before the pixels are looked at.
         match *choice {
             LatticeChoice::Cells(nx, ny) => self = self.with_lattice(nx, ny)?,
-            _ => self.lattice = choice.explicit(self.side)?,
+            _ => self.lattice = choice.explicit(self.width, self.height)?,
         }
-        let found = crate::lattice::detect(&self.pixels, self.side);
+        let found = crate::lattice::detect(&self.pixels, self.width, self.height);
         if *choice == LatticeChoice::Auto {
             self.lattice = found.lattice.clone();
         }
@@ -327,6 +357,19 @@ impl Exemplar {
         self.repeat = found.repeat;
         Ok(self)
     }
+}
+
+/// The largest centred square of a `w × h` image (itself when square) and its side: what the
+/// analyses that look at a square (structure detection, umbrella extraction) see of a
+/// non-square exemplar.
+pub fn centred_square<T: Copy>(pixels: &[T], (w, h): (usize, usize)) -> (std::borrow::Cow<'_, [T]>, usize) {
+    if w == h {
+        return (std::borrow::Cow::Borrowed(pixels), w);
+    }
+    let side = w.min(h);
+    let (ox, oy) = ((w - side) / 2, (h - side) / 2);
+    let square = (0..side).flat_map(|y| &pixels[(oy + y) * w + ox..][..side]).copied().collect();
+    (std::borrow::Cow::Owned(square), side)
 }
 
 /// The colour variation of `pixels`: the standard deviation, in 8-bit levels, of the most
@@ -352,11 +395,16 @@ fn check_size(w: u32, h: u32, max: u32) -> Result<()> {
     Ok(())
 }
 
-/// The prepared side for a crop of side `s`: the largest power of two ≤ `s`, clamped to
-/// `[MIN_SIDE, MAX_SIDE]`.
-pub fn target_side(s: u32) -> u32 {
-    let p = if s == 0 { 1 } else { 1u32 << (31 - s.leading_zeros()) };
-    p.clamp(MIN_SIDE, MAX_SIDE)
+/// The prepared size of a `w × h` image: the same, unless a side exceeds [`MAX_SIDE`]; then
+/// scaled so that the longer side is [`MAX_SIDE`], keeping the shape (the shorter side
+/// rounded, at least [`MIN_INPUT_SIDE`]).
+pub fn prepared_size(w: u32, h: u32) -> (u32, u32) {
+    let long = w.max(h);
+    if long <= MAX_SIDE {
+        return (w, h);
+    }
+    let scale = |s: u32| ((s as u64 * MAX_SIDE as u64 + long as u64 / 2) / long as u64).max(MIN_INPUT_SIDE as u64) as u32;
+    (scale(w), scale(h))
 }
 
 /// Composite RGBA over the alpha-weighted mean colour of the image, with integer rounding.
@@ -377,73 +425,77 @@ fn composite_over_mean(px: &[[u8; 4]]) -> Vec<[u8; 3]> {
         .collect()
 }
 
-/// Exact area resampling of an `s × s` image to `t × t` with integer weights (works both ways).
-/// Output pixel `i` covers source interval `[i·s/t, (i+1)·s/t)`; weights are overlap lengths in
-/// units of `1/t` source pixels, so every sum is an exact integer.
-fn area_resample(src: &[[u8; 3]], s: usize, t: usize) -> Vec<[u8; 3]> {
-    let weights: Vec<Vec<(usize, u64)>> = (0..t)
-        .map(|i| {
-            let (a, b) = (i * s, (i + 1) * s); // in units of 1/t source pixels
-            let mut w = Vec::new();
-            for j in a / t..b.div_ceil(t) {
-                let lo = a.max(j * t);
-                let hi = b.min((j + 1) * t);
-                if hi > lo {
-                    w.push((j, (hi - lo) as u64));
+/// Exact area resampling of a `sw × sh` image to `tw × th` with integer weights (works both
+/// ways, per axis). Output pixel `i` covers source interval `[i·s/t, (i+1)·s/t)`; weights are
+/// overlap lengths in units of `1/t` source pixels, so every sum is an exact integer.
+pub(crate) fn area_resample(src: &[[u8; 3]], (sw, sh): (usize, usize), (tw, th): (usize, usize)) -> Vec<[u8; 3]> {
+    let weights = |s: usize, t: usize| -> Vec<Vec<(usize, u64)>> {
+        (0..t)
+            .map(|i| {
+                let (a, b) = (i * s, (i + 1) * s); // in units of 1/t source pixels
+                let mut w = Vec::new();
+                for j in a / t..b.div_ceil(t) {
+                    let lo = a.max(j * t);
+                    let hi = b.min((j + 1) * t);
+                    if hi > lo {
+                        w.push((j, (hi - lo) as u64));
+                    }
                 }
-            }
-            w
-        })
-        .collect();
-    // Horizontal pass (sums of weight·value, total weight s per output pixel).
-    let mut tmp = vec![[0u64; 3]; s * t];
-    for y in 0..s {
-        for (x, w) in weights.iter().enumerate() {
+                w
+            })
+            .collect()
+    };
+    let (wx, wy) = (weights(sw, tw), weights(sh, th));
+    // Horizontal pass (sums of weight·value, total weight sw per output pixel).
+    let mut tmp = vec![[0u64; 3]; sh * tw];
+    for y in 0..sh {
+        for (x, w) in wx.iter().enumerate() {
             let mut acc = [0u64; 3];
             for &(j, wt) in w {
-                let p = src[y * s + j];
+                let p = src[y * sw + j];
                 for c in 0..3 {
                     acc[c] += wt * p[c] as u64;
                 }
             }
-            tmp[y * t + x] = acc;
+            tmp[y * tw + x] = acc;
         }
     }
-    let total = (s * s) as u64;
-    let mut out = vec![[0u8; 3]; t * t];
-    for (y, w) in weights.iter().enumerate() {
-        for x in 0..t {
+    let total = (sw * sh) as u64;
+    let mut out = vec![[0u8; 3]; tw * th];
+    for (y, w) in wy.iter().enumerate() {
+        for x in 0..tw {
             let mut acc = [0u64; 3];
             for &(j, wt) in w {
-                let p = tmp[j * t + x];
+                let p = tmp[j * tw + x];
                 for c in 0..3 {
                     acc[c] += wt * p[c];
                 }
             }
-            out[y * t + x] = acc.map(|v| ((v + total / 2) / total).min(255) as u8);
+            out[y * tw + x] = acc.map(|v| ((v + total / 2) / total).min(255) as u8);
         }
     }
     out
 }
 
-/// Mean absolute gradient across the wrap-around edges divided by the interior mean.
-pub(crate) fn seam_ratio(px: &[[u8; 3]], m: usize) -> f64 {
+/// Mean absolute gradient across the wrap-around edges of a `w × h` image divided by the
+/// interior mean.
+pub(crate) fn seam_ratio(px: &[[u8; 3]], w: usize, h: usize) -> f64 {
     let diff = |a: [u8; 3], b: [u8; 3]| -> u64 { (0..3).map(|c| a[c].abs_diff(b[c]) as u64).sum() };
     let (mut inner, mut n_inner) = (0u64, 0u64);
     let (mut seam, mut n_seam) = (0u64, 0u64);
-    for y in 0..m {
-        for x in 0..m {
-            let p = px[y * m + x];
-            let right = px[y * m + (x + 1) % m];
-            let down = px[((y + 1) % m) * m + x];
-            if x + 1 < m {
+    for y in 0..h {
+        for x in 0..w {
+            let p = px[y * w + x];
+            let right = px[y * w + (x + 1) % w];
+            let down = px[((y + 1) % h) * w + x];
+            if x + 1 < w {
                 inner += diff(p, right);
                 n_inner += 1;
             } else {
                 seam += diff(p, right);
                 n_seam += 1;
             }
-            if y + 1 < m {
+            if y + 1 < h {
                 inner += diff(p, down);
                 n_inner += 1;
             } else {
@@ -470,20 +522,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn target_sides() {
-        assert_eq!(target_side(16), 32);
-        assert_eq!(target_side(100), 64);
-        assert_eq!(target_side(128), 128);
-        assert_eq!(target_side(1024), 512);
+    fn sizes_are_kept_up_to_the_cap() {
+        assert_eq!(prepared_size(50, 50), (50, 50));
+        assert_eq!(prepared_size(300, 200), (300, 200));
+        assert_eq!(prepared_size(1024, 600), (512, 300));
+        assert_eq!(levels_for(128, 128), 7);
+        assert_eq!(levels_for(100, 100), 7);
+        assert_eq!(levels_for(300, 200), 9);
+        assert_eq!(levels_for(78, 43), 7);
+        assert_eq!(levels_for(16, 16), 4);
     }
 
     #[test]
     fn area_resample_preserves_flat_images_and_means() {
         let src = vec![[10u8, 20, 30]; 100 * 100];
-        let out = area_resample(&src, 100, 64);
+        let out = area_resample(&src, (100, 100), (64, 50));
         assert!(out.iter().all(|p| *p == [10, 20, 30]));
         let src: Vec<[u8; 3]> = (0..16 * 16).map(|i| [(i % 2 * 255) as u8; 3]).collect();
-        let out = area_resample(&src, 16, 32);
-        assert_eq!(out.len(), 32 * 32);
+        let out = area_resample(&src, (16, 16), (32, 24));
+        assert_eq!(out.len(), 32 * 24);
     }
 }

@@ -94,6 +94,23 @@ impl Rect {
     }
 }
 
+/// `v` wrapped onto `0..n` (`n > 0`): a mask when `n` is a power of two, else the Euclidean
+/// remainder. Exemplar coordinates wrap at the exemplar's width and height.
+#[inline(always)]
+pub fn wrap(v: i64, n: i64) -> i64 {
+    if n & (n - 1) == 0 {
+        v & (n - 1)
+    } else {
+        v.rem_euclid(n)
+    }
+}
+
+/// Exemplar coordinates `(x, y)` wrapped onto a `w × h` exemplar and packed as `x | y << 16`.
+#[inline(always)]
+pub fn pack_wrapped(x: i64, y: i64, (w, h): (i64, i64)) -> u32 {
+    (wrap(x, w) | wrap(y, h) << 16) as u32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

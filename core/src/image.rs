@@ -47,9 +47,9 @@ impl RgbWindow {
         [self.pixels[i], self.pixels[i + 1], self.pixels[i + 2]]
     }
 
-    /// An image of `side × side` pixels from row-major RGB texels.
-    pub fn from_texels(side: u32, texels: &[[u8; 3]]) -> Self {
-        RgbWindow { width: side, height: side, pixels: texels.iter().flatten().copied().collect() }
+    /// An image of `width × height` pixels from row-major RGB texels.
+    pub fn from_texels((width, height): (u32, u32), texels: &[[u8; 3]]) -> Self {
+        RgbWindow { width, height, pixels: texels.iter().flatten().copied().collect() }
     }
 
     /// The exact box average over `f × f` blocks (rounded to nearest); width and height must be
@@ -92,44 +92,59 @@ pub struct Rendered {
     pub synthesized: u64,
 }
 
-/// An `n × n` exemplar box-filtered `lvl` times (side `n >> lvl`).
-pub fn box_mip(texels: &[[u8; 3]], n: usize, lvl: usize) -> Vec<[u8; 3]> {
-    RgbWindow::from_texels(n as u32, texels).box_down(1 << lvl).texels()
+/// The mean colour of `texels` (rounded to nearest).
+pub fn mean_colour(texels: &[[u8; 3]]) -> [u8; 3] {
+    let n = texels.len().max(1) as u64;
+    let mut sum = [0u64; 3];
+    for t in texels {
+        for c in 0..3 {
+            sum[c] += t[c] as u64;
+        }
+    }
+    sum.map(|v| ((v + n / 2) / n) as u8)
 }
 
-/// Sums of an `n × n` exemplar's texels over `f × f` boxes anywhere on its torus, from an
+/// A `w × h` exemplar box-filtered `lvl` times (size `(w >> lvl) × (h >> lvl)`).
+pub fn box_mip(texels: &[[u8; 3]], (w, h): (usize, usize), lvl: usize) -> Vec<[u8; 3]> {
+    RgbWindow::from_texels((w as u32, h as u32), texels).box_down(1 << lvl).texels()
+}
+
+/// Sums of a `w × h` exemplar's texels over `f × f` boxes anywhere on its torus, from an
 /// integral image of the exemplar extended by `f` texels right and down (wrapping).
 pub(crate) struct Integral {
-    /// Side of the exemplar (a power of two).
-    n: usize,
-    /// Box side (a power of two, at most `n`).
+    /// Size of the exemplar.
+    w: usize,
+    h: usize,
+    /// Box side (a power of two; it may exceed the exemplar, whose texels then repeat).
     f: usize,
-    /// `(n + f + 1)²` prefix sums per channel: entry `(x, y)` sums the texels left of and
-    /// above it.
+    /// `(w + f + 1) × (h + f + 1)` prefix sums per channel: entry `(x, y)` sums the texels
+    /// left of and above it.
     sums: Vec<[u32; 3]>,
 }
 
 impl Integral {
-    pub(crate) fn new(texels: &[[u8; 3]], n: usize, f: usize) -> Integral {
-        debug_assert!(n.is_power_of_two() && f.is_power_of_two() && f <= n);
-        let s = n + f + 1;
-        let mut sums = vec![[0u32; 3]; s * s];
-        for y in 1..s {
-            for x in 1..s {
-                let t = texels[((y - 1) & (n - 1)) * n + ((x - 1) & (n - 1))];
-                let (l, u, d) = (sums[y * s + x - 1], sums[(y - 1) * s + x], sums[(y - 1) * s + x - 1]);
-                sums[y * s + x] = std::array::from_fn(|c| t[c] as u32 + l[c] + u[c] - d[c]);
+    pub(crate) fn new(texels: &[[u8; 3]], (w, h): (usize, usize), f: usize) -> Integral {
+        debug_assert!(f.is_power_of_two());
+        let (sw, sh) = (w + f + 1, h + f + 1);
+        let mut sums = vec![[0u32; 3]; sw * sh];
+        for y in 1..sh {
+            for x in 1..sw {
+                let t = texels[((y - 1) % h) * w + (x - 1) % w];
+                let (l, u, d) = (sums[y * sw + x - 1], sums[(y - 1) * sw + x], sums[(y - 1) * sw + x - 1]);
+                sums[y * sw + x] = std::array::from_fn(|c| t[c] as u32 + l[c] + u[c] - d[c]);
             }
         }
-        Integral { n, f, sums }
+        Integral { w, h, f, sums }
     }
 
     /// The mean (rounded to nearest) of the `f × f` texels centred on texel `(x, y)` (from
     /// `f/2` before it to `f/2 − 1` after), on the torus.
     pub(crate) fn mean_around(&self, x: usize, y: usize) -> [u8; 3] {
-        let (n, f, s) = (self.n, self.f, self.n + self.f + 1);
-        let (x0, y0) = ((x + n - f / 2) & (n - 1), (y + n - f / 2) & (n - 1));
-        let at = |x: usize, y: usize| self.sums[y * s + x];
+        let (f, sw) = (self.f, self.w + self.f + 1);
+        let half = (f / 2) as i64;
+        let (x0, y0) =
+            ((x as i64 - half).rem_euclid(self.w as i64) as usize, (y as i64 - half).rem_euclid(self.h as i64) as usize);
+        let at = |x: usize, y: usize| self.sums[y * sw + x];
         let (a, b, c, d) = (at(x0, y0), at(x0 + f, y0), at(x0, y0 + f), at(x0 + f, y0 + f));
         // `f` is a power of two: dividing by the area is a shift.
         let shift = 2 * f.trailing_zeros();
@@ -137,16 +152,16 @@ impl Integral {
     }
 }
 
-/// The centred box means of an `n × n` exemplar at every scale: entry `k` (`0..=log2 n`) holds,
-/// for each texel, the mean of the `2^k × 2^k` texels centred on it on the torus (see
-/// [`Integral::mean_around`]). A zoomed-out pixel whose native texels are the exemplar's block
-/// around one coordinate shows exactly this colour.
-pub fn box_stack(texels: &[[u8; 3]], n: usize) -> Vec<Vec<[u8; 3]>> {
-    let levels = n.trailing_zeros() as usize;
+/// The centred box means of a `w × h` exemplar at every scale: entry `k` (`0..=L`,
+/// [`crate::exemplar::levels_for`]) holds, for each texel, the mean of the `2^k × 2^k` texels
+/// centred on it on the torus (see [`Integral::mean_around`]). A zoomed-out pixel whose native
+/// texels are the exemplar's block around one coordinate shows exactly this colour.
+pub fn box_stack(texels: &[[u8; 3]], (w, h): (usize, usize)) -> Vec<Vec<[u8; 3]>> {
+    let levels = crate::exemplar::levels_for(w as u32, h as u32) as usize;
     (0..=levels)
         .map(|k| {
-            let sums = Integral::new(texels, n, 1 << k);
-            (0..n * n).map(|i| sums.mean_around(i % n, i / n)).collect()
+            let sums = Integral::new(texels, (w, h), 1 << k);
+            (0..w * h).map(|i| sums.mean_around(i % w, i / w)).collect()
         })
         .collect()
 }

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cache::{Pyramid, Stack};
 use crate::error::{CoreError, Result};
-use crate::image::{box_stack, Integral};
+use crate::image::box_stack;
 use crate::stack::low_pass;
 
 /// The maps every material tool knows by name (any other valid name is an extra map).
@@ -42,9 +42,13 @@ pub enum NormalConvention {
 pub struct MaterialMap {
     /// Its name (`normal`, `height`, … or an extra map's).
     pub name: String,
-    /// Row-major RGB texels, `side × side` like the exemplar's (grey maps in all three).
+    /// Width in texels, the exemplar's.
+    pub width: u32,
+    /// Height in texels, the exemplar's.
+    pub height: u32,
+    /// Row-major RGB texels, `width × height` like the exemplar's (grey maps in all three).
     pub texels: Vec<[u8; 3]>,
-    /// Its `2·side` version when the exemplar has one ([`Exemplar::hires`]).
+    /// Its version twice as wide and high when the exemplar has one ([`Exemplar::hires`]).
     pub hires: Option<Vec<[u8; 3]>>,
     /// Whether it is the normal map (OpenGL convention, unit vectors).
     pub normal: bool,
@@ -53,16 +57,23 @@ pub struct MaterialMap {
 }
 
 impl MaterialMap {
-    /// Map `name` from its texels, prepared like the exemplar's (and its `2·side`
-    /// version when the exemplar has one): a normal map is converted to the OpenGL convention
-    /// from `convention` (required) and renormalised.
+    /// Map `name` from its `width × height` texels, prepared like the exemplar's (and its
+    /// version twice as large when the exemplar has one): a normal map is converted to the
+    /// OpenGL convention from `convention` (required) and renormalised.
     pub fn new(
         name: &str,
+        (width, height): (u32, u32),
         texels: Vec<[u8; 3]>,
         hires: Option<Vec<[u8; 3]>>,
         convention: Option<NormalConvention>,
     ) -> Result<Self> {
         check_name(name)?;
+        if texels.len() != width as usize * height as usize {
+            return Err(CoreError::Map {
+                name: name.to_string(),
+                message: format!("has {} texels, not {width}x{height}", texels.len()),
+            });
+        }
         let normal = name == "normal";
         let convention = match (normal, convention) {
             (true, Some(c)) => Some(c),
@@ -90,32 +101,31 @@ impl MaterialMap {
             h.update(hi.as_flattened());
         }
         let hash = h.finalize().to_hex()[..16].to_string();
-        Ok(MaterialMap { name: name.to_string(), texels, hires, normal, hash })
+        Ok(MaterialMap { name: name.to_string(), width, height, texels, hires, normal, hash })
     }
 
-    /// Exemplar side.
-    pub fn side(&self) -> u32 {
-        (self.texels.len() as f64).sqrt() as u32
+    /// Its size `(width, height)` for indexing.
+    pub fn dims(&self) -> (usize, usize) {
+        (self.width as usize, self.height as usize)
     }
 
     /// The centred `2^k × 2^k` box means of the map, per texel, for every `k` (see
     /// [`box_stack`]), derived on first use and kept in `cache` within its bytes.
     pub fn box_stack(&self, cache: &Pyramid) -> Stack {
-        cache.derived(&format!("boxes|map|{}", self.hash), || box_stack(&self.texels, self.side() as usize))
+        cache.derived(&format!("boxes|map|{}", self.hash), || box_stack(&self.texels, self.dims()))
     }
 
     /// The map low-passed `steps` stack levels (see [`crate::stack::low_pass`]), with the
     /// addressing of a `toroidal` exemplar or not, as a one-level stack kept in `cache`.
     pub fn low_pass(&self, cache: &Pyramid, toroidal: bool, steps: u32) -> Stack {
         cache.derived(&format!("low|map|{}|{toroidal}|{steps}", self.hash), || {
-            vec![low_pass(&self.texels, self.side() as usize, toroidal, steps)]
+            vec![low_pass(&self.texels, self.dims(), toroidal, steps)]
         })
     }
 
-    /// The map's mean (the box mean over the whole map).
+    /// The map's mean colour (rounded to nearest).
     pub fn mean(&self) -> [u8; 3] {
-        let n = self.side() as usize;
-        Integral::new(&self.texels, n, n).mean_around(0, 0)
+        crate::image::mean_colour(&self.texels)
     }
 }
 
@@ -257,12 +267,12 @@ mod tests {
         let m = 16usize;
         let texels: Vec<[u8; 3]> =
             (0..m * m).map(|i| [(i * 37 % 251) as u8, (i % m * 16) as u8, (i / m * 16) as u8]).collect();
-        let map = MaterialMap::new("height", texels.clone(), None, None).unwrap();
+        let map = MaterialMap::new("height", (16, 16), texels.clone(), None, None).unwrap();
         let cache = Pyramid::new(1 << 20);
         for (toroidal, steps) in [(true, 2), (false, 2), (true, 1), (true, 2)] {
             assert_eq!(
                 &map.low_pass(&cache, toroidal, steps)[0][..],
-                &low_pass(&texels, m, toroidal, steps)[..],
+                &low_pass(&texels, (m, m), toroidal, steps)[..],
                 "{toroidal} {steps}"
             );
         }
@@ -271,17 +281,17 @@ mod tests {
     #[test]
     fn maps_that_are_not_normal_maps_are_refused() {
         let flat = vec![[128, 128, 255]; 64 * 64];
-        assert!(MaterialMap::new("normal", flat, None, Some(NormalConvention::OpenGl)).is_ok());
+        assert!(MaterialMap::new("normal", (64, 64), flat, None, Some(NormalConvention::OpenGl)).is_ok());
         // All black (the hostile run's upload), all white, and pointing down.
         for c in [[0, 0, 0], [255, 255, 255], [128, 128, 20]] {
-            let e = MaterialMap::new("normal", vec![c; 64 * 64], None, Some(NormalConvention::OpenGl)).unwrap_err();
+            let e = MaterialMap::new("normal", (64, 64), vec![c; 64 * 64], None, Some(NormalConvention::OpenGl)).unwrap_err();
             assert!(e.to_string().contains("normal") && e.to_string().contains("100 %"), "{c:?}: {e}");
         }
         // A few wrong texels are tolerated; a height map is not checked as one.
         let mut few = vec![[128, 128, 255]; 64 * 64];
         few[..30].fill([0, 0, 0]);
-        assert!(MaterialMap::new("normal", few, None, Some(NormalConvention::DirectX)).is_ok());
-        assert!(MaterialMap::new("height", vec![[0, 0, 0]; 64 * 64], None, None).is_ok());
+        assert!(MaterialMap::new("normal", (64, 64), few, None, Some(NormalConvention::DirectX)).is_ok());
+        assert!(MaterialMap::new("height", (64, 64), vec![[0, 0, 0]; 64 * 64], None, None).is_ok());
     }
 
     #[test]

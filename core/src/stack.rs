@@ -1,4 +1,4 @@
-//! The Gaussian stack (design note §1.2a): one full `m × m` image per synthesis level, blurred
+//! The Gaussian stack (design note §1.2a): one full `w × h` image per synthesis level, blurred
 //! more at coarser levels with an à-trous binomial filter, in exact u16 fixed point (value·256).
 //! Edges are handled by an addressing rule: wrap for toroidal exemplars, mirror otherwise. Also
 //! one level of it alone ([`low_pass`]): what `synth` blends seams with, for maps as for colour.
@@ -16,17 +16,17 @@ pub fn addr(i: i64, m: i64, toroidal: bool) -> usize {
 
 const TAPS: [u32; 5] = [1, 4, 6, 4, 1];
 
-/// Build the stack for an `m × m` exemplar (`m = 2^L`): `L + 1` levels, index `l` = level `l`
-/// (0 = coarsest, the exact mean colour; `L` = the exemplar itself).
-pub fn build_stack(pixels: &[[u8; 3]], m: usize, toroidal: bool) -> Vec<Vec<[u16; 3]>> {
-    let levels = m.trailing_zeros() as usize;
+/// Build the stack for a `w × h` exemplar: `L + 1` levels ([`crate::exemplar::levels_for`]),
+/// index `l` = level `l` (0 = coarsest, the exact mean colour; `L` = the exemplar itself).
+pub fn build_stack(pixels: &[[u8; 3]], (w, h): (usize, usize), toroidal: bool) -> Vec<Vec<[u16; 3]>> {
+    let levels = crate::exemplar::levels_for(w as u32, h as u32) as usize;
     let mut stack = vec![Vec::new(); levels + 1];
     stack[levels] = pixels.iter().map(|p| p.map(|v| (v as u16) << 8)).collect();
     for l in (1..=levels).rev() {
-        stack[l - 1] = blur(&stack[l], m, 1 << (levels - l), toroidal);
+        stack[l - 1] = blur(&stack[l], (w, h), 1 << (levels - l), toroidal);
     }
     // Level 0 is the exact mean colour (LH05).
-    let n = (m * m) as u64;
+    let n = (w * h) as u64;
     let mut sum = [0u64; 3];
     for p in pixels {
         for c in 0..3 {
@@ -34,30 +34,30 @@ pub fn build_stack(pixels: &[[u8; 3]], m: usize, toroidal: bool) -> Vec<Vec<[u16
         }
     }
     let mean = sum.map(|s| (((s << 8) + n / 2) / n) as u16);
-    stack[0] = vec![mean; m * m];
+    stack[0] = vec![mean; w * h];
     stack
 }
 
 /// One step of the à-trous filter at stride `h`: the next coarser stack level.
-fn blur(src: &[[u16; 3]], m: usize, h: i64, toroidal: bool) -> Vec<[u16; 3]> {
+fn blur(src: &[[u16; 3]], (w, hh): (usize, usize), h: i64, toroidal: bool) -> Vec<[u16; 3]> {
     let pass = |src: &[[u16; 3]], horizontal: bool| -> Vec<[u16; 3]> {
-        let mut out = vec![[0u16; 3]; m * m];
-        for y in 0..m {
-            for x in 0..m {
+        let mut out = vec![[0u16; 3]; w * hh];
+        for y in 0..hh {
+            for x in 0..w {
                 let mut acc = [0u32; 3];
                 for (k, &t) in TAPS.iter().enumerate() {
                     let off = (k as i64 - 2) * h;
                     let (sx, sy) = if horizontal {
-                        (addr(x as i64 + off, m as i64, toroidal), y)
+                        (addr(x as i64 + off, w as i64, toroidal), y)
                     } else {
-                        (x, addr(y as i64 + off, m as i64, toroidal))
+                        (x, addr(y as i64 + off, hh as i64, toroidal))
                     };
-                    let p = src[sy * m + sx];
+                    let p = src[sy * w + sx];
                     for c in 0..3 {
                         acc[c] += t * p[c] as u32;
                     }
                 }
-                out[y * m + x] = acc.map(|s| ((s + 8) >> 4) as u16);
+                out[y * w + x] = acc.map(|s| ((s + 8) >> 4) as u16);
             }
         }
         out
@@ -65,13 +65,13 @@ fn blur(src: &[[u16; 3]], m: usize, h: i64, toroidal: bool) -> Vec<[u16; 3]> {
     pass(&pass(src, true), false)
 }
 
-/// Stack level `L − steps` of an `m × m` image, 8-bit: what [`build_stack`] gives there,
+/// Stack level `L − steps` of a `w × h` image, 8-bit: what [`build_stack`] gives there,
 /// without the coarser levels.
-pub fn low_pass(pixels: &[[u8; 3]], m: usize, toroidal: bool, steps: u32) -> Vec<[u8; 3]> {
-    let steps = steps.min(m.trailing_zeros());
+pub fn low_pass(pixels: &[[u8; 3]], dims: (usize, usize), toroidal: bool, steps: u32) -> Vec<[u8; 3]> {
+    let steps = steps.min(crate::exemplar::levels_for(dims.0 as u32, dims.1 as u32));
     let mut level: Vec<[u16; 3]> = pixels.iter().map(|p| p.map(|v| (v as u16) << 8)).collect();
     for s in 0..steps {
-        level = blur(&level, m, 1 << s, toroidal);
+        level = blur(&level, dims, 1 << s, toroidal);
     }
     level.iter().map(|c| c.map(to_u8)).collect()
 }
@@ -100,10 +100,10 @@ mod tests {
         let px: Vec<[u8; 3]> =
             (0..m * m).map(|i| [(i * 37 % 251) as u8, (i * 11 % 256) as u8, (i / m * 16) as u8]).collect();
         for toroidal in [false, true] {
-            let stack = build_stack(&px, m, toroidal);
+            let stack = build_stack(&px, (m, m), toroidal);
             for steps in 0..=3u32 {
                 let level: Vec<[u8; 3]> = stack[4 - steps as usize].iter().map(|c| c.map(to_u8)).collect();
-                assert_eq!(low_pass(&px, m, toroidal, steps), level, "toroidal {toroidal}, {steps} steps");
+                assert_eq!(low_pass(&px, (m, m), toroidal, steps), level, "toroidal {toroidal}, {steps} steps");
             }
         }
     }
@@ -111,7 +111,7 @@ mod tests {
     #[test]
     fn flat_exemplar_gives_flat_stack() {
         let px = vec![[7u8, 8, 9]; 32 * 32];
-        let s = build_stack(&px, 32, false);
+        let s = build_stack(&px, (32, 32), false);
         assert_eq!(s.len(), 6);
         for level in &s {
             assert!(level.iter().all(|p| *p == [7 << 8, 8 << 8, 9 << 8]));

@@ -86,9 +86,11 @@ const FULL: [(i64, i64); 24] = [
 /// Full 3×3 around the parent one level coarser.
 const PARENT: [(i64, i64); 9] = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 0), (0, 1), (1, -1), (1, 0), (1, 1)];
 
-/// Pyramid levels for an exemplar side `m`: coarsest exemplar level at least 16 px, at most 4.
+/// Pyramid levels for an exemplar whose shorter side is `m`: coarsest exemplar level at least
+/// 16 px, at most 4.
 pub fn levels(m: u32) -> u32 {
-    (m.trailing_zeros().saturating_sub(3)).clamp(1, 4)
+    let log2 = 31 - m.max(1).leading_zeros();
+    (log2.saturating_sub(3)).clamp(1, 4)
 }
 
 /// One level of an image pyramid, `f32` RGB.
@@ -186,7 +188,7 @@ fn exact_nearest(c: &Candidates, q: &[f32]) -> u32 {
 /// Check the options against the exemplar; the number of pyramid levels.
 pub fn check(ex: &Exemplar, opts: &TileableOptions) -> Result<u32> {
     let bad = |message: String| CoreError::Param { name: "size", message };
-    let levels = levels(ex.side);
+    let levels = levels(ex.width.min(ex.height));
     let step = 1u32 << (levels - 1);
     if !(MIN_SIZE..=MAX_SIZE).contains(&opts.size) {
         return Err(bad(format!("{} is outside {MIN_SIZE}..={MAX_SIZE}", opts.size)));
@@ -211,14 +213,26 @@ pub fn synthesize(
     cancel: &Cancel,
 ) -> Result<RgbWindow> {
     let levels = check(ex, opts)? as usize;
-    let m = ex.side as usize;
-    let mut pyr = vec![Level { w: m, h: m, px: ex.pixels.iter().map(|p| p.map(|c| c as f32)).collect() }];
+    synthesize_sized(ex, levels, (opts.size as usize, opts.size as usize), opts, progress, cancel)
+}
+
+/// [`synthesize`] of a `width × height` texture over `levels` pyramid levels (sizes unchecked:
+/// a level of an odd size is the floor of half the finer one's, wrapping all the same).
+fn synthesize_sized(
+    ex: &Exemplar,
+    levels: usize,
+    (width, height): (usize, usize),
+    opts: &TileableOptions,
+    progress: &dyn Progress,
+    cancel: &Cancel,
+) -> Result<RgbWindow> {
+    let (ew, eh) = ex.dims();
+    let mut pyr = vec![Level { w: ew, h: eh, px: ex.pixels.iter().map(|p| p.map(|c| c as f32)).collect() }];
     for _ in 1..levels {
         let next = pyr[pyr.len() - 1].down();
         pyr.push(next);
     }
-    let size = opts.size as usize;
-    let total: u32 = (0..levels).map(|l| SWEEPS * (size >> l) as u32).sum();
+    let total: u32 = (0..levels).map(|l| SWEEPS * (height >> l) as u32).sum();
     let mut done = 0;
     progress.step(0, total, "starting");
     let mut out: Vec<Level> = Vec::with_capacity(levels);
@@ -236,22 +250,22 @@ pub fn synthesize(
                 (c, tree)
             })
             .collect();
-        let s = size >> l;
+        let (s, sh) = ((width >> l).max(1), (height >> l).max(1));
         // Starting noise: exemplar pixels picked by a hash of the seed and the pixel.
-        let px = (0..s * s)
+        let px = (0..s * sh)
             .map(|i| {
                 let h = hash(0x7117, opts.seed, (i % s) as i64, (i / s) as i64, l as i64);
                 ex_level.px[(h % ex_level.px.len() as u64) as usize]
             })
             .collect();
-        let mut level = Level { w: s, h: s, px };
+        let mut level = Level { w: s, h: sh, px };
         let parent = out.last();
         let mut q = Vec::new();
         for sweep in 0..SWEEPS {
             // The last sweep sees both sides of every pixel, across the wrap too.
             let (shape, (cands, tree)) =
                 if sweep + 1 < SWEEPS { (&CAUSAL[..], &searches[0]) } else { (&FULL[..], &searches[1]) };
-            for y in 0..s {
+            for y in 0..sh {
                 cancel.check()?;
                 for x in 0..s {
                     neighbourhood(shape, &level, parent, x as i64, y as i64, &mut q);
@@ -272,17 +286,18 @@ pub fn synthesize(
     }
     let finest = out.pop().ok_or_else(|| CoreError::Param { name: "size", message: "no level".into() })?;
     let pixels = finest.px.iter().flat_map(|p| p.map(|c| c.round().clamp(0.0, 255.0) as u8)).collect();
-    Ok(RgbWindow { width: opts.size, height: opts.size, pixels })
+    Ok(RgbWindow { width: width as u32, height: height as u32, pixels })
 }
 
-/// A toroidal exemplar made from a non-toroidal one: a seamless texture of the same side
+/// A toroidal exemplar made from a non-toroidal one: a seamless texture of the same size
 /// synthesized from it (TSVQ, [`DEFAULT_BACKTRACK`] leaves), so that the main engine can wrap
 /// around it with no border rule. Deterministic for a seed.
 pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
-    let opts = TileableOptions { size: ex.side, seed, search: Search::Tsvq { backtrack: DEFAULT_BACKTRACK } };
-    let img = synthesize(ex, &opts, &crate::analysis::NoProgress, &Cancel::new())?;
+    let opts = TileableOptions { size: ex.width, seed, search: Search::Tsvq { backtrack: DEFAULT_BACKTRACK } };
+    let levels = levels(ex.width.min(ex.height)) as usize;
+    let img = synthesize_sized(ex, levels, ex.dims(), &opts, &crate::analysis::NoProgress, &Cancel::new())?;
     let pixels: Vec<[u8; 3]> = img.pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
-    let seam_ratio = crate::exemplar::seam_ratio(&pixels, ex.side as usize);
+    let seam_ratio = crate::exemplar::seam_ratio(&pixels, ex.width as usize, ex.height as usize);
     let preparation = crate::exemplar::Preparation {
         toroidal_forced: true,
         seam_ratio,
@@ -290,7 +305,8 @@ pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
         ..ex.preparation.clone()
     };
     Ok(Exemplar {
-        side: ex.side,
+        width: ex.width,
+        height: ex.height,
         pixels,
         toroidal: true,
         preparation,

@@ -56,7 +56,7 @@ fn a_calm_stroke_keeps_the_tiled_exemplar_under_it() {
 #[test]
 fn inside_a_features_inner_radius_the_output_is_the_exemplar_around_its_source() {
     let (ex, an) = (common::small_exemplar(), common::small());
-    let m = ex.side as i64;
+    let m = ex.width as i64;
     // Two features, one straddling the border of two windows, one far away.
     for (x, y) in [(-37i64, 50i64), (7 << 36, -(9 << 35))] {
         let json = format!(r#"{{"features": [{{"at": [{x}, {y}], "source": [30, 25], "inner": 10, "outer": 24}}]}}"#);

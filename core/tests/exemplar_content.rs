@@ -149,7 +149,7 @@ proptest! {
     ) {
         let an = common::small();
         prop_assert!(!an.header.toroidal);
-        let m = an.side();
+        let m = an.width();
         let rect = Rect::new(x >> (an.levels() - level), y >> (an.levels() - level), w, h);
         let c = synthesize(an, &SynthParams { seed, ..SynthParams::default() }, level, rect).unwrap();
         prop_assert!(c.coords.iter().all(|&v| (v & 0xFFFF) < m && (v >> 16) < m));

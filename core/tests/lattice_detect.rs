@@ -42,7 +42,7 @@ impl Fill {
     /// offset, with the cell's own brightness.
     fn stone(&self, x: i64, y: i64, cell: (i64, i64)) -> [u8; 3] {
         let h = cell_hash(cell.0, cell.1);
-        let m = self.stone.side as i64;
+        let m = self.stone.width as i64;
         let (ox, oy) = ((h % 97) as i64, ((h >> 8) % 89) as i64);
         let p = self.stone.pixels[((y + oy).rem_euclid(m) * m + (x + ox).rem_euclid(m)) as usize];
         let gain = 0.85 + 0.3 * ((h >> 16) % 100) as f64 / 100.0;
@@ -51,7 +51,7 @@ impl Fill {
 
     /// The joint texture at `(x, y)`: rock, dark.
     fn joint(&self, x: i64, y: i64) -> [u8; 3] {
-        let m = self.joint.side as i64;
+        let m = self.joint.width as i64;
         self.joint.pixels[(y.rem_euclid(m) * m + x.rem_euclid(m)) as usize].map(|c| (c as f64 * 0.3) as u8)
     }
 }
@@ -174,7 +174,7 @@ fn same_lattice(found: &[[f64; 2]], want: &[[f64; 2]], tol: f64) -> bool {
 
 /// Detection of a made image, with its report for failures.
 fn found(px: &[[u8; 3]]) -> (Detection, Vec<[f64; 2]>) {
-    let d = detect(px, SIDE);
+    let d = detect(px, SIDE, SIDE);
     let basis = d.lattice.as_ref().map(|l| l.basis()).unwrap_or_default();
     (d, basis)
 }
@@ -215,7 +215,7 @@ fn a_stack_bond_and_a_diagonal_tread_are_two_dimensional() {
 fn a_tile_repeated_is_exact_with_its_tile() {
     let fill = Fill::new();
     for (a, b) in [([128, 0], [0, 128]), ([96, 0], [40, 80])] {
-        let d = detect(&tiled(&fill, a, b), SIDE);
+        let d = detect(&tiled(&fill, a, b), SIDE, SIDE);
         assert_eq!(d.class(), Class::Exact, "{a:?} × {b:?}: {:?}", d.repeat);
         let rep = d.repeat.expect("a repeat");
         let got: Vec<[f64; 2]> = rep.basis.iter().map(|v| [v[0] as f64, v[1] as f64]).collect();
@@ -226,7 +226,7 @@ fn a_tile_repeated_is_exact_with_its_tile() {
     }
     // The shared planks material: two blocks as a checkerboard, boards every 42.67 inside.
     let planks = load("test/planks.png");
-    let d = detect(&planks.pixels, planks.side);
+    let d = detect(&planks.pixels, planks.width, planks.height);
     let rep = d.repeat.clone().expect("planks repeat");
     let got: Vec<[f64; 2]> = rep.basis.iter().map(|v| [v[0] as f64, v[1] as f64]).collect();
     assert!(same_lattice(&got, &[[128.0, 128.0], [128.0, -128.0]], 0.01), "planks: {got:?}");
@@ -246,7 +246,7 @@ fn stochastic_exemplars_have_no_structure() {
         "test/gravel_material.png",
     ] {
         let ex = load(name);
-        let d = detect(&ex.pixels, ex.side);
+        let d = detect(&ex.pixels, ex.width, ex.height);
         assert_eq!(d.class(), Class::None, "{name}: {:?} {:?} {:?}", d.repeat, d.lattice, d.ridges);
     }
 }

@@ -44,7 +44,7 @@ fn native_coordinates_look_the_colour_up_and_modes_without_them_say_so() {
     let ex = common::small_exemplar();
     let src = Source::new(ex, an);
     let defaults = Defaults::builtin(&src);
-    let m = ex.side as usize;
+    let m = ex.width as usize;
     for mode in textile_core::modes::all() {
         let p = defaults.request(&src, ParamReader::request([("mode", mode.name)]).unwrap()).unwrap();
         let view = View::native(Rect::new(500, -300, 40, 30));

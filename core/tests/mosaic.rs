@@ -68,7 +68,7 @@ fn zoomed_out_views_of_the_plain_tiling_are_its_exact_box_filter() {
 }
 
 fn tiled(ex: &Exemplar, r: Rect) -> Vec<u8> {
-    let m = ex.side as i64;
+    let m = ex.width as i64;
     let mut v = Vec::new();
     for y in r.y0..r.y1 {
         for x in r.x0..r.x1 {

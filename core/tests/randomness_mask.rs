@@ -11,7 +11,7 @@ use textile_core::{Analysis, Defaults, Exemplar, NoProgress, ParamReader, Pyrami
 /// `ex` with a mask made by `value(x, y)`, built through the public preparation (an image of
 /// the exemplar's size).
 fn masked(ex: &Exemplar, value: impl Fn(u32, u32) -> u8) -> Exemplar {
-    let m = ex.side;
+    let m = ex.width;
     let px: Vec<[u8; 4]> = (0..m * m)
         .map(|i| {
             let v = value(i % m, i / m);

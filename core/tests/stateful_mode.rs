@@ -40,14 +40,14 @@ impl Preparation for Means {
     fn compute(input: &Input, _: &dyn Progress, cancel: &Cancel) -> textile_core::Result<Means> {
         cancel.check()?;
         let ex = input.exemplar;
-        let blocks = ex.side / 8;
+        let blocks = ex.width / 8;
         let mut means = Vec::new();
         for by in 0..blocks {
             for bx in 0..blocks {
                 let mut s = [0u32; 3];
                 for y in 0..8 {
                     for x in 0..8 {
-                        let p = ex.pixels[((by * 8 + y) * ex.side + bx * 8 + x) as usize];
+                        let p = ex.pixels[((by * 8 + y) * ex.width + bx * 8 + x) as usize];
                         (0..3).for_each(|c| s[c] += p[c] as u32);
                     }
                 }

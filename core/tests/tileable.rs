@@ -93,7 +93,7 @@ fn make_toroidal_gives_an_exemplar_that_wraps() {
     let ex = gravel(64);
     assert!(!ex.toroidal && ex.preparation.seam_ratio > 1.5, "{}", ex.preparation.seam_ratio);
     let t = textile_core::tileable::make_toroidal(&ex, 0).unwrap();
-    assert_eq!((t.side, t.toroidal, t.preparation.toroidal_synthesized), (64, true, true));
+    assert_eq!((t.width, t.toroidal, t.preparation.toroidal_synthesized), (64, true, true));
     assert!(t.preparation.seam_ratio <= 1.5, "seam ratio {}", t.preparation.seam_ratio);
     assert_eq!(textile_core::tileable::make_toroidal(&ex, 0).unwrap(), t, "deterministic");
 }

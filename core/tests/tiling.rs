@@ -18,7 +18,7 @@ fn render(query: &[(&str, &str)], zoom_out: u32, rect: Rect) -> RgbWindow {
 #[test]
 fn native_pixels_are_the_exemplar_repeated() {
     let ex = common::small_exemplar();
-    let m = ex.side as i64;
+    let m = ex.width as i64;
     let rect = Rect::new(-3 * m - 5, 7 * m + 11, 150, 90);
     let img = render(&[], 0, rect);
     for j in 0..rect.height() {

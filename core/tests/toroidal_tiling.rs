@@ -16,7 +16,7 @@ fn zero_randomness_on_toroidal_exemplars_is_exact_tiling() {
         let an = toroidal(side, salt);
         assert!(an.header.toroidal, "{name} should be detected as toroidal");
         let p = SynthParams { randomness: Randomness::Uniform(0), ..SynthParams::default() };
-        let m = an.side() as i64;
+        let m = an.width() as i64;
         let r = Rect::new(-m - 5, 3 * m + 1, 2 * m + 9, m + 7);
         let img = render(&an, &p, 0, r).unwrap();
         for j in 0..r.height() {
@@ -31,7 +31,7 @@ fn zero_randomness_on_toroidal_exemplars_is_exact_tiling() {
 #[test]
 fn randomness_changes_the_tiling() {
     let an = toroidal(64, 3);
-    let m = an.side() as i64;
+    let m = an.width() as i64;
     let r = Rect::new(0, 0, 2 * m, 2 * m);
     let tiled =
         render(&an, &SynthParams { randomness: Randomness::Uniform(0), ..SynthParams::default() }, 0, r).unwrap();

@@ -56,7 +56,7 @@ fn extraction_finds_bases_inside_their_elements() {
     for name in ["leaves.png", "smallstone.png"] {
         let ex = fixture(name);
         let (el, _) = elements(&ex).unwrap();
-        let m = ex.side;
+        let m = ex.width;
         assert!((4..=10).contains(&el.bases.len()), "{name}: {} bases", el.bases.len());
         for (i, b) in el.bases.iter().enumerate() {
             // No element touches the border: its crop (bounding box + 2) lies inside.

@@ -122,7 +122,7 @@ fn seeds_give_different_textures() {
 fn zero_randomness_without_correction_is_the_tiled_exemplar_anywhere() {
     let an = common::small();
     let p = SynthParams { randomness: Randomness::Uniform(0), passes: 0, ..SynthParams::default() };
-    let m = an.side() as i64;
+    let m = an.width() as i64;
     for (x0, y0) in [(0, 0), (-77, -5), (1 << 40, -(1 << 39) - 3)] {
         let w = synthesize(an, &p, an.levels(), Rect::new(x0, y0, 70, 70)).unwrap();
         for j in 0..70 {

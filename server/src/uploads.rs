@@ -330,10 +330,10 @@ pub fn with_stored(cfg: &Config, log: &dyn Fn(String)) -> Config {
     all
 }
 
-/// Working memory an analysis of an exemplar of side `side` holds at its peak (measured:
+/// Working memory an analysis of an exemplar of `texels` texels holds at its peak (measured:
 /// 8 MiB for 128², 37 MiB for 256²; about 600 bytes a texel).
-pub fn analysis_bytes(side: u32) -> u64 {
-    (16 << 20) + 600 * side as u64 * side as u64
+pub fn analysis_bytes(texels: u64) -> u64 {
+    (16 << 20) + 600 * texels
 }
 
 /// Analyse an uploaded texture in the background on the analysis pool, at most
@@ -343,7 +343,7 @@ pub fn analysis_bytes(side: u32) -> u64 {
 pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
     tokio::spawn(async move {
         let Ok(_permit) = st.analyses.clone().acquire_owned().await else { return };
-        let Some(_memory) = st.reserve_patiently(analysis_bytes(tex.exemplar.side)).await else { return };
+        let Some(_memory) = st.reserve_patiently(analysis_bytes(tex.exemplar.pixels.len() as u64)).await else { return };
         if tex.removed.is_set() || st.stopping.is_set() {
             return;
         }

@@ -15,8 +15,10 @@ use crate::lattice::{LevelLattice, Repeat};
 
 /// Geometry of one level's candidate problem.
 pub struct CandidateRules {
-    /// Exemplar side.
-    pub m: usize,
+    /// Exemplar width.
+    pub w: usize,
+    /// Exemplar height.
+    pub h: usize,
     /// Whether the exemplar wraps (toroidal distances and shifts).
     pub toroidal: bool,
     /// Minimum distance between the two candidates.
@@ -31,12 +33,13 @@ pub struct CandidateRules {
 }
 
 impl CandidateRules {
-    /// Rules for an `m × m` exemplar (separation `⌈0.05·m⌉`).
-    pub fn new(m: usize, toroidal: bool) -> Self {
+    /// Rules for a `w × h` exemplar (separation `⌈0.05·max(w, h)⌉`).
+    pub fn new((w, h): (usize, usize), toroidal: bool) -> Self {
         CandidateRules {
-            m,
+            w,
+            h,
             toroidal,
-            separation: (m * 5).div_ceil(100),
+            separation: (w.max(h) * 5).div_ceil(100),
             phase: LevelLattice::FREE,
             copies: None,
             leaves_per_texel: LEAVES_PER_TEXEL,
@@ -65,7 +68,7 @@ impl CandidateRules {
     /// Whether `v` may be the second candidate of `u`: far enough from it, on its lattice
     /// phase, not its copy.
     fn allowed(&self, v: usize, u: usize) -> bool {
-        let d = ((v % self.m) as i64 - (u % self.m) as i64, (v / self.m) as i64 - (u / self.m) as i64);
+        let d = ((v % self.w) as i64 - (u % self.w) as i64, (v / self.w) as i64 - (u / self.w) as i64);
         self.phase.same_phase(d) && !self.is_copy(d) && self.far_enough(v, u)
     }
 
@@ -76,8 +79,8 @@ impl CandidateRules {
         if r.is_copy(d) {
             return true;
         }
-        let m = self.m as i64;
-        let wrap = |v: i64| {
+        let wrap = |v: i64, m: usize| {
+            let m = m as i64;
             if v > m / 2 {
                 v - m
             } else if v < -m / 2 {
@@ -86,28 +89,28 @@ impl CandidateRules {
                 v
             }
         };
-        self.toroidal && r.is_copy((wrap(d.0), wrap(d.1)))
+        self.toroidal && r.is_copy((wrap(d.0, self.w), wrap(d.1, self.h)))
     }
 
     /// Texel `c` moved by `(dx, dy)` (wrapping when toroidal), unless that leaves the exemplar.
     fn shifted(&self, c: u32, dx: i64, dy: i64) -> Option<u32> {
-        let m = self.m as i64;
-        let (mut x, mut y) = ((c as i64) % m + dx, (c as i64) / m + dy);
+        let (w, h) = (self.w as i64, self.h as i64);
+        let (mut x, mut y) = ((c as i64) % w + dx, (c as i64) / w + dy);
         if self.toroidal {
-            (x, y) = (x.rem_euclid(m), y.rem_euclid(m));
-        } else if x < 0 || y < 0 || x >= m || y >= m {
+            (x, y) = (x.rem_euclid(w), y.rem_euclid(h));
+        } else if x < 0 || y < 0 || x >= w || y >= h {
             return None;
         }
-        Some((y * m + x) as u32)
+        Some((y * w + x) as u32)
     }
 
     fn far_enough(&self, a: usize, b: usize) -> bool {
-        let m = self.m as i64;
-        let (ax, ay, bx, by) = ((a % self.m) as i64, (a / self.m) as i64, (b % self.m) as i64, (b / self.m) as i64);
+        let (w, h) = (self.w as i64, self.h as i64);
+        let (ax, ay, bx, by) = ((a % self.w) as i64, (a / self.w) as i64, (b % self.w) as i64, (b / self.w) as i64);
         let (mut dx, mut dy) = ((ax - bx).abs(), (ay - by).abs());
         if self.toroidal {
-            dx = dx.min(m - dx);
-            dy = dy.min(m - dy);
+            dx = dx.min(w - dx);
+            dy = dy.min(h - dy);
         }
         let s = self.separation as i64;
         dx * dx + dy * dy >= s * s
@@ -183,7 +186,7 @@ pub fn candidate_sets(
     plan: SearchPlan,
     between: &dyn Fn(usize) -> Result<()>,
 ) -> Result<Vec<[u32; 2]>> {
-    let m = rules.m;
+    let (w, h) = (rules.w, rules.h);
     let tree = KdTree::new((0..feats.len()).map(|i| (feats[i], i as u32)).collect());
     // The work so far, checked against the budget between bands.
     let leaves = AtomicU64::new(0);
@@ -191,7 +194,7 @@ pub fn candidate_sets(
     let between = |done: usize| {
         let opened = leaves.load(Ordering::Relaxed);
         if opened > budget {
-            return Err(CoreError::AnalysisWork { side: m as u32, leaves: opened, budget });
+            return Err(CoreError::AnalysisWork { side: w.max(h) as u32, leaves: opened, budget });
         }
         between(done)
     };
@@ -201,26 +204,26 @@ pub fn candidate_sets(
         found
     };
     let search = |u: usize| [u as u32, nearest(u, 1).first().map_or(u as u32, |b| b.1)];
-    let step = plan.step.clamp(1, m.max(1));
+    let step = plan.step.clamp(1, w.min(h).max(1));
     if step == 1 {
         between(0)?;
-        let sets = in_bands(m, m, BANDS, &|b| between(BANDS + b), &|_: &mut (), u| search(u))?;
+        let sets = in_bands(h, w, BANDS, &|b| between(BANDS + b), &|_: &mut (), u| search(u))?;
         between(2 * BANDS)?;
         return Ok(sets);
     }
     // Per grid texel: its nearest matches far enough from it (C_2 first).
-    let gm = m.div_ceil(step);
-    let grid: Vec<Vec<u32>> = in_bands(gm, gm, BANDS, &between, &|_: &mut (), g| {
-        let u = (g / gm) * step * m + (g % gm) * step;
+    let (gw, gh) = (w.div_ceil(step), h.div_ceil(step));
+    let grid: Vec<Vec<u32>> = in_bands(gh, gw, BANDS, &between, &|_: &mut (), g| {
+        let u = (g / gw) * step * w + (g % gw) * step;
         nearest(u, GRID_MATCHES).into_iter().map(|b| b.1).collect()
     })?;
-    let sets = in_bands(m, m, BANDS, &|b| between(BANDS + b), &|props: &mut Vec<u32>, u| {
-        let (x, y) = (u % m, u / m);
+    let sets = in_bands(h, w, BANDS, &|b| between(BANDS + b), &|props: &mut Vec<u32>, u| {
+        let (x, y) = (u % w, u / w);
         if x % step == 0 && y % step == 0 {
-            let g = &grid[(y / step) * gm + x / step];
+            let g = &grid[(y / step) * gw + x / step];
             return [u as u32, g.first().copied().unwrap_or(u as u32)];
         }
-        proposals(rules, &grid, gm, step, x, y, props);
+        proposals(rules, &grid, (gw, gh), step, x, y, props);
         let q = &feats[u];
         let best = props
             .iter()
@@ -261,7 +264,7 @@ fn in_bands<T: Send, S: Default>(
 fn proposals(
     rules: &CandidateRules,
     grid: &[Vec<u32>],
-    gm: usize,
+    (gw, gh): (usize, usize),
     step: usize,
     x: usize,
     y: usize,
@@ -269,17 +272,17 @@ fn proposals(
 ) {
     out.clear();
     let (gx0, gy0) = ((x / step) as i64, (y / step) as i64);
-    let gmi = gm as i64;
+    let (gwi, ghi) = (gw as i64, gh as i64);
     for gy in gy0..=gy0 + 1 {
         for gx in gx0..=gx0 + 1 {
             let (tx, ty) = (gx * step as i64, gy * step as i64);
-            let (gx, gy) = if rules.toroidal { (gx.rem_euclid(gmi), gy.rem_euclid(gmi)) } else { (gx, gy) };
-            if gx < 0 || gy < 0 || gx >= gmi || gy >= gmi {
+            let (gx, gy) = if rules.toroidal { (gx.rem_euclid(gwi), gy.rem_euclid(ghi)) } else { (gx, gy) };
+            if gx < 0 || gy < 0 || gx >= gwi || gy >= ghi {
                 continue;
             }
             let (gx, gy) = (gx as usize, gy as usize);
             let (dx, dy) = (x as i64 - tx, y as i64 - ty);
-            for &c in &grid[gy * gm + gx] {
+            for &c in &grid[gy * gw + gx] {
                 for (ex, ey) in AROUND {
                     if let Some(v) = rules.shifted(c, dx + ex, dy + ey) {
                         out.push(v);
@@ -316,9 +319,9 @@ mod tests {
     #[test]
     fn a_search_over_its_work_budget_stops_with_a_clear_error() {
         let feats = features(64 * 64);
-        let rules = CandidateRules::new(64, true);
+        let rules = CandidateRules::new((64, 64), true);
         assert!(candidate_sets(&feats, &rules, SearchPlan::EXACT, &|_| Ok(())).is_ok());
-        let tight = CandidateRules { leaves_per_texel: 1, ..CandidateRules::new(64, true) };
+        let tight = CandidateRules { leaves_per_texel: 1, ..CandidateRules::new((64, 64), true) };
         match candidate_sets(&feats, &tight, SearchPlan::EXACT, &|_| Ok(())) {
             Err(CoreError::AnalysisWork { side: 64, leaves, budget: 4096 }) => assert!(leaves > 4096),
             other => panic!("expected the work budget's error, got {:?}", other.map(|v| v.len())),
@@ -328,7 +331,7 @@ mod tests {
     #[test]
     fn the_search_stops_between_bands_when_asked_and_reports_each() {
         let feats = features(32 * 32);
-        let rules = CandidateRules::new(32, true);
+        let rules = CandidateRules::new((32, 32), true);
         let seen = std::sync::Mutex::new(Vec::new());
         let stop_at_3 = |done: usize| {
             seen.lock().unwrap().push(done);

@@ -21,10 +21,12 @@ pub const TAPS5: usize = 25;
 
 /// The 8-bit stack colours of one level, for neighbourhood gathering.
 pub struct LevelColours<'a> {
-    /// Row-major `m × m` colours.
+    /// Row-major `width × height` colours.
     pub px: &'a [[u8; 3]],
-    /// Exemplar side.
-    pub m: i64,
+    /// Exemplar width.
+    pub width: i64,
+    /// Exemplar height.
+    pub height: i64,
     /// Wrap (true) or mirror (false) addressing.
     pub toroidal: bool,
     /// Sampling stride `h_l`.
@@ -36,10 +38,10 @@ impl LevelColours<'_> {
     pub fn neighbourhood(&self, x: i64, y: i64, r: i64, out: &mut Vec<i32>) {
         out.clear();
         for dy in -r..=r {
-            let sy = addr(y + dy * self.h, self.m, self.toroidal);
+            let sy = addr(y + dy * self.h, self.height, self.toroidal);
             for dx in -r..=r {
-                let sx = addr(x + dx * self.h, self.m, self.toroidal);
-                let p = self.px[sy * self.m as usize + sx];
+                let sx = addr(x + dx * self.h, self.width, self.toroidal);
+                let p = self.px[sy * self.width as usize + sx];
                 out.extend(p.iter().map(|&v| v as i32));
             }
         }
@@ -62,20 +64,20 @@ pub struct InnerTaps {
 }
 
 impl InnerTaps {
-    /// The taps inside an `m × m` exemplar of the 5×5 neighbourhood at stride `h` around
-    /// `(x, y)`, or `None` when all are (the usual case: `2h ≤ x, y < m − 2h`).
+    /// The taps inside a `w × ht` exemplar of the 5×5 neighbourhood at stride `h` around
+    /// `(x, y)`, or `None` when all are (the usual case: `2h ≤ x < w − 2h`, and so for `y`).
     #[inline]
-    pub fn at(x: i64, y: i64, h: i64, m: i64) -> Option<InnerTaps> {
-        let t = Self::around(x as u32, y as u32, h as u32, m as u32);
+    pub fn at(x: i64, y: i64, h: i64, (w, ht): (i64, i64)) -> Option<InnerTaps> {
+        let t = Self::around(x as u32, y as u32, h as u32, (w as u32, ht as u32));
         (t != InnerTaps { r0: 0, r1: 5, c0: 0, c1: 5 }).then_some(t)
     }
 
     /// [`InnerTaps::at`] without the test for the usual case (branch-free).
     #[inline(always)]
-    pub fn around(x: u32, y: u32, h: u32, m: u32) -> InnerTaps {
+    pub fn around(x: u32, y: u32, h: u32, (w, ht): (u32, u32)) -> InnerTaps {
         let lo = |v: u32| (v < 2 * h) as u8 + (v < h) as u8;
-        let hi = |v: u32| 5 - (v + 2 * h >= m) as u8 - (v + h >= m) as u8;
-        InnerTaps { r0: lo(y), r1: hi(y), c0: lo(x), c1: hi(x) }
+        let hi = |v: u32, m: u32| 5 - (v + 2 * h >= m) as u8 - (v + h >= m) as u8;
+        InnerTaps { r0: lo(y), r1: hi(y, ht), c0: lo(x), c1: hi(x, w) }
     }
 
     /// Number of taps inside.
@@ -97,9 +99,9 @@ impl InnerTaps {
 /// Each vector has its largest-magnitude component positive.
 pub fn principal_directions(cols: &LevelColours, r: i64, k: usize) -> Vec<Vec<f64>> {
     let dim = ((2 * r + 1) * (2 * r + 1) * 3) as usize;
-    let step = (cols.m / 64).max(1);
+    let step = (cols.width.max(cols.height) / 64).max(1);
     // Integer sums per sampled row, added up: exact, so the same whatever the thread count.
-    let rows: Vec<i64> = (0..cols.m).step_by(step as usize).collect();
+    let rows: Vec<i64> = (0..cols.height).step_by(step as usize).collect();
     let (sum, cross, n) = rows
         .par_iter()
         .map(|&y| {
@@ -107,7 +109,7 @@ pub fn principal_directions(cols: &LevelColours, r: i64, k: usize) -> Vec<Vec<f6
             let mut cross = vec![0i64; dim * dim];
             let mut n = 0i64;
             let mut v = Vec::with_capacity(dim);
-            for x in (0..cols.m).step_by(step as usize) {
+            for x in (0..cols.width).step_by(step as usize) {
                 cols.neighbourhood(x, y, r, &mut v);
                 for i in 0..dim {
                     let vi = v[i] as i64;

@@ -169,19 +169,30 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
     }
     let mut r = Reader { b: body, pos: 20 };
     let json_len = r.u32()? as usize;
-    let header: AnalysisHeader =
+    let mut header: AnalysisHeader =
         serde_json::from_slice(r.take(json_len)?).map_err(|e| AnalysisFileProblem::Corrupt(format!("header: {e}")))?;
+    // Written when exemplars were square: the height is the width.
+    if header.height == 0 {
+        header.height = header.width;
+    }
+    if header.preparation.height == 0 {
+        header.preparation.height = header.preparation.width;
+    }
     if header.algorithm_version != crate::analysis::ALGORITHM_VERSION {
         return Err(AnalysisFileProblem::UnsupportedVersion {
             found: header.algorithm_version,
             expected: crate::analysis::ALGORITHM_VERSION,
         });
     }
-    let m = header.side as usize;
-    if !(32..=512).contains(&m) || !m.is_power_of_two() || header.levels != header.side.trailing_zeros() {
-        return Err(AnalysisFileProblem::Corrupt(format!("invalid exemplar side {m}")));
+    let (w, h) = (header.width as usize, header.height as usize);
+    let sides = crate::exemplar::MIN_INPUT_SIDE as usize..=crate::exemplar::MAX_SIDE as usize;
+    if !sides.contains(&w)
+        || !sides.contains(&h)
+        || header.levels != crate::exemplar::levels_for(header.width, header.height)
+    {
+        return Err(AnalysisFileProblem::Corrupt(format!("invalid exemplar size {w}x{h}")));
     }
-    let n = m * m;
+    let n = w * h;
     let exemplar: Vec<[u8; 3]> = r.take(n * 3)?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     let mut stack = Vec::new();
     for _ in 0..=header.levels {
@@ -200,7 +211,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
             let mut pair = [Candidate::default(); 2];
             for c in pair.iter_mut() {
                 c.coord = r.u32()?;
-                if (c.coord & 0xFFFF) as usize >= m || (c.coord >> 16) as usize >= m {
+                if (c.coord & 0xFFFF) as usize >= w || (c.coord >> 16) as usize >= h {
                     return Err(AnalysisFileProblem::Corrupt("candidate outside the exemplar".into()));
                 }
                 for f in c.feat.iter_mut() {

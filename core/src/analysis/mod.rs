@@ -112,7 +112,7 @@ impl IndexChoice {
         }
     }
 
-    /// The search used for an exemplar of side `side`.
+    /// The search used for an exemplar whose longer side is `side`.
     pub fn resolve(self, side: u32) -> SearchIndex {
         match self {
             IndexChoice::Exact => SearchIndex::Exact,
@@ -162,9 +162,13 @@ pub struct AnalysisHeader {
     pub id: String,
     /// Algorithm version the analysis was made for.
     pub algorithm_version: u32,
-    /// Exemplar side `m`.
-    pub side: u32,
-    /// `L = log2 m`: the finest level index.
+    /// Exemplar width (analyses written when exemplars were square call it `side`).
+    #[serde(alias = "side")]
+    pub width: u32,
+    /// Exemplar height (0 in analyses written when exemplars were square: the width).
+    #[serde(default)]
+    pub height: u32,
+    /// `L = ⌈log2 max(width, height)⌉`: the finest level index.
     pub levels: u32,
     /// Wrap-around synthesis.
     pub toroidal: bool,
@@ -238,14 +242,14 @@ impl Analysis {
         progress: &dyn Progress,
         cancel: &Cancel,
     ) -> Result<Analysis> {
-        let search = index.resolve(ex.side);
-        let m = ex.side as usize;
-        let levels = ex.side.trailing_zeros();
+        let search = index.resolve(ex.width.max(ex.height));
+        let dims = ex.dims();
+        let levels = ex.levels();
         // Steps: the stack, then every corrected level's bands of candidate search.
         let per_level = 2 * BANDS as u32;
         let total = 1 + (levels + 1 - FIRST_CORRECTED_LEVEL) * per_level;
         progress.step(0, total, "gaussian stack");
-        let stack = build_stack(&ex.pixels, m, ex.toroidal);
+        let stack = build_stack(&ex.pixels, dims, ex.toroidal);
         let stack8 = derive_stack8(&stack);
         let mut corrected = Vec::new();
         for l in FIRST_CORRECTED_LEVEL..=levels {
@@ -256,15 +260,16 @@ impl Analysis {
                 Ok(())
             };
             let h = 1 << (levels - l);
-            let phase = ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, m as u32));
-            let rules = CandidateRules::new(m, ex.toroidal).with_phase(phase).without_copies(ex.repeat.as_ref());
+            let phase = ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, ex.width.max(ex.height)));
+            let rules = CandidateRules::new(dims, ex.toroidal).with_phase(phase).without_copies(ex.repeat.as_ref());
             corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search, &between)?);
         }
         progress.step(total, total, "done");
         let header = AnalysisHeader {
             id: analysis_id(ex, search),
             algorithm_version: ALGORITHM_VERSION,
-            side: ex.side,
+            width: ex.width,
+            height: ex.height,
             levels,
             toroidal: ex.toroidal,
             preparation: ex.preparation.clone(),
@@ -289,15 +294,16 @@ impl Analysis {
     /// The analysis id an exemplar would get with the search `index` chooses: compare with a
     /// stored analysis's `header.id` to know whether it is still current.
     pub fn id_for(ex: &Exemplar, index: IndexChoice) -> String {
-        analysis_id(ex, index.resolve(ex.side))
+        analysis_id(ex, index.resolve(ex.width.max(ex.height)))
     }
 
-    /// The exemplar as the analysis holds it (pixels, side, flags, lattice; not the
+    /// The exemplar as the analysis holds it (pixels, size, flags, lattice; not the
     /// high-resolution image or randomness mask, which stay with the texture).
     pub fn exemplar(&self) -> Exemplar {
         let h = &self.header;
         Exemplar {
-            side: h.side,
+            width: h.width,
+            height: h.height,
             pixels: self.exemplar.clone(),
             toroidal: h.toroidal,
             preparation: h.preparation.clone(),
@@ -311,9 +317,19 @@ impl Analysis {
         }
     }
 
-    /// Exemplar side `m`.
-    pub fn side(&self) -> u32 {
-        self.header.side
+    /// Exemplar width.
+    pub fn width(&self) -> u32 {
+        self.header.width
+    }
+
+    /// Exemplar height.
+    pub fn height(&self) -> u32 {
+        self.header.height
+    }
+
+    /// Exemplar size `(width, height)` for indexing.
+    pub fn dims(&self) -> (usize, usize) {
+        (self.header.width as usize, self.header.height as usize)
     }
 
     /// Finest level index `L`.
@@ -335,7 +351,7 @@ impl Analysis {
     /// (`0`: the exemplar itself; `levels`: the mean colour everywhere), derived on first use
     /// and kept in `cache` within its bytes.
     pub fn box_stack(&self, cache: &Pyramid) -> Stack {
-        cache.derived(&format!("boxes|{}", self.header.id), || box_stack(&self.exemplar, self.header.side as usize))
+        cache.derived(&format!("boxes|{}", self.header.id), || box_stack(&self.exemplar, self.dims()))
     }
 
     /// How much of the exemplar's variation is fine detail: its energy above stack level
@@ -430,18 +446,18 @@ fn analyse_level(
     between: &dyn Fn(usize) -> Result<()>,
 ) -> Result<CorrectionLevel> {
     use rayon::prelude::*;
-    let (m, toroidal) = (rules.m, rules.toroidal);
-    let cols = LevelColours { px, m: m as i64, toroidal, h: h as i64 };
+    let (w, ht, toroidal) = (rules.w, rules.h, rules.toroidal);
+    let cols = LevelColours { px, width: w as i64, height: ht as i64, toroidal, h: h as i64 };
     let dirs5 = principal_directions(&cols, 2, RUNTIME_DIMS);
     let proj = quantise_projection(&dirs5);
     let search_proj = SearchProjection::new(&principal_directions(&cols, 3, SEARCH_DIMS));
-    let (runtime, search): (Vec<[i16; RUNTIME_DIMS]>, Vec<[f64; SEARCH_DIMS]>) = (0..m * m)
+    let (runtime, search): (Vec<[i16; RUNTIME_DIMS]>, Vec<[f64; SEARCH_DIMS]>) = (0..w * ht)
         .into_par_iter()
         .map_init(Vec::new, |buf, i| {
-            let (x, y) = ((i % m) as i64, (i / m) as i64);
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
             cols.neighbourhood(x, y, 2, buf);
             // Near a non-toroidal edge, the feature of the real texels only (outside: zero).
-            if let Some(inner) = (!toroidal).then(|| InnerTaps::at(x, y, h as i64, m as i64)).flatten() {
+            if let Some(inner) = (!toroidal).then(|| InnerTaps::at(x, y, h as i64, (w as i64, ht as i64))).flatten() {
                 for (t, rgb) in buf.chunks_mut(3).enumerate() {
                     if !inner.contains(t) {
                         rgb.fill(0);
@@ -460,7 +476,7 @@ fn analyse_level(
     let sets = candidate_sets(&search, rules, plan, between)?;
     let cand = |i: u32| {
         let i = i as usize;
-        Candidate { coord: (i % m) as u32 | ((i / m) as u32) << 16, feat: runtime[i] }
+        Candidate { coord: (i % w) as u32 | ((i / w) as u32) << 16, feat: runtime[i] }
     };
     let cands = sets.iter().map(|&[a, b]| [cand(a), cand(b)]).collect();
     Ok(CorrectionLevel { proj, cands })

@@ -48,7 +48,8 @@ impl Preparation for Analysis {
         let mut m = Map::new();
         m.insert("id".into(), json!(h.id));
         m.insert("algorithm_version".into(), json!(h.algorithm_version));
-        m.insert("side".into(), json!(h.side));
+        m.insert("width".into(), json!(h.width));
+        m.insert("height".into(), json!(h.height));
         m.insert("levels".into(), json!(h.levels));
         m.insert("toroidal".into(), json!(h.toroidal));
         m.insert("search".into(), json!(h.index.name()));

@@ -35,13 +35,14 @@ impl LatticeChoice {
         matches!(self, LatticeChoice::Cells(..))
     }
 
-    /// The lattice this setting names explicitly on an exemplar of side `side` (cells,
-    /// waves or vectors, checked); `None` for `auto`, whose lattice is detected from the
-    /// pixels ([`super::detect`]), and for `none`.
-    pub fn explicit(&self, side: u32) -> Result<Option<Lattice>> {
+    /// The lattice this setting names explicitly on a `w × h` exemplar (cells, waves or
+    /// vectors, checked); `None` for `auto`, whose lattice is detected from the pixels
+    /// ([`super::detect`]), and for `none`.
+    pub fn explicit(&self, w: u32, h: u32) -> Result<Option<Lattice>> {
+        let side = w.max(h);
         Ok(match self {
             LatticeChoice::Auto | LatticeChoice::None => None,
-            LatticeChoice::Cells(nx, ny) => Some(Lattice::cells(*nx, *ny, side)?),
+            LatticeChoice::Cells(nx, ny) => Some(Lattice::cells(*nx, *ny, w, h)?),
             LatticeChoice::Waves(w) => Some(Lattice::given(w.iter().map(|&(p, a)| Wave::new(p, a)).collect(), side)?),
             LatticeChoice::Vectors(v) => Some(Lattice::given(waves_of(v, side)?, side)?),
         })
@@ -233,7 +234,7 @@ mod tests {
         assert_eq!("[[28.4, 30.65], [0, 61.3]]".parse(), Ok(LatticeChoice::Vectors(vec![[28.4, 30.65], [0.0, 61.3]])));
         assert_eq!(read_json("[[19.3, 0]]"), LatticeChoice::Vectors(vec![[19.3, 0.0]]));
         // A running bond's basis comes back (as [x, y] translations) from its waves.
-        let lat = LatticeChoice::Vectors(vec![[28.4, 30.65], [0.0, 61.3]]).explicit(256).unwrap().unwrap();
+        let lat = LatticeChoice::Vectors(vec![[28.4, 30.65], [0.0, 61.3]]).explicit(256, 256).unwrap().unwrap();
         let want = [[30.65, 28.4], [61.3, 0.0]];
         for t in lat.basis() {
             let k: Vec<f64> = lat.waves.iter().map(|w| w.vector()).map(|k| k[0] * t[0] + k[1] * t[1]).collect();
@@ -246,7 +247,7 @@ mod tests {
             }
         }
         // Stripes: one vector, across them.
-        let one = LatticeChoice::Vectors(vec![[0.0, 19.3]]).explicit(128).unwrap().unwrap();
+        let one = LatticeChoice::Vectors(vec![[0.0, 19.3]]).explicit(128, 128).unwrap().unwrap();
         assert!((one.waves[0].period() - 19.3).abs() < 1e-3 && one.waves[0].angle_deg().abs() < 1e-3);
         // Zero, too long, collinear: refused, naming the vectors.
         for (v, says) in [
@@ -255,7 +256,7 @@ mod tests {
             (vec![[10.0, 10.0], [20.0, 21.0]], "collinear"),
             (vec![[1.0, 1.0], [2.0, 2.0], [3.0, 0.0]], "3 basis vectors"),
         ] {
-            let e = LatticeChoice::Vectors(v).explicit(256).unwrap_err().to_string();
+            let e = LatticeChoice::Vectors(v).explicit(256, 256).unwrap_err().to_string();
             assert!(e.contains(says) && e.contains("lattice"), "{e}");
         }
         assert!("[[1, x]]".parse::<LatticeChoice>().unwrap_err().contains("expected"));

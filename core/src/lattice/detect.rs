@@ -193,9 +193,17 @@ pub fn describe(summary: &serde_json::Value) -> String {
     }
 }
 
-/// Detect the structure of the `side × side` exemplar `pixels` (see the module comment): its
-/// exact repeat first, then the lattice, inside one tile for a tiling.
-pub fn detect(pixels: &[[u8; 3]], side: u32) -> Detection {
+/// Detect the structure of the `w × h` exemplar `pixels` (see the module comment): its exact
+/// repeat first, then the lattice, inside one tile for a tiling. A non-square exemplar is
+/// looked at through its largest centred square: a lattice or a repeat is the same
+/// everywhere in the image, and the square keeps the autocorrelation's lags isotropic.
+pub fn detect(pixels: &[[u8; 3]], w: u32, h: u32) -> Detection {
+    let (square, side) = crate::exemplar::centred_square(pixels, (w as usize, h as usize));
+    detect_square(&square, side as u32)
+}
+
+/// [`detect`] on a `side × side` image.
+fn detect_square(pixels: &[[u8; 3]], side: u32) -> Detection {
     let mut m = side as usize;
     let mut luma: Vec<f64> =
         pixels.iter().map(|p| 0.299 * p[0] as f64 + 0.587 * p[1] as f64 + 0.114 * p[2] as f64).collect();
@@ -274,7 +282,7 @@ fn halve(v: &[f64], m: usize) -> Vec<f64> {
 struct Autocorrelation {
     /// Exemplar side.
     m: usize,
-    /// Padded side (`2m`).
+    /// Padded side (`2m`, up to a power of two).
     n: usize,
     /// Values at integer lags, row-major, negative lags wrapped.
     a: Vec<f64>,
@@ -282,7 +290,7 @@ struct Autocorrelation {
 
 impl Autocorrelation {
     fn new(luma: &[f64], m: usize) -> Autocorrelation {
-        let n = 2 * m;
+        let n = (2 * m).next_power_of_two();
         let mean = luma.iter().sum::<f64>() / luma.len().max(1) as f64;
         let hann: Vec<f64> =
             (0..m)
@@ -586,7 +594,7 @@ mod tests {
     #[test]
     fn stripes_with_a_fractional_period() {
         let px = image(256, |x, y| if (x / 23.4).fract() < 0.15 { 40.0 } else { 170.0 + noise(x, y) });
-        let d = detect(&px, 256);
+        let d = detect(&px, 256, 256);
         let lat = d.lattice.clone().expect("stripes detected");
         assert_eq!(lat.waves.len(), 1, "{d:?}");
         let w = lat.waves[0];
@@ -598,7 +606,7 @@ mod tests {
     fn oblique_stripes() {
         let (c, s) = 33f64.to_radians().sin_cos();
         let px = image(256, |x, y| if ((x * s + y * c) / 19.3).fract() < 0.2 { 40.0 } else { 170.0 + noise(x, y) });
-        let d = detect(&px, 256);
+        let d = detect(&px, 256, 256);
         let w = d.lattice.clone().expect("stripes detected").waves[0];
         assert!((w.period() - 19.3).abs() < 0.1 && angle_gap(w.angle_deg(), 33.0) < 0.3, "{d:?}");
     }
@@ -623,7 +631,7 @@ mod tests {
                 }
             },
         );
-        let d = detect(&px, 256);
+        let d = detect(&px, 256, 256);
         let lat = d.lattice.clone().expect("tiles detected");
         assert_eq!(lat.waves.len(), 2, "{d:?}");
         for a in [0.0, 90.0] {
@@ -645,7 +653,7 @@ mod tests {
                 165.0 + noise(x, y)
             }
         });
-        let d = detect(&px, 256);
+        let d = detect(&px, 256, 256);
         let lat = d.lattice.clone().expect("bond detected");
         let (period, angle) = wave_near(&lat, 90.0);
         assert!((period - 16.0).abs() < 0.5 && angle_gap(angle, 90.0) < 1.0, "{d:?}");
@@ -663,6 +671,6 @@ mod tests {
     #[test]
     fn noise_has_no_lattice() {
         let px = image(128, |x, y| 128.0 + 3.0 * noise(x, y));
-        assert_eq!(detect(&px, 128).lattice, None);
+        assert_eq!(detect(&px, 128, 128).lattice, None);
     }
 }

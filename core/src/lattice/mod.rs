@@ -86,32 +86,32 @@ pub struct Lattice {
 }
 
 impl Lattice {
-    /// A lattice of `nx × ny` cells over an exemplar of side `side`: each count must divide
-    /// the side (a power of two), so that cells are whole texels.
-    pub fn cells(nx: u32, ny: u32, side: u32) -> Result<Lattice> {
-        for n in [nx, ny] {
+    /// A lattice of `nx × ny` cells over a `w × h` exemplar: `nx` must divide the width and
+    /// `ny` the height, so that cells are whole texels.
+    pub fn cells(nx: u32, ny: u32, w: u32, h: u32) -> Result<Lattice> {
+        for (n, side) in [(nx, w), (ny, h)] {
             if n == 0 || n > side || !side.is_multiple_of(n) {
                 return Err(CoreError::Param {
                     name: "lattice",
                     message: format!(
-                        "{nx}x{ny} does not divide the {side}x{side} exemplar into whole cells: \
-                         each count must be a power of two from 1 to {side}"
+                        "{nx}x{ny} does not divide the {w}x{h} exemplar into whole cells: \
+                         each count must divide its side ({w} across, {h} down)"
                     ),
                 });
             }
         }
         let mut waves = Vec::new();
         if nx > 1 {
-            waves.push(Wave::new(side as f64 / nx as f64, 0.0));
+            waves.push(Wave::new(w as f64 / nx as f64, 0.0));
         }
         if ny > 1 {
-            waves.push(Wave::new(side as f64 / ny as f64, 90.0));
+            waves.push(Wave::new(h as f64 / ny as f64, 90.0));
         }
-        Lattice::given(waves, side)
+        Lattice::given(waves, w.max(h))
     }
 
     /// A lattice of the given waves (`(period, angle°)`): one or two, periods from 2 texels to
-    /// the side, two waves at least 20° apart.
+    /// `side` (the exemplar's longer side), two waves at least 20° apart.
     pub fn given(waves: Vec<Wave>, side: u32) -> Result<Lattice> {
         let bad = |message: String| Err(CoreError::Param { name: "lattice", message });
         if waves.is_empty() || waves.len() > 2 {
@@ -167,8 +167,8 @@ impl Lattice {
         LevelLattice::new(&active, self.waves.iter().map(|w| w.period()).fold(0.0, f64::max))
     }
 
-    /// The lattice's constants for the synthesis level of stride `h`, on an exemplar of side
-    /// `side`. Stripes hold at every level: their free axis is where the cells vary, and held
+    /// The lattice's constants for the synthesis level of stride `h`, on an exemplar whose
+    /// longer side is `side`. Stripes hold at every level: their free axis is where the cells vary, and held
     /// only from half a period up (LH05's rule) plank gaps and brick columns wander at the finer
     /// levels — texq `lattice` 0.35 planks, 0.56 cobblestones, 0.54 brick, against 1.02, 0.92,
     /// 0.78 held at every level, nn_err no worse (bench/README.md). A grid's only freedom is
@@ -349,21 +349,21 @@ mod tests {
 
     #[test]
     fn counts_must_divide_the_side() {
-        assert!(Lattice::cells(2, 4, 128).is_ok());
-        assert!(Lattice::cells(1, 64, 128).is_ok());
+        assert!(Lattice::cells(2, 4, 128, 128).is_ok());
+        assert!(Lattice::cells(1, 64, 128, 128).is_ok());
         for (nx, ny) in [(3, 4), (0, 2), (2, 256), (2, 6)] {
-            let e = Lattice::cells(nx, ny, 128).unwrap_err().to_string();
+            let e = Lattice::cells(nx, ny, 128, 128).unwrap_err().to_string();
             assert!(e.contains("lattice") && e.contains(&format!("{nx}x{ny}")), "{e}");
         }
     }
 
     #[test]
     fn cells_are_two_waves() {
-        let l = Lattice::cells(2, 4, 128).unwrap();
+        let l = Lattice::cells(2, 4, 128, 128).unwrap();
         let b = l.basis();
         assert!(b[0][0].abs() < 1e-9 && (b[0][1] - 32.0).abs() < 1e-9 && (b[1][0] - 64.0).abs() < 1e-9, "{b:?}");
         assert_eq!(l.whole().count, 2);
-        assert_eq!(Lattice::cells(1, 4, 128).unwrap().whole().count, 1);
+        assert_eq!(Lattice::cells(1, 4, 128, 128).unwrap().whole().count, 1);
         // A grid wave repeating n times holds from period / n up (n from 2 to 8): the 64-texel
         // one (n = 2) from stride 32, the 32-texel one (n = 4) from stride 8, none below.
         assert_eq!([32, 16, 8, 4].map(|h| l.level(h, 128).count), [2, 1, 1, 0]);

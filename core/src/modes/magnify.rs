@@ -19,14 +19,16 @@ use crate::maps::{UvWindow, UV_SCALE};
 /// fewer, so that its `@2x` tiles at the highest zoom stay within it).
 pub const MAX_ZOOM_IN: u32 = 4;
 
-/// The image magnified texels are sampled from: the exemplar, or a version `side / m` times
+/// The image magnified texels are sampled from: the exemplar, or a version 2, 4 … times
 /// larger of the same content (a higher-resolution photograph the exemplar was reduced from).
 #[derive(Debug, Clone, Copy)]
 pub struct Detail<'a> {
-    /// Row-major RGB texels, `side × side`.
+    /// Row-major RGB texels, `width × height`.
     pub pixels: &'a [[u8; 3]],
-    /// Side: the exemplar's side times 1, 2, 4 …
-    pub side: u32,
+    /// Width: the exemplar's times 1, 2, 4 …
+    pub width: u32,
+    /// Height: the exemplar's times the same factor.
+    pub height: u32,
     /// Wrap around the edges (toroidal exemplar) or clamp to them.
     pub toroidal: bool,
 }
@@ -67,22 +69,22 @@ fn axis(a: i64, b: i64, k: u32) -> Vec<(i64, i64, i64)> {
 }
 
 /// Magnify `rect` (pixels at zoom `native + k`) from synthesized coordinates: `coords` holds
-/// the packed level-`L` coordinates (`x | y << 16`, exemplar side `m`) of
+/// the packed level-`L` coordinates (`x | y << 16`, exemplar width `m`) of
 /// [`source_rect`]`(rect, k)`, row-major.
 pub fn patches(coords: &[u32], m: u32, detail: Detail, k: u32, rect: Rect) -> RgbWindow {
     let src = source_rect(rect, k);
     let sw = src.width() as usize;
     let two_s = 2i64 << k;
-    let r = (detail.side / m.max(1)).max(1) as i64;
-    let n = detail.side as i64;
+    let r = (detail.width / m.max(1)).max(1) as i64;
+    let (n, nh) = (detail.width as i64, detail.height as i64);
     let (ax, ay) = (axis(rect.x0, rect.x1, k), axis(rect.y0, rect.y1, k));
-    // Detail texel index along an axis: wrapped or clamped.
-    let index = |i: i64| if detail.toroidal { i.rem_euclid(n) } else { i.clamp(0, n - 1) } as usize;
+    // Detail texel index along an axis of `n` texels: wrapped or clamped.
+    let index = |i: i64, n: i64| if detail.toroidal { i.rem_euclid(n) } else { i.clamp(0, n - 1) } as usize;
     // Bilinear sample of the detail image at `V / 2s` texels past the first texel centre.
     let sample = |vx: i64, vy: i64| -> [u32; 3] {
         let (ix, gx) = (vx.div_euclid(two_s), vx.rem_euclid(two_s));
         let (iy, gy) = (vy.div_euclid(two_s), vy.rem_euclid(two_s));
-        let (x0, x1, y0, y1) = (index(ix), index(ix + 1), index(iy), index(iy + 1));
+        let (x0, x1, y0, y1) = (index(ix, n), index(ix + 1, n), index(iy, nh), index(iy + 1, nh));
         let w = [(two_s - gx) * (two_s - gy), gx * (two_s - gy), (two_s - gx) * gy, gx * gy];
         let t = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)];
         let mut c = [0u32; 3];
@@ -127,7 +129,7 @@ pub fn patches(coords: &[u32], m: u32, detail: Detail, k: u32, rect: Rect) -> Rg
 /// pixel's centre in the patch of the texel it lies in (`coords` as for [`patches`]), in
 /// `1/UV_SCALE` texel. Where neighbouring patches disagree [`patches`] blends them; this
 /// names the one the pixel belongs to.
-pub fn patch_points(coords: &[u32], m: u32, _toroidal: bool, k: u32, rect: Rect) -> UvWindow {
+pub fn patch_points(coords: &[u32], (w, h): (u32, u32), k: u32, rect: Rect) -> UvWindow {
     let src = source_rect(rect, k);
     let sw = src.width() as usize;
     let unit = (UV_SCALE >> 1 >> k) as i64;
@@ -140,8 +142,8 @@ pub fn patch_points(coords: &[u32], m: u32, _toroidal: bool, k: u32, rect: Rect)
             let fx = 2 * x + 1 - ((2 * qx) << k);
             let v = coords[(qy - src.y0) as usize * sw + (qx - src.x0) as usize];
             let (sx, sy) = ((v & 0xFFFF) as i64, (v >> 16) as i64);
-            let at = |s: i64, f: i64| (s * UV_SCALE as i64 + f * unit).clamp(0, (m * UV_SCALE) as i64 - 1) as u16;
-            uv.push([at(sx, fx), at(sy, fy)]);
+            let at = |s: i64, f: i64, m: u32| (s * UV_SCALE as i64 + f * unit).clamp(0, (m * UV_SCALE) as i64 - 1) as u16;
+            uv.push([at(sx, fx, w), at(sy, fy, h)]);
         }
     }
     UvWindow { width: rect.width() as u32, height: rect.height() as u32, uv }
@@ -198,7 +200,7 @@ mod tests {
         let m = 8u32;
         let ex: Vec<[u8; 3]> =
             (0..64u32).map(|i| [(i * 37 % 251) as u8, (i * 11) as u8, (255 - i * 3) as u8]).collect();
-        let detail = Detail { pixels: &ex, side: m, toroidal: true };
+        let detail = Detail { pixels: &ex, width: m, height: m, toroidal: true };
         for k in 1..=3 {
             let rect = Rect::new(-13, 5, 40, 24);
             let src = source_rect(rect, k);

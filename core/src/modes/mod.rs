@@ -55,7 +55,7 @@ pub enum Cost {
 /// its modes prepared ([`Mode::preparation`]).
 #[derive(Clone, Copy)]
 pub struct Source<'a> {
-    /// The prepared (square, power-of-two) exemplar.
+    /// The prepared exemplar (at its own width and height).
     pub exemplar: &'a Exemplar,
     /// The analysis, when available.
     pub analysis: Option<&'a Analysis>,
@@ -69,7 +69,7 @@ pub struct Source<'a> {
 impl std::fmt::Debug for Source<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Source")
-            .field("side", &self.exemplar.side)
+            .field("size", &self.exemplar.dims())
             .field("analysis", &self.analysis.map(|a| &a.header.id))
             .field("prepared", &self.prepared.map(|p| p.all().into_iter().map(|(m, _)| m).collect::<Vec<_>>()))
             .field("map", &self.map.map(|m| &m.name))
@@ -122,14 +122,19 @@ impl<'a> Source<'a> {
         }
     }
 
-    /// Exemplar side `m`.
-    pub fn side(&self) -> u32 {
-        self.exemplar.side
+    /// Exemplar size `(width, height)` for indexing.
+    pub fn dims(&self) -> (usize, usize) {
+        self.exemplar.dims()
     }
 
-    /// `L = log2 m`: the native zoom and finest level.
+    /// The exemplar's longer side (what parameters bounded by the exemplar's size compare with).
+    pub fn longer_side(&self) -> u32 {
+        self.exemplar.width.max(self.exemplar.height)
+    }
+
+    /// `L = ⌈log2 max(w, h)⌉`: the native zoom and finest level.
     pub fn levels(&self) -> u32 {
-        self.exemplar.side.trailing_zeros()
+        self.exemplar.levels()
     }
 
     /// The analysis, or [`CoreError::NotAnalysed`] for `mode`.
@@ -611,7 +616,7 @@ impl Defaults {
                 MODE_NAMES.join(", ")
             ))
         })?;
-        let common = Common::read(&mut r, src.side())?;
+        let common = Common::read(&mut r, src.longer_side())?;
         let p = base.parse(&common, &mut r, src)?;
         r.finish(&mode, &all_specs())?;
         Ok(p)

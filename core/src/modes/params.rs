@@ -211,7 +211,7 @@ pub struct Common {
 }
 
 impl Common {
-    /// Read `seed` and `world`; `side` is the exemplar side (a period must be at least that).
+    /// Read `seed` and `world`; `side` is the exemplar's longer side (a period must be at least that).
     pub fn read(r: &mut ParamReader, side: u32) -> Result<Common> {
         let seed = r.get(&SEED).map(|s| SEED.integer(&s)).transpose()?;
         let period = match r.get(&WORLD) {

@@ -16,8 +16,8 @@ pub fn run(a: InfoArgs) -> CliResult {
     println!("format version:    {}", textile_core::analysis::file::FORMAT_VERSION);
     println!("algorithm version: {}", h.algorithm_version);
     println!(
-        "exemplar:          {}x{} (input {}x{}, crop {})",
-        h.side, h.side, h.preparation.input_width, h.preparation.input_height, h.preparation.crop_side
+        "exemplar:          {}x{} (input {}x{})",
+        h.width, h.height, h.preparation.input_width, h.preparation.input_height
     );
     println!(
         "toroidal:          {} ({})",

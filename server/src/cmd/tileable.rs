@@ -28,8 +28,8 @@ pub fn run(a: TileableArgs) -> CliResult {
         a.size,
         a.size,
         a.exemplar.display(),
-        ex.side,
-        ex.side,
+        ex.width,
+        ex.height,
         ex.toroidal,
         t.elapsed().as_secs_f64(),
         if a.exact { "exhaustive search".to_string() } else { format!("TSVQ search, {} leaves", a.backtrack) }

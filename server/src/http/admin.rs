@@ -267,7 +267,7 @@ pub async fn upload(
         }
         st.set_registry(Arc::new(reg.with(tex.clone())));
     }
-    tracing::info!("texture '{id}': uploaded ({}x{}); analysing", tex.exemplar.side, tex.exemplar.side);
+    tracing::info!("texture '{id}': uploaded ({}x{}); analysing", tex.exemplar.width, tex.exemplar.height);
     uploads::analyse_in_background(st.clone(), tex.clone());
     let mut resp = (StatusCode::ACCEPTED, Json(status_body(&tex))).into_response();
     if let Ok(v) = HeaderValue::from_str(&format!("/textures/{id}")) {

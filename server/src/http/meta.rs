@@ -138,9 +138,9 @@ pub async fn texture_meta(
         "uploaded": t.config.uploaded,
         "attribution": t.config.attribution,
         "exemplar": {
-            "width": ex.side, "height": ex.side, "toroidal": ex.toroidal,
+            "width": ex.width, "height": ex.height, "toroidal": ex.toroidal,
             "input_width": prep.input_width, "input_height": prep.input_height,
-            "crop_side": prep.crop_side, "toroidal_forced": prep.toroidal_forced,
+            "toroidal_forced": prep.toroidal_forced,
             "toroidal_synthesized": prep.toroidal_synthesized,
             "randomness_mask": ex.randomness_mask.is_some(),
             "lattice": ex.lattice.as_ref().map(|l| l.summary()),
@@ -160,7 +160,7 @@ pub async fn texture_meta(
             "steps": t.max_zoom() - t.native_zoom(),
             "method": "patch extrapolation (synth), bilinear (other modes)",
             "detail": match &t.exemplar.hires {
-                Some(_) => format!("exemplar_hires {0}x{0}", 2 * ex.side),
+                Some(_) => format!("exemplar_hires {}x{}", 2 * ex.width, 2 * ex.height),
                 None => "exemplar".to_string(),
             },
         },
@@ -208,7 +208,7 @@ fn parameters(t: &Texture) -> Value {
     let default_params = t.defaults.get(t.defaults.mode).map(|p| p.values(&src)).unwrap_or_default();
     out[SEED.name]["default"] = default_params.get("seed").cloned().unwrap_or(Value::Null);
     out[WORLD.name]["default"] = Value::Null;
-    out[WORLD.name]["min"] = json!((src.side() as i64 / TILE_SIZE).max(1));
+    out[WORLD.name]["min"] = json!(((src.longer_side() as i64 + TILE_SIZE - 1) / TILE_SIZE).max(1));
     for info in textile_core::modes::all() {
         let values = t.defaults.get(info.name).map(|p| p.values(&src)).unwrap_or_default();
         for spec in info.specs.iter().filter(|s| s.scope == Scope::Request) {
@@ -297,12 +297,12 @@ pub async fn map_image(
     if if_none_match(&headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
-    let (texels, side) = (map.texels.clone(), t.exemplar.side);
+    let (texels, (w, h)) = (map.texels.clone(), (map.width, map.height));
     let (png, hit) = st
         .cache
         .get_or_compute(&etag, || async move {
             tokio::task::spawn_blocking(move || {
-                crate::encode::encode(texels.as_flattened(), side, side, Format::Png, Effort::Tight)
+                crate::encode::encode(texels.as_flattened(), w, h, Format::Png, Effort::Tight)
                     .map(Into::into)
                     .map_err(|e| ApiError::internal(format!("encoding: {e}")))
             })
@@ -377,7 +377,8 @@ pub async fn tilejson(
         "center": [0.0, 0.0, t.native_zoom()],
         "tileSize": TILE_SIZE,
         "textile": {
-            "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.side,
+            "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.width.max(t.exemplar.height),
+            "exemplar_width": t.exemplar.width, "exemplar_height": t.exemplar.height,
             "magnified_zooms": t.max_zoom() - t.native_zoom(),
         },
     })))

@@ -83,9 +83,9 @@ impl Texture {
     /// A texture from its configuration (`index`: its place in the configuration, for errors)
     /// and prepared exemplar, without its analysis yet.
     pub fn prepare(config: TextureConfig, index: usize, exemplar: Exemplar) -> Result<Self, LoadError> {
-        let m = exemplar.side;
+        let (w, h) = (exemplar.width, exemplar.height);
         let rgb: Vec<u8> = exemplar.pixels.iter().flatten().copied().collect();
-        let exemplar_png = crate::encode::encode(&rgb, m, m, crate::encode::Format::Png, crate::encode::Effort::Tight)
+        let exemplar_png = crate::encode::encode(&rgb, w, h, crate::encode::Format::Png, crate::encode::Effort::Tight)
             .map_err(|e| LoadError::Core {
                 id: config.id.clone(),
                 source: textile_core::CoreError::ExemplarUndecodable(e.to_string()),
@@ -184,9 +184,10 @@ impl Texture {
             state.limit_caches(bytes);
         }
     }
-    /// Zoom at which one tile pixel is one texel.
+    /// Zoom at which one tile pixel is one texel: `⌈log2⌉` of the exemplar's longer side (a
+    /// whole exemplar fits in one tile at zoom 0).
     pub fn native_zoom(&self) -> u32 {
-        self.exemplar.side.trailing_zeros()
+        self.exemplar.levels()
     }
     /// Smallest zoom served.
     pub fn min_zoom(&self) -> u32 {

@@ -75,8 +75,8 @@ pub fn prepare_texture(
     };
     if t.exemplar_hires.is_some() {
         ex = Exemplar::from_hires(ex).map_err(core)?;
-        let (m, big) = (ex.side, 2 * ex.side);
-        log(format!("texture '{}': exemplar {m}x{m} reduced from its {big}x{big} exemplar_hires", t.id));
+        let (w, h) = (ex.width, ex.height);
+        log(format!("texture '{}': exemplar {w}x{h} reduced from its {}x{} exemplar_hires", t.id, 2 * w, 2 * h));
     }
     if t.toroidal == crate::config::Toroidal::Synthesize {
         let started = std::time::Instant::now();
@@ -108,19 +108,15 @@ pub fn prepare_texture(
         ex = ex.with_map(name, &map, t.normal_convention()).map_err(core)?;
     }
     let prep = &ex.preparation;
-    if prep.input_width != prep.input_height || prep.crop_side != ex.side {
+    if (prep.input_width, prep.input_height) != (prep.width, prep.height) {
         log(format!(
-            "texture '{}': exemplar {}x{} {}resized to {}x{} (exemplars are used as power-of-two squares)",
+            "texture '{}': exemplar {}x{} scaled to {}x{} (exemplars are used up to {} texels a side)",
             t.id,
             prep.input_width,
             prep.input_height,
-            if prep.input_width != prep.input_height {
-                format!("cropped to its central {0}x{0} and ", prep.crop_side)
-            } else {
-                String::new()
-            },
-            ex.side,
-            ex.side
+            prep.width,
+            prep.height,
+            textile_core::exemplar::MAX_SIDE
         ));
     }
     Texture::prepare(t.clone(), index, ex)

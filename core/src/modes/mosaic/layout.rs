@@ -14,7 +14,8 @@ use super::params::MosaicParams;
 pub const TAG_MOSAIC_BLOCK: u64 = 0x4D4F_5341_4943_0001;
 /// Domain tag of block priority.
 pub const TAG_MOSAIC_PRIO: u64 = 0x4D4F_5341_4943_0002;
-/// Tiles per super-tile side (the cat map's torus is `SUPER·n` texels).
+/// Tiles per super-tile side (without a period; the cat map's torus is `SUPER·n` texels for
+/// an `n × n` exemplar).
 pub const SUPER: i64 = 16;
 
 /// One pasted block: source rect in the exemplar, absolute destination, priority.
@@ -29,25 +30,36 @@ pub(super) struct Block {
     pub(super) prio: (u64, i64, i64),
 }
 
-/// Block geometry and placement for a plane of `n`-texel tiles.
+/// Block geometry and placement for a plane of `w × h`-texel tiles.
+///
+/// The cat map is a map of a square torus; a super-tile of a non-square exemplar is not square
+/// (`SUPER` tiles each way). Its blocks are moved on the square torus of side `q` (the
+/// smallest power of two at least as long as the super-tile's longer side, so a power-of-two
+/// square exemplar's torus is its super-tile, as in the paper), their positions scaled to it
+/// and back along each axis.
 pub(super) struct Layout {
-    pub(super) n: i64,
-    tiles: i64,    // tiles per super-tile side
-    span: i64,     // texels per super-tile side
-    cat: [u64; 4], // A^iterations mod span
+    /// The exemplar's width and height: the tiles.
+    pub(super) ew: i64,
+    pub(super) eh: i64,
+    tiles: (i64, i64), // tiles per super-tile across and down (powers of two)
+    span: (i64, i64),  // texels per super-tile across and down
+    q: i64,            // the cat map's torus side (a power of two)
+    cat: [u64; 4],     // A^iterations mod q
     keys: [u64; 2], // hash keys of block geometry and priority
-    period_tiles: Option<i64>,
+    period_tiles: Option<(i64, i64)>,
     /// The exemplar's lattice: block offsets are snapped to its translations.
     lattice: LevelLattice,
     pub(super) p: MosaicParams,
 }
 
 impl Layout {
-    pub(super) fn new(n: i64, p: &MosaicParams, lattice: Option<&Lattice>) -> Layout {
-        let period_tiles = p.period.map(|per| per / n);
-        let tiles = period_tiles.map_or(SUPER, |t| t.min(SUPER));
-        let span = tiles * n;
-        let mask = span as u64 - 1;
+    pub(super) fn new((ew, eh): (i64, i64), p: &MosaicParams, lattice: Option<&Lattice>) -> Layout {
+        // A period is a multiple of both sides (checked: `MosaicParams::validate`).
+        let period_tiles = p.period.map(|per| (per / ew, per / eh));
+        let tiles = period_tiles.map_or((SUPER, SUPER), |(tx, ty)| (tx.min(SUPER), ty.min(SUPER)));
+        let span = (tiles.0 * ew, tiles.1 * eh);
+        let q = (span.0.max(span.1) as u64).next_power_of_two() as i64;
+        let mask = q as u64 - 1;
         let mut cat = [1u64, 0, 0, 1];
         for _ in 0..p.iterations {
             // cat · [[1,1],[1,2]]
@@ -56,7 +68,7 @@ impl Layout {
         }
         let keys = [key(TAG_MOSAIC_BLOCK, p.seed), key(TAG_MOSAIC_PRIO, p.seed)];
         let lattice = lattice.map_or(LevelLattice::FREE, Lattice::whole);
-        Layout { n, tiles, span, cat, keys, period_tiles, lattice, p: p.clone() }
+        Layout { ew, eh, tiles, span, q, cat, keys, period_tiles, lattice, p: p.clone() }
     }
 
     /// The block of tile `(a1, a2)` of super-tile `(s1, s2)`: absolute tile
@@ -70,9 +82,9 @@ impl Layout {
     /// The geometry and priority hashes of a tile.
     #[inline]
     fn hashes(&self, s1: i64, s2: i64, a1: i64, a2: i64) -> (u64, u64) {
-        let (k1, k2) = (s1 * self.tiles + a1, s2 * self.tiles + a2);
+        let (k1, k2) = (s1 * self.tiles.0 + a1, s2 * self.tiles.1 + a2);
         let (h1, h2) = match self.period_tiles {
-            Some(t) => (k1.rem_euclid(t), k2.rem_euclid(t)),
+            Some((tx, ty)) => (k1.rem_euclid(tx), k2.rem_euclid(ty)),
             None => (k1, k2),
         };
         (hash_keyed(self.keys[0], h1, h2, 0), hash_keyed(self.keys[1], h1, h2, 0))
@@ -81,7 +93,7 @@ impl Layout {
     /// Width and height of the block whose geometry hash is `z`.
     #[inline]
     fn sides(&self, z: u64) -> (i64, i64) {
-        let n = self.n;
+        let (ew, eh) = (self.ew, self.eh);
         // Integers below 2^48 convert to f64 exactly, and from i64 in one instruction.
         let rho = self.p.block_area.0 as f64
             + ((((z & 0xFFFF) * (self.p.block_area.1 - self.p.block_area.0) as u64) >> 16) as i64) as f64;
@@ -89,8 +101,8 @@ impl Layout {
         // Aspect in [2/3, 3/2], symmetric in log scale (α and 1/α equally likely).
         let u = (((z >> 16) & 0xFFFF) as i64) as f64 / 32768.0 - 1.0;
         let alpha = if u >= 0.0 { 1.0 + 0.5 * u } else { 1.0 / (1.0 - 0.5 * u) };
-        let w = round(n as f64 * (rho * alpha).sqrt()).clamp(1, n);
-        let h = round(n as f64 * (rho / alpha).sqrt()).clamp(1, n);
+        let w = round(ew as f64 * (rho * alpha).sqrt()).clamp(1, ew);
+        let h = round(eh as f64 * (rho / alpha).sqrt()).clamp(1, eh);
         (w, h)
     }
 
@@ -99,16 +111,20 @@ impl Layout {
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn place(&self, s1: i64, s2: i64, a1: i64, a2: i64, z: u64, prio: u64, (w, h): (i64, i64)) -> Block {
-        let n = self.n;
-        let sx = (((z >> 32) & 0xFFFF) as i64 * (n - w + 1)) >> 16;
-        let sy = (((z >> 48) & 0xFFFF) as i64 * (n - h + 1)) >> 16;
-        let (x0, y0) = ((sx + a1 * n) as u64, (sy + a2 * n) as u64);
-        let mask = self.span as u64 - 1;
+        let (ew, eh) = (self.ew, self.eh);
+        let sx = (((z >> 32) & 0xFFFF) as i64 * (ew - w + 1)) >> 16;
+        let sy = (((z >> 48) & 0xFFFF) as i64 * (eh - h + 1)) >> 16;
+        // The source in the super-tile, on the cat map's torus.
+        let (span_x, span_y, q) = (self.span.0, self.span.1, self.q);
+        let to_q = |v: i64, span: i64| if span == q { v } else { v * q / span };
+        let from_q = |v: i64, span: i64| if span == q { v } else { v * span / q };
+        let (x0, y0) = (to_q(sx + a1 * ew, span_x) as u64, to_q(sy + a2 * eh, span_y) as u64);
+        let mask = q as u64 - 1;
         let [a, b, c, d] = self.cat;
         let s = (a.wrapping_mul(x0).wrapping_add(b.wrapping_mul(y0))) & mask;
         let t = (c.wrapping_mul(x0).wrapping_add(d.wrapping_mul(y0))) & mask;
-        let (k1, k2) = (s1 * self.tiles + a1, s2 * self.tiles + a2);
-        let (mut s, mut t) = (s as i64, t as i64);
+        let (k1, k2) = (s1 * self.tiles.0 + a1, s2 * self.tiles.1 + a2);
+        let (mut s, mut t) = (from_q(s as i64, span_x), from_q(t as i64, span_y));
         if !self.lattice.is_free() {
             // A near-regular exemplar's block moves by a lattice translation from where the
             // tiled exemplar shows its source, so rows and gaps continue across its border
@@ -117,17 +133,16 @@ impl Layout {
             let (tx, ty) = self.lattice.translation((s - sx, t - sy));
             (s, t) = (sx + tx, sy + ty);
         }
-        Block { sx, sy, w, h, dx: s1 * self.span + s, dy: s2 * self.span + t, prio: (prio, k2, k1) }
+        Block { sx, sy, w, h, dx: s1 * span_x + s, dy: s2 * span_y + t, prio: (prio, k2, k1) }
     }
 
     /// The blocks of super-tile `(s1, s2)` that meet `r`, appended to `out`. Hashes, sides and
     /// placement are separate passes over the super-tile's tiles: one block's chain of
     /// divisions and square roots is longer than the processor's window, so computed one
     /// block at a time they ran back to back (43 ns a block); in passes they overlap. No
-    /// coordinate is divided (tiles per side is a power of two).
+    /// coordinate is divided (tiles across is a power of two).
     fn super_tile(&self, s1: i64, s2: i64, r: Rect, out: &mut Vec<Block>) {
-        let t = self.tiles;
-        let count = (t * t) as usize;
+        let (t, count) = (self.tiles.0, (self.tiles.0 * self.tiles.1) as usize);
         let (shift, mask) = (t.trailing_zeros(), t - 1);
         let tile = |a: usize| (a as i64 & mask, a as i64 >> shift);
         let mut hashes = [(0u64, 0u64); (SUPER * SUPER) as usize];
@@ -169,12 +184,15 @@ impl Layout {
         // A block lies within its super-tile or spills at most n−1 texels right/down, and a
         // lattice's snap moves it at most `reach` texels either way.
         let reach = self.lattice.reach;
-        let lo = |v: i64| (v - self.n - reach).div_euclid(self.span);
-        let hi = |v: i64| (v - 1 + reach).div_euclid(self.span);
-        let (s1s, s2s) = (lo(r.x0)..=hi(r.x1), lo(r.y0)..=hi(r.y1));
+        let lo = |v: i64, n: i64, span: i64| (v - n - reach).div_euclid(span);
+        let hi = |v: i64, span: i64| (v - 1 + reach).div_euclid(span);
+        let (s1s, s2s) = (
+            lo(r.x0, self.ew, self.span.0)..=hi(r.x1, self.span.0),
+            lo(r.y0, self.eh, self.span.1)..=hi(r.y1, self.span.1),
+        );
         s2s.into_par_iter()
             .map(|s2| {
-                let mut blocks = Vec::with_capacity(s1s.clone().count() * (self.tiles * self.tiles) as usize);
+                let mut blocks = Vec::with_capacity(s1s.clone().count() * (self.tiles.0 * self.tiles.1) as usize);
                 for s1 in s1s.clone() {
                     self.super_tile(s1, s2, r, &mut blocks);
                 }
@@ -212,13 +230,13 @@ mod tests {
     #[test]
     fn super_tile_passes_equal_single_blocks() {
         for period in [None, Some(512), Some(1 << 20)] {
-            let l = Layout::new(128, &MosaicParams { seed: 3, period, ..MosaicParams::default() }, None);
+            let l = Layout::new((128, 128), &MosaicParams { seed: 3, period, ..MosaicParams::default() }, None);
             for (s1, s2) in [(0, 0), (-3, 7), (1 << 30, -(1 << 29))] {
                 let mut out = Vec::new();
                 l.super_tile(s1, s2, Rect::new(i64::MIN / 4, i64::MIN / 4, i64::MAX / 2, i64::MAX / 2), &mut out);
-                assert_eq!(out.len() as i64, l.tiles * l.tiles);
+                assert_eq!(out.len() as i64, l.tiles.0 * l.tiles.1);
                 for (a, b) in out.iter().enumerate() {
-                    let r = l.block(s1, s2, a as i64 % l.tiles, a as i64 / l.tiles);
+                    let r = l.block(s1, s2, a as i64 % l.tiles.0, a as i64 / l.tiles.0);
                     assert_eq!((b.sx, b.sy, b.w, b.h, b.dx, b.dy, b.prio), (r.sx, r.sy, r.w, r.h, r.dx, r.dy, r.prio));
                 }
             }

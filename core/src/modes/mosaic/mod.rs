@@ -15,7 +15,7 @@ use crate::cache::Pyramid;
 use crate::error::Result;
 use crate::exemplar::Exemplar;
 use crate::geom::Rect;
-use crate::image::{box_mip, Integral, Rendered, RgbWindow};
+use crate::image::{mean_colour, Integral, Rendered, RgbWindow};
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
 
 pub use params::{MosaicParams, BLOCK_AREA, ITERATIONS, MAX_ITERATIONS, MAX_SMOOTHING, SMOOTHING};
@@ -68,9 +68,9 @@ pub fn render(ex: &Exemplar, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Res
 /// material maps; what it derives from them is kept in `cache`.
 pub fn render_texels(src: &Source, cache: &Pyramid, p: &MosaicParams, zoom_out: u32, rect: Rect) -> Result<RgbWindow> {
     let ex = src.exemplar;
-    p.validate(ex.side)?;
+    p.validate(ex.width, ex.height)?;
     check_window(rect, MAX_PIXELS)?;
-    let layout = Layout::new(ex.side as i64, p, ex.lattice.as_ref());
+    let layout = Layout::new((ex.width as i64, ex.height as i64), p, ex.lattice.as_ref());
     if zoom_out == 0 {
         return Ok(native(ex, src.texels(), &layout, rect));
     }
@@ -88,20 +88,20 @@ const SAMPLED_PIXELS: usize = 1 << 13;
 /// pixel covers the whole exemplar.
 fn sampled(src: &Source, cache: &Pyramid, layout: &Layout, k: u32, rect: Rect) -> RgbWindow {
     let (ex, texels) = (src.exemplar, src.texels());
-    let n = layout.n as usize;
+    let (ew, eh) = (layout.ew as usize, layout.eh as usize);
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let step = 1i64 << k.min(40);
-    let levels = ex.side.trailing_zeros();
+    let levels = ex.levels();
     if k >= levels {
-        let mean = box_mip(texels, n, levels as usize)[0];
+        let mean = mean_colour(texels);
         return RgbWindow { width: w as u32, height: h as u32, pixels: mean.repeat(w * h) };
     }
     let labels = sources(layout, rect, ex.toroidal, step, step / 2);
     // The box means the analysis or the map holds, else each pixel's from an integral image.
     let mean: Box<dyn Fn(usize, usize) -> [u8; 3] + Sync> = match src.box_stack(cache) {
-        Some(stack) => Box::new(move |x, y| stack[k as usize][y * n + x]),
+        Some(stack) => Box::new(move |x, y| stack[k as usize][y * ew + x]),
         None => {
-            let sums = Integral::new(texels, n, step as usize);
+            let sums = Integral::new(texels, (ew, eh), step as usize);
             Box::new(move |x, y| sums.mean_around(x, y))
         }
     };

@@ -74,20 +74,16 @@ pub(super) fn sources(layout: &Layout, rect: Rect, toroidal: bool, step: i64, of
 
 /// Labels and source texels of the background (the tiled exemplar) at every sample.
 fn background(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i64) -> (Vec<u32>, Vec<u32>) {
-    let n = layout.n;
-    let (shift, mask) = (n.trailing_zeros(), n - 1);
+    let (ew, eh) = (layout.ew, layout.eh);
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let mut label = vec![0u32; w * h];
     let mut src = vec![0u32; w * h];
-    let cols: Vec<(u32, u32)> = (rect.x0..rect.x1)
-        .map(|i| {
-            let x = i * step + offset;
-            (((x >> shift) & 0x7FFF) as u32, (x & mask) as u32)
-        })
-        .collect();
+    // Tile and texel within it along an axis of `n`-texel tiles.
+    let split = |v: i64, n: i64| ((v.div_euclid(n) & 0x7FFF) as u32, v.rem_euclid(n) as u32);
+    let cols: Vec<(u32, u32)> = (rect.x0..rect.x1).map(|i| split(i * step + offset, ew)).collect();
     for j in 0..h {
-        let y = (rect.y0 + j as i64) * step + offset;
-        let (ty, sy) = ((((y >> shift) & 0x7FFF) as u32) << 15, ((y & mask) as u32) << 16);
+        let (ty, sy) = split((rect.y0 + j as i64) * step + offset, eh);
+        let (ty, sy) = (ty << 15, sy << 16);
         let (lrow, srow) = (&mut label[j * w..(j + 1) * w], &mut src[j * w..(j + 1) * w]);
         for ((l, s), &(tx, sx)) in lrow.iter_mut().zip(srow.iter_mut()).zip(&cols) {
             *l = if toroidal { 1 << 31 } else { (1 << 31) | ty | tx };
@@ -136,7 +132,7 @@ mod tests {
     #[test]
     fn sources_equal_the_painted_sources() {
         for (seed, period) in [(0, None), (7, Some(512)), (3, Some(4096))] {
-            let layout = Layout::new(128, &MosaicParams { seed, period, ..MosaicParams::default() }, None);
+            let layout = Layout::new((128, 128), &MosaicParams { seed, period, ..MosaicParams::default() }, None);
             for (step, rect) in [
                 (1, Rect::new(-300, 70, 96, 64)),
                 (4, Rect::new(1000, -2000, 64, 48)),

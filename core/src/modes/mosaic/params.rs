@@ -26,16 +26,17 @@ crate::declare_params! {
         pub smoothing: u32 { default: 3, canonical: ";smooth=",
             spec SMOOTHING = "smoothing", Kind::Integer { min: 0, max: MAX_SMOOTHING as u64 }, Request,
             "pixel layers smoothed on each side of block and tile edges" }
-        /// Optional period in texels (power of two ≥ the exemplar side): a mosaic on a torus.
+        /// Optional period in texels (power of two ≥ the exemplar side, a multiple of its
+        /// width and height): a mosaic on a torus.
         pub period: Option<i64> { default: None, canonical: ";period=", period }
     }
-    check(p, src) { p.validate(src.side()) }
+    check(p, src) { p.validate(src.exemplar.width, src.exemplar.height) }
 }
 
 impl MosaicParams {
-    /// Check ranges for an exemplar of side `side` (parameters made in code are checked here
-    /// too, not only parsed ones).
-    pub fn validate(&self, side: u32) -> Result<()> {
+    /// Check ranges for a `w × h` exemplar (parameters made in code are checked here too, not
+    /// only parsed ones).
+    pub fn validate(&self, w: u32, h: u32) -> Result<()> {
         let bad = |name, message: String| Err(CoreError::Param { name, message });
         if self.iterations > MAX_ITERATIONS {
             return bad("iterations", format!("{} is outside 0..={MAX_ITERATIONS}", self.iterations));
@@ -54,7 +55,20 @@ impl MosaicParams {
         if self.smoothing > MAX_SMOOTHING {
             return bad("smoothing", format!("{} is outside 0..={MAX_SMOOTHING}", self.smoothing));
         }
-        check_period(self.period, side)?;
+        check_period(self.period, w.max(h))?;
+        // The mosaic's background is the tiled exemplar: a periodic mosaic repeats whole tiles.
+        if let Some(n) = self.period {
+            if n % w as i64 != 0 || n % h as i64 != 0 {
+                return bad(
+                    "world",
+                    format!(
+                        "a periodic mosaic repeats whole tiles of the exemplar, and its {w}x{h} \
+                         tiles do not divide the period of {n} texels; use mode=synth, whose \
+                         world= takes any exemplar"
+                    ),
+                );
+            }
+        }
         Ok(())
     }
 }

@@ -19,7 +19,7 @@ const PAR_ROWS: usize = 128;
 const PAR_PIXELS: usize = 1 << 15;
 
 pub(super) fn native(ex: &Exemplar, texels: &[[u8; 3]], layout: &Layout, rect: Rect) -> RgbWindow {
-    let n = layout.n as usize;
+    let ew = layout.ew as usize;
     let s = layout.p.smoothing;
     // Labels and unsmoothed colours M0 on rect ⊕ 4 (edges on rect ⊕ 3 need 4-neighbours).
     let g = rect.grow(4);
@@ -29,7 +29,7 @@ pub(super) fn native(ex: &Exemplar, texels: &[[u8; 3]], layout: &Layout, rect: R
         .src
         .par_iter()
         .with_min_len(PAR_PIXELS)
-        .map(|&v| texels[(v >> 16) as usize * n + (v & 0xFFFF) as usize])
+        .map(|&v| texels[(v >> 16) as usize * ew + (v & 0xFFFF) as usize])
         .collect();
     let (w, h) = (rect.width() as usize, rect.height() as usize);
     let mut pixels = Vec::with_capacity(3 * w * h);

@@ -39,7 +39,7 @@ pub fn render_map(
     let levels = an.levels();
     let mut synthesized = 0;
     let (w, h) = (rect.width() as usize, rect.height() as usize);
-    let m = an.side() as usize;
+    let (ew, eh) = an.dims();
     let mut pixels = Vec::with_capacity(3 * w * h);
     if zoom_out == 0 {
         // The window grown by the blend's reach, blended back to `rect` (super::seams).
@@ -55,7 +55,7 @@ pub fn render_map(
                 (&mp.texels[..], &map_low[0][..])
             }
         };
-        seams::blend(&sw.window.coords, (w, h), &seams::Texels { texels, low, m, toroidal }, style.fade, &mut pixels);
+        seams::blend(&sw.window.coords, (w, h), &seams::Texels { texels, low, dims: (ew, eh), toroidal }, style.fade, &mut pixels);
     } else if zoom_out <= levels {
         // Level `L − k`, one pixel per pixel: coherent upsampling would give each of them the
         // `2^k × 2^k` exemplar block centred on its coordinate at the finest level, so it shows
@@ -66,10 +66,10 @@ pub fn render_map(
         let stack = map.map_or_else(|| an.box_stack(pyr), |m| m.box_stack(pyr));
         let boxes = &stack[zoom_out as usize];
         for &v in &sw.window.coords {
-            pixels.extend_from_slice(&boxes[(v >> 16) as usize * m + (v & 0xFFFF) as usize]);
+            pixels.extend_from_slice(&boxes[(v >> 16) as usize * ew + (v & 0xFFFF) as usize]);
         }
     } else {
-        params.validate(an.side())?;
+        params.validate(an.dims())?;
         let mean = map.map_or_else(|| an.mean_colour(), MaterialMap::mean);
         for _ in 0..w * h {
             pixels.extend_from_slice(&mean);
@@ -91,9 +91,9 @@ pub fn coordinates(pyr: &Pyramid, an: &Analysis, params: &SynthParams, zoom_out:
         let half = if zoom_out == 0 { s / 2 } else { 0 };
         sw.window.coords.iter().map(|&v| [(v & 0xFFFF) * s + half, (v >> 16) * s + half].map(|c| c as u16)).collect()
     } else {
-        params.validate(an.side())?;
-        let c = (an.side() * s / 2) as u16;
-        vec![[c, c]; (w * h) as usize]
+        params.validate(an.dims())?;
+        let centre = [an.width() * s / 2, an.height() * s / 2].map(|c| c as u16);
+        vec![centre; (w * h) as usize]
     };
     Ok(UvWindow { width: w, height: h, uv })
 }

@@ -234,10 +234,10 @@ impl Controls {
     }
 
     /// Check against an exemplar of side `side`: every feature's source lies in it.
-    pub fn check_side(&self, side: u32) -> Result<()> {
-        match self.features.iter().find(|f| f.u >= side as i64 || f.v >= side as i64) {
+    pub fn check_size(&self, w: u32, h: u32) -> Result<()> {
+        match self.features.iter().find(|f| f.u >= w as i64 || f.v >= h as i64) {
             Some(f) => Err(err(format!(
-                "a feature's source [{}, {}] is outside the {side}×{side} exemplar",
+                "a feature's source [{}, {}] is outside the {w}×{h} exemplar",
                 f.u, f.v
             ))),
             None => Ok(()),

@@ -89,7 +89,7 @@ fn hashed_64(colour: impl Fn(u64) -> [u8; 3]) -> Vec<[u8; 4]> {
 
 /// The share of a finest-level window's pixels whose 5×5 neighbourhood is coherent.
 fn coherent_share(s: &[u32], w: usize, an: &Analysis) -> f64 {
-    let m = an.side() as i64;
+    let (ew, eh) = (an.width() as i64, an.height() as i64);
     let h = s.len() / w;
     let mut n = 0;
     for y in 2..h - 2 {
@@ -98,8 +98,8 @@ fn coherent_share(s: &[u32], w: usize, an: &Analysis) -> f64 {
             let ok = (0..25).all(|t| {
                 let (dx, dy) = (t % 5 - 2, t / 5 - 2);
                 let q = s[(y as i64 + dy) as usize * w + (x as i64 + dx) as usize];
-                let ex = ((v & 0xFFFF) as i64 + dx).rem_euclid(m) as u32;
-                let ey = ((v >> 16) as i64 + dy).rem_euclid(m) as u32;
+                let ex = ((v & 0xFFFF) as i64 + dx).rem_euclid(ew) as u32;
+                let ey = ((v >> 16) as i64 + dy).rem_euclid(eh) as u32;
                 q == ex | ey << 16
             });
             n += ok as usize;

@@ -56,7 +56,7 @@ impl Mode for Synth {
         }
         let (k, rect) = (view.zoom_in, view.rect);
         let sw = synthesize_with(cache, an, p, an.levels(), magnify::source_rect(rect, k))?;
-        Ok(magnify::patch_points(&sw.window.coords, an.side(), an.header.toroidal, k, rect))
+        Ok(magnify::patch_points(&sw.window.coords, (an.width(), an.height()), k, rect))
     }
 
     fn magnify(p: &SynthParams, _: &(), src: &Source, cache: &Pyramid, k: u32, rect: Rect) -> Result<Rendered> {
@@ -64,10 +64,15 @@ impl Mode for Synth {
         let sw = synthesize_with(cache, an, p, an.levels(), magnify::source_rect(rect, k))?;
         let toroidal = an.header.toroidal;
         let detail = match src.hires() {
-            Some(h) => Detail { pixels: h, side: 2 * an.side(), toroidal },
-            None => Detail { pixels: src.map.map_or(&an.exemplar[..], |m| &m.texels), side: an.side(), toroidal },
+            Some(h) => Detail { pixels: h, width: 2 * an.width(), height: 2 * an.height(), toroidal },
+            None => Detail {
+                pixels: src.map.map_or(&an.exemplar[..], |m| &m.texels),
+                width: an.width(),
+                height: an.height(),
+                toroidal,
+            },
         };
-        let image = magnify::patches(&sw.window.coords, an.side(), detail, k, rect);
+        let image = magnify::patches(&sw.window.coords, an.width(), detail, k, rect);
         Ok(Rendered { image, synthesized: sw.synthesized })
     }
 }

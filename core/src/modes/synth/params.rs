@@ -103,7 +103,7 @@ crate::declare_params! {
         pub kappa: u32 { default: ONE_Q16, canonical: ";kappa=",
             spec KAPPA = "kappa", Kind::Unit, Texture,
             "κ, the penalty on jumps to a pixel's second candidate (default 1): higher keeps exemplar patches more coherent and the colour distribution closer to the exemplar's" }
-        /// Optional period in texels (a power of two ≥ the exemplar side): periodic output.
+        /// Optional period in texels (a power of two ≥ the exemplar's longer side): periodic output.
         pub period: Option<i64> { default: None, canonical: ";period=", period }
         /// Spatial modulation of randomness over the output (`R_S`), from the request; part of
         /// the canonical text only when given, so that every other request keeps its identity.
@@ -111,7 +111,7 @@ crate::declare_params! {
             spec CONTROLS = "controls", Kind::Text { max_len: super::controls::MAX_CONTROLS_LEN as u64 }, Request,
             "spatial modulation of randomness over the output (R_S): base64url of JSON {\"noise\": {\"scale\": 64, \"range\": [0.2, 1]}, \"strokes\": [{\"at\": [x, y], \"radius\": 40, \"soft\": 8, \"value\": 0}], \"features\": [{\"at\": [x, y], \"source\": [u, v], \"inner\": 12, \"outer\": 40}]} (native texels; values in [0, 1]: 0 calm, 1 the full randomness; a feature shows the exemplar around its source within its inner radius; at most 64 strokes and 32 features)" }
     }
-    check(p, src) { p.validate(src.side()) }
+    check(p, src) { p.validate(src.dims()) }
 }
 
 impl Canonical for Randomness {
@@ -137,9 +137,10 @@ impl ParamValue for Randomness {
 }
 
 impl SynthParams {
-    /// Check the parameters for an exemplar of side `side` (list length, period, ranges).
-    pub fn validate(&self, side: u32) -> Result<()> {
-        let levels = side.trailing_zeros();
+    /// Check the parameters for a `w × h` exemplar (list length, period, ranges).
+    pub fn validate(&self, (w, h): (usize, usize)) -> Result<()> {
+        let levels = crate::exemplar::levels_for(w as u32, h as u32);
+        let side = w.max(h) as u32;
         if let Randomness::PerLevel(v) = &self.randomness {
             if v.len() != levels as usize + 1 {
                 return Err(CoreError::Param {
@@ -167,7 +168,7 @@ impl SynthParams {
         }
         check_period(self.period, side)?;
         self.controls.check_period(self.period)?;
-        self.controls.check_side(side)?;
+        self.controls.check_size(w as u32, h as u32)?;
         Ok(())
     }
 

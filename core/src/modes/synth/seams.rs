@@ -60,8 +60,8 @@ pub(crate) struct Texels<'a> {
     pub texels: &'a [[u8; 3]],
     /// Their low-pass `Ē`, same layout.
     pub low: &'a [[u8; 3]],
-    /// The side `m`.
-    pub m: usize,
+    /// The exemplar's size `(width, height)`.
+    pub dims: (usize, usize),
     /// Whether the exemplar wraps (else its edge repeats).
     pub toroidal: bool,
 }
@@ -71,7 +71,7 @@ pub(crate) struct Texels<'a> {
 /// `x | y << 16`, from `src`, with the texture's `fade`. Rows run in parallel; each pixel
 /// depends on its neighbourhood only.
 pub(crate) fn blend(coords: &[u32], (w, h): (usize, usize), src: &Texels, fade: i32, out: &mut Vec<u8>) {
-    let Texels { texels, low, m, toroidal } = *src;
+    let Texels { texels, low, dims: (ew, eh), toroidal } = *src;
     const R: usize = RADIUS;
     const SIDE: usize = 2 * R + 1;
     let (bw, bh) = (w + 2 * R, h + 2 * R);
@@ -79,43 +79,43 @@ pub(crate) fn blend(coords: &[u32], (w, h): (usize, usize), src: &Texels, fade: 
     if w == 0 || h == 0 {
         return;
     }
-    let mask = (m - 1) as i64;
+    let (ewi, ehi) = (ew as i64, eh as i64);
     // The low-pass padded by `R` on every side (wrapped on a torus, else its edge repeated):
     // every prediction `S(q) − d` is then a plain index into it.
-    let pm = m + 2 * R;
+    let (pm, ph) = (ew + 2 * R, eh + 2 * R);
     // Channels packed 21 bits apart, so one multiply-add weighs all three: a weighted sum
     // stays below 255 · 256 < 2^21 per channel.
     let pack = |c: [u8; 3]| c[0] as u64 | (c[1] as u64) << 21 | (c[2] as u64) << 42;
-    let mut padded = vec![0u64; pm * pm];
+    let mut padded = vec![0u64; pm * ph];
     padded.par_chunks_exact_mut(pm).enumerate().for_each(|(py, row)| {
         let y = py as i64 - R as i64;
-        let y = if toroidal { y & mask } else { y.clamp(0, mask) } as usize;
+        let y = if toroidal { y.rem_euclid(ehi) } else { y.clamp(0, ehi - 1) } as usize;
         for (px, out) in row.iter_mut().enumerate() {
             let x = px as i64 - R as i64;
-            let x = if toroidal { x & mask } else { x.clamp(0, mask) } as usize;
-            *out = pack(low[y * m + x]);
+            let x = if toroidal { x.rem_euclid(ewi) } else { x.clamp(0, ewi - 1) } as usize;
+            *out = pack(low[y * ew + x]);
         }
     });
     // Each buffer pixel's translation `t(q)`: its coordinate as an index into `padded` less its
     // own position `lin(q)` at `padded`'s stride, so that what `q` predicts for `p` (`S(q) −
-    // (q − p)`) is `padded[t(q) + lin(p)]`. Coordinates are below `m` (a power of two) and
-    // masked all the same, so that every such index, `(S_y(q) + R − dy)·pm + S_x(q) + R − dx`
+    // (q − p)`) is `padded[t(q) + lin(p)]`. Coordinates are inside the exemplar and wrapped
+    // all the same, so that every such index, `(S_y(q) + R − dy)·pm + S_x(q) + R − dx`
     // with `|dx|, |dy| ≤ R`, provably lies in `padded`: the sum below reads it unchecked.
     let lin = |x: usize, y: usize| (y * pm + x) as isize;
     let mut trans = vec![0isize; bw * bh];
     trans.par_chunks_exact_mut(bw).zip(coords.par_chunks_exact(bw)).enumerate().for_each(|(y, (row_t, row_c))| {
         for (x, (t, &v)) in row_t.iter_mut().zip(row_c).enumerate() {
-            let (sx, sy) = ((v & 0xFFFF) as i64 & mask, (v >> 16) as i64 & mask);
+            let (sx, sy) = (((v & 0xFFFF) as i64).rem_euclid(ewi), ((v >> 16) as i64).rem_euclid(ehi));
             *t = ((sy as usize + R) * pm + sx as usize + R) as isize - lin(x, y);
         }
     });
-    let index = |v: u32| (v >> 16) as usize * m + (v & 0xFFFF) as usize;
+    let index = |v: u32| (v >> 16) as usize * ew + (v & 0xFFFF) as usize;
     // Pixels whose right or lower neighbour does not continue them, then whether one lies
     // within `R` along each row: a pixel with none in its window is its texel.
     let next = |v: u32, dx: i64, dy: i64| -> u32 {
         let (x, y) = ((v & 0xFFFF) as i64 + dx, (v >> 16) as i64 + dy);
         if toroidal {
-            ((x & mask) | ((y & mask) << 16)) as u32
+            (x.rem_euclid(ewi) | (y.rem_euclid(ehi) << 16)) as u32
         } else {
             (x | y << 16) as u32
         }
@@ -222,13 +222,13 @@ mod tests {
     fn coherent_windows_are_exemplar_texels() {
         let m = 32;
         let ex = texels(m);
-        let low = low_pass(&ex, m, true, LOW_STEPS);
+        let low = low_pass(&ex, (m, m), true, LOW_STEPS);
         let (w, h) = (20, 9);
         let (bw, bh) = (w + 2 * RADIUS, h + 2 * RADIUS);
         // A coherent window that wraps around the torus.
         let coords: Vec<u32> = (0..bw * bh).map(|i| ((i % bw + 25) % m) as u32 | ((((i / bw) + 7) % m) as u32) << 16).collect();
         let mut out = Vec::new();
-        blend(&coords, (w, h), &Texels { texels: &ex, low: &low, m, toroidal: true }, MAX_FADE, &mut out);
+        blend(&coords, (w, h), &Texels { texels: &ex, low: &low, dims: (m, m), toroidal: true }, MAX_FADE, &mut out);
         let want: Vec<u8> = (0..w * h)
             .flat_map(|i| ex[((i / w + RADIUS + 7) % m) * m + (i % w + RADIUS + 25) % m])
             .collect();
@@ -241,7 +241,7 @@ mod tests {
         // continuation next to a white one.
         let m = 32;
         let ex: Vec<[u8; 3]> = (0..m * m).map(|i| if i % m < m / 2 { [0; 3] } else { [255; 3] }).collect();
-        let low = low_pass(&ex, m, false, LOW_STEPS);
+        let low = low_pass(&ex, (m, m), false, LOW_STEPS);
         let (w, h) = (16, 1);
         let (bw, bh) = (w + 2 * RADIUS, h + 2 * RADIUS);
         let coords: Vec<u32> = (0..bw * bh)
@@ -252,7 +252,7 @@ mod tests {
             })
             .collect();
         let mut out = Vec::new();
-        blend(&coords, (w, h), &Texels { texels: &ex, low: &low, m, toroidal: false }, 2, &mut out);
+        blend(&coords, (w, h), &Texels { texels: &ex, low: &low, dims: (m, m), toroidal: false }, 2, &mut out);
         let row: Vec<i32> = out.chunks(3).map(|c| c[0] as i32).collect();
         let steps: Vec<i32> = row.windows(2).map(|p| p[1] - p[0]).collect();
         assert!(steps.iter().all(|&s| s >= 0), "monotone: {row:?}");

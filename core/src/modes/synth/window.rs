@@ -13,7 +13,7 @@ use crate::analysis::{Analysis, CorrectionLevel};
 use crate::error::{CoreError, Result};
 use crate::analysis::features::TAPS5;
 use super::generations::{class_cols, class_layout, needed_generations};
-use crate::geom::{fl2, par, Rect};
+use crate::geom::{fl2, pack_wrapped, par, wrap, Rect};
 use crate::hash::{hash_tail, head, key, TAG_JITTER};
 use crate::lattice::LevelLattice;
 use crate::mask::RandomnessMask;
@@ -95,7 +95,7 @@ pub fn synthesize_with(
     level: u32,
     rect: Rect,
 ) -> Result<Synthesized> {
-    params.validate(an.side())?;
+    params.validate(an.dims())?;
     if level > an.levels() {
         return Err(CoreError::Param { name: "level", message: format!("must be 0 to {}", an.levels()) });
     }
@@ -135,7 +135,8 @@ struct Ctx<'a> {
     r: Vec<u32>,
     phi: [u64; 2],
     period: Option<i64>,
-    m: i64,
+    /// The exemplar's width and height: coordinates wrap at them.
+    dims: (i64, i64),
     levels: u32,
     /// The randomness mask over the exemplar (`R_E`), scaling jitter.
     mask: Option<&'a RandomnessMask>,
@@ -156,7 +157,7 @@ impl<'a> Ctx<'a> {
             r: p.randomness.resolve(an.levels()),
             phi: p.phi(),
             period: p.period,
-            m: an.side() as i64,
+            dims: (an.width() as i64, an.height() as i64),
             levels: an.levels(),
         }
     }
@@ -217,7 +218,7 @@ impl<'a> Ctx<'a> {
         let lc = self.level_consts(l);
         let rs = Modulation::over(&self.controls, ext, lc.h, self.period);
         // What features impose on this level's pixels, drawn once (usually nothing).
-        let imposed = Imposed::draw(&self.controls, l, self.levels, ext, lc.h, lc.mask, self.period);
+        let imposed = Imposed::draw(&self.controls, l, self.levels, ext, lc.h, self.dims, self.period);
         let mut s = vec![0u32; lo.len()];
         s.par_chunks_mut(w).enumerate().with_min_len(8).for_each(|(j, row)| {
             let y = ext.y0 + j as i64;
@@ -244,10 +245,10 @@ impl<'a> Ctx<'a> {
 
         // Generations 1..: the correction subpasses (Jacobi: each reads the previous generation).
         if let Some(cl) = cl {
-            let m = self.m as usize;
+            let ew = self.dims.0 as usize;
             let pal: Vec<u32> =
                 self.an.colours8(l).iter().map(|c| c[0] as u32 | (c[1] as u32) << 8 | (c[2] as u32) << 16).collect();
-            let colour = |v: u32| pal[(v >> 16) as usize * m + (v & 0xFFFF) as usize];
+            let colour = |v: u32| pal[(v >> 16) as usize * ew + (v & 0xFFFF) as usize];
             let mut col: Vec<u32> = Vec::with_capacity(s.len());
             s.par_iter().map(|&v| colour(v)).collect_into_vec(&mut col);
             let proj: Vec<i32> = cl.proj.iter().map(|&v| v as i32).collect();
@@ -330,11 +331,16 @@ impl<'a> Ctx<'a> {
         LevelConsts {
             l,
             h,
-            mask: self.m - 1,
+            dims: self.dims,
             rq: self.r[l as usize] as i64,
             period: self.period.map(|n| n >> (self.levels - l)),
             jitter_head: head(key(TAG_JITTER, self.seed), l as i64),
-            lattice: self.an.header.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h, self.m as u32)),
+            lattice: self
+                .an
+                .header
+                .lattice
+                .as_ref()
+                .map_or(LevelLattice::FREE, |lat| lat.level(h, self.dims.0.max(self.dims.1) as u32)),
         }
     }
 
@@ -358,20 +364,21 @@ impl<'a> Ctx<'a> {
         let mut sy = (v >> 16) as i64 + off(par(y));
         if c.still() && c.lattice.is_free() {
             // Every jitter below rounds to 0 (`|hx| ≤ 2²³`, effective `r ≤ c.rq`).
-            return ((sx & c.mask) | ((sy & c.mask) << 16)) as u32;
+            return pack_wrapped(sx, sy, c.dims);
         }
         let (hx_, hy_) = match c.period {
             Some(n) => (x.rem_euclid(n), y.rem_euclid(n)),
             None => (x, y),
         };
         // Nor does a jump land inside a kept part (it would show it cut).
-        let kept = |jx: i64, jy: i64| self.mask.is_some_and(|mk| mk.at(c.l, (jx & c.mask) as u32, (jy & c.mask) as u32) == 0);
+        let (ew, eh) = c.dims;
+        let kept = |jx: i64, jy: i64| self.mask.is_some_and(|mk| mk.at(c.l, wrap(jx, ew) as u32, wrap(jy, eh) as u32) == 0);
         if !c.still() {
             // R_E (design note §1.9): the mask's minimum around the upsampled coordinate scales
             // this level's randomness (0 keeps the exemplar there).
             let rq = match self.mask {
                 Some(mk) if c.rq != 0 => {
-                    (c.rq * mk.at(c.l, (sx & c.mask) as u32, (sy & c.mask) as u32) as i64 + 127) / 255
+                    (c.rq * mk.at(c.l, wrap(sx, ew) as u32, wrap(sy, eh) as u32) as i64 + 127) / 255
                 }
                 _ => c.rq,
             };
@@ -394,13 +401,13 @@ impl<'a> Ctx<'a> {
             (sx, sy) = (sx + mx, sy + my);
         }
 
-        ((sx & c.mask) | ((sy & c.mask) << 16)) as u32
+        pack_wrapped(sx, sy, c.dims)
     }
 
     /// The correction kernel of level `l` for buffers `w` pixels wide.
     fn kernel<'k>(&self, l: u32, w: usize, proj: &'k [i32], cl: &'k CorrectionLevel) -> Kernel<'k> {
         let h = 1i64 << (self.levels - l);
-        let m = self.m as usize;
+        let (ew, eh) = (self.dims.0 as u32, self.dims.1 as u32);
         let taps: Vec<isize> = (-2..=2).flat_map(|dy| (-2..=2).map(move |dx| dy * w as isize + dx)).collect::<Vec<_>>();
         // Candidate neighbours: (0,0) first, then the other 8 in raster order.
         let mut nb: Vec<(i64, i64)> = vec![(0, 0)];
@@ -408,8 +415,8 @@ impl<'a> Ctx<'a> {
         let nb_off: Vec<(isize, u32, u32)> = nb
             .iter()
             .map(|&(dx, dy)| {
-                let sub = |d: i64| ((-(h * d)).rem_euclid(self.m)) as u32;
-                (dy as isize * w as isize + dx as isize, sub(dx), sub(dy))
+                let sub = |d: i64, n: u32| ((-(h * d)).rem_euclid(n as i64)) as u32;
+                (dy as isize * w as isize + dx as isize, sub(dx, ew), sub(dy, eh))
             })
             .collect();
         Kernel {
@@ -419,13 +426,14 @@ impl<'a> Ctx<'a> {
             pairs: projection_pairs(&cl.proj),
             run_pairs: projection_run_pairs(&cl.proj),
             cands: &cl.cands,
-            m,
-            mask: (m - 1) as u32,
+            ew,
+            eh,
             phi: self.phi,
             h: h as u32,
             edged: !self.an.header.toroidal,
-            span: tap_spans(m as u32, h as u32),
-            shift: tap_shifts(m as u32, h as u32),
+            span_x: tap_spans(ew, h as u32),
+            span_y: tap_spans(eh, h as u32),
+            shift: tap_shifts((ew, eh), h as u32),
         }
     }
 }
@@ -451,7 +459,7 @@ struct Imposed {
 impl Imposed {
     const NONE: u32 = u32::MAX;
 
-    fn draw(controls: &Controls, l: u32, levels: u32, rect: Rect, h: i64, mask: i64, period: Option<i64>) -> Imposed {
+    fn draw(controls: &Controls, l: u32, levels: u32, rect: Rect, h: i64, dims: (i64, i64), period: Option<i64>) -> Imposed {
         if controls.features.is_empty() {
             return Imposed { cells: Vec::new() };
         }
@@ -472,7 +480,7 @@ impl Imposed {
             for y in area.y0..area.y1 {
                 for x in area.x0..area.x1 {
                     if let Some((u, v)) = f.imposes(l, levels, x * h + h / 2, y * h + h / 2, period) {
-                        cells[((y - rect.y0) * w + (x - rect.x0)) as usize] = ((u & mask) | ((v & mask) << 16)) as u32;
+                        cells[((y - rect.y0) * w + (x - rect.x0)) as usize] = pack_wrapped(u, v, dims);
                     }
                 }
             }
@@ -521,7 +529,8 @@ impl Modulation {
 struct LevelConsts {
     l: u32,
     h: i64,
-    mask: i64,
+    /// The exemplar's width and height.
+    dims: (i64, i64),
     rq: i64,
     period: Option<i64>,
     /// The jitter hash with its tag, seed and level applied ([`crate::hash::head`]).

@@ -1,13 +1,14 @@
 //! `mode=tiling`: the exemplar repeated, as it is — the reference every synthesis is compared
 //! with (quality tables, "better-looking than tiling"). Native pixels are exemplar texels at
-//! `(x mod m, y mod m)`; a zoomed-out pixel is the exact box average of the texels it covers,
-//! which for an aligned power-of-two block is the exemplar's box mip, and the exemplar's mean
-//! once a pixel covers a whole period. Needs only the exemplar; seed and world change nothing
-//! (its period, the exemplar side, divides every allowed world).
+//! `(x mod w, y mod h)`: the tiling repeats at the exemplar's own width and height. A
+//! zoomed-out pixel is the exact box average of the `2^k × 2^k` texels it covers: a box on
+//! the exemplar's torus (for a power-of-two square, its box mip; the mean once a pixel covers
+//! a whole period). Needs only the exemplar; seed and world change nothing (a world's period
+//! is a multiple of a power-of-two exemplar's; any other exemplar repeats at its own size).
 
 use crate::cache::Pyramid;
 use crate::error::Result;
-use crate::image::{box_mip, Rendered, RgbWindow};
+use crate::image::{Integral, Rendered, RgbWindow};
 use crate::maps::{UvWindow, UV_SCALE};
 use crate::modes::params::check_period;
 use crate::modes::{check_window, Cost, Mode, Needs, Source, View};
@@ -24,10 +25,10 @@ crate::declare_params! {
     pub struct TilingParams {
         /// Accepted like every mode's; the tiling does not depend on it.
         pub seed: u64 { default: 0, canonical: none, seed }
-        /// Accepted like every mode's; every allowed period is a multiple of the exemplar side.
+        /// Accepted like every mode's; the tiling repeats at the exemplar's own size.
         pub period: Option<i64> { default: None, canonical: none, period }
     }
-    check(p, src) { check_period(p.period, src.side()) }
+    check(p, src) { check_period(p.period, src.longer_side()) }
 }
 
 impl Mode for Tiling {
@@ -44,16 +45,29 @@ impl Mode for Tiling {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
         let texels = src.texels();
-        let n = src.side() as usize;
-        let lvl = view.zoom_out.min(src.levels()) as usize;
-        let mip = if lvl == 0 { texels.to_vec() } else { box_mip(texels, n, lvl) };
-        let side = (n >> lvl) as i64;
+        let (ew, eh) = src.dims();
+        let lvl = view.zoom_out.min(src.levels());
         let (w, h) = (rect.width() as usize, rect.height() as usize);
         let mut pixels = Vec::with_capacity(3 * w * h);
-        for y in rect.y0..rect.y1 {
-            let row = y.rem_euclid(side) as usize * side as usize;
-            for x in rect.x0..rect.x1 {
-                pixels.extend_from_slice(&mip[row + x.rem_euclid(side) as usize]);
+        if lvl == 0 {
+            for y in rect.y0..rect.y1 {
+                let row = y.rem_euclid(eh as i64) as usize * ew;
+                for x in rect.x0..rect.x1 {
+                    pixels.extend_from_slice(&texels[row + x.rem_euclid(ew as i64) as usize]);
+                }
+            }
+        } else {
+            // Pixel `x` covers texels `[x·f, (x + 1)·f)` of the tiled plane: the box centred on
+            // `x·f + f/2`, on the exemplar's torus.
+            let f = 1i64 << lvl;
+            let sums = Integral::new(texels, (ew, eh), f as usize);
+            let centre = |v: i64, n: usize| (v * f + f / 2).rem_euclid(n as i64) as usize;
+            let xs: Vec<usize> = (rect.x0..rect.x1).map(|x| centre(x, ew)).collect();
+            for y in rect.y0..rect.y1 {
+                let cy = centre(y, eh);
+                for &cx in &xs {
+                    pixels.extend_from_slice(&sums.mean_around(cx, cy));
+                }
             }
         }
         let image = RgbWindow { width: w as u32, height: h as u32, pixels };
@@ -65,10 +79,11 @@ impl Mode for Tiling {
     fn coordinates(_: &TilingParams, _: &(), src: &Source, _: &Pyramid, view: View) -> Result<UvWindow> {
         let rect = view.rect;
         check_window(rect, MAX_PIXELS)?;
-        let period = (src.side() * UV_SCALE) as i64;
+        let (ew, eh) = src.dims();
         let lvl = view.zoom_out.min(src.levels());
-        // A pixel's centre along an axis, in 1/UV_SCALE texel, on the exemplar.
-        let at = |x: i64| -> u16 {
+        // A pixel's centre along an axis of `n` texels, in 1/UV_SCALE texel, on the exemplar.
+        let at = |x: i64, n: usize| -> u16 {
+            let period = (n as u32 * UV_SCALE) as i64;
             let c = if view.zoom_in > 0 {
                 ((2 * x + 1) * (UV_SCALE as i64 / 2)) >> view.zoom_in
             } else if lvl < src.levels() {
@@ -78,8 +93,8 @@ impl Mode for Tiling {
             };
             c.rem_euclid(period) as u16
         };
-        let xs: Vec<u16> = (rect.x0..rect.x1).map(at).collect();
-        let uv = (rect.y0..rect.y1).flat_map(|y| xs.iter().map(move |&u| [u, at(y)])).collect();
+        let xs: Vec<u16> = (rect.x0..rect.x1).map(|x| at(x, ew)).collect();
+        let uv = (rect.y0..rect.y1).flat_map(|y| xs.iter().map(move |&u| [u, at(y, eh)])).collect();
         Ok(UvWindow { width: rect.width() as u32, height: rect.height() as u32, uv })
     }
 }

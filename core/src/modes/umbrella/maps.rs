@@ -62,7 +62,7 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../config/exemplars/gravel.png");
         let ex = Exemplar::from_bytes(&std::fs::read(path).unwrap(), &ExemplarOptions::default()).unwrap();
         let (el, _) = super::super::elements(&ex).unwrap();
-        let same = el.of_map(&ex.pixels, ex.side as usize, false);
+        let same = el.of_map(&ex.pixels, ex.width as usize, false);
         for (a, b) in el.bases.iter().zip(&same.bases) {
             assert_eq!(a.texture, b.texture, "the re-cut crop is the colour's crop");
             assert!(b.variants.iter().all(|v| v.colour == [[0.0; 3]; RAYS + 1]));

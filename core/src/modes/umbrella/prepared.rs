@@ -15,7 +15,7 @@ use super::store::{self, Outcome};
 use crate::progress::Progress;
 use crate::cancel::Cancel;
 use crate::error::{AnalysisFileProblem, CoreError, Result};
-use crate::exemplar::Exemplar;
+use crate::exemplar::{centred_square, Exemplar};
 use crate::maps::MaterialMap;
 use crate::prepare::{Input, Preparation, Setting};
 
@@ -56,7 +56,7 @@ impl Extraction {
         if self.handmade.is_some() {
             return Err(fail("cannot be rendered with a hand-made umbrella set (`set`): its elements were not cut from the exemplar"));
         }
-        if map.side() != ex.side {
+        if map.dims() != ex.dims() {
             return Err(fail("is not the exemplar's size"));
         }
         let id = format!("{id}~{}", map.hash);
@@ -64,7 +64,8 @@ impl Extraction {
         if let Some((_, e)) = maps.iter().find(|(h, _)| *h == map.hash) {
             return Ok((e.clone(), id));
         }
-        let e = Arc::new(el.of_map(&map.texels, ex.side as usize, map.normal));
+        let (texels, side) = centred_square(&map.texels, map.dims());
+        let e = Arc::new(el.of_map(&texels, side, map.normal));
         maps.push((map.hash.clone(), e.clone()));
         Ok((e, id))
     }
@@ -75,9 +76,13 @@ impl Extraction {
         Ok((el, self.id.clone()))
     }
 
-    /// Extract the elements of `ex`, now.
+    /// Extract the elements of `ex`, now: of a non-square exemplar, from its largest centred
+    /// square ([`centred_square`]; elements are cut from a square image), which wraps only
+    /// when it is the whole exemplar.
     pub fn extract(ex: &Exemplar) -> Extraction {
-        let outcome = match extract::extract(&ex.pixels, ex.side as usize, ex.toroidal) {
+        let (square, side) = centred_square(&ex.pixels, ex.dims());
+        let toroidal = ex.toroidal && ex.width == ex.height;
+        let outcome = match extract::extract(&square, side, toroidal) {
             Ok(e) => Ok(Arc::new(e)),
             Err(CoreError::Param { message, .. }) => Err(message),
             Err(e) => Err(e.to_string()),

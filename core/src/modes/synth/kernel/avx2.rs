@@ -51,8 +51,11 @@ impl Kernel<'_> {
             || nb.w < 2
             || (start as isize + lo) < 0
             || last as isize + hi >= s.len() as isize
-            || self.cands.len() < self.m * self.m
-            || self.m > crate::exemplar::MAX_SIDE as usize
+            || self.cands.len() < self.ew as usize * self.eh as usize
+            || self.ew.max(self.eh) > crate::exemplar::MAX_SIDE
+            // An exemplar at most `4h` across has every texel near an edge: the vector test
+            // of [`Kernel::near_edge_avx2`] assumes some are not.
+            || (self.edged && self.ew.min(self.eh) <= 4 * self.h)
         {
             return self.row_portable(s, col, start, step, out);
         }
@@ -105,7 +108,7 @@ impl Kernel<'_> {
         use std::arch::x86_64::*;
         let (mut texel, mut coord) = ([0u32; 9], [[0u32; 9]; 2]);
         let v = s[idx];
-        texel[0] = (v >> 16) * self.m as u32 + (v & 0xFFFF);
+        texel[0] = (v >> 16) * self.ew + (v & 0xFFFF);
         // The eight neighbours are three runs of the buffer: loaded as rows (a gather's
         // latency was a tenth of the kernel's time) and put in raster order.
         // SAFETY: `row_avx2` checked that `idx − w − 1` and `idx + w + 1` lie inside `s`, for
@@ -123,12 +126,21 @@ impl Kernel<'_> {
             _mm_blend_epi32::<0b0001>(below, _mm_shuffle_epi32::<2>(middle)),
             _mm_blend_epi32::<0b1000>(above, _mm_shuffle_epi32::<0>(middle)),
         );
-        let vx = _mm256_and_si256(_mm256_add_epi32(_mm256_and_si256(v, nb.low), nb.subx), nb.mask);
-        let vy = _mm256_and_si256(_mm256_add_epi32(_mm256_srli_epi32(v, 16), nb.suby), nb.mask);
-        let t = _mm256_or_si256(_mm256_sll_epi32(vy, nb.log2m), vx);
+        // Each coordinate plus its shift, wrapped once: less the side where it reached it.
+        let wrap = |v: __m256i, last: __m256i, side: __m256i| {
+            _mm256_sub_epi32(v, _mm256_and_si256(_mm256_cmpgt_epi32(v, last), side))
+        };
+        let vx = wrap(_mm256_add_epi32(_mm256_and_si256(v, nb.low), nb.subx), nb.last_x, nb.w_side);
+        let vy = wrap(_mm256_add_epi32(_mm256_srli_epi32(v, 16), nb.suby), nb.last_y, nb.h_side);
+        // Row-major texel index: a shift for a power-of-two width (a multiply's latency sits
+        // on the gathers' critical path), else a multiply.
+        let t = match nb.log2w {
+            Some(log2w) => _mm256_or_si256(_mm256_sll_epi32(vy, log2w), vx),
+            None => _mm256_add_epi32(_mm256_mullo_epi32(vy, nb.w_side), vx),
+        };
         // SAFETY (all four): 8 u32 = 256 bits at `texel[1..]`, `coord[k][1..]`; the gathered
-        // texels are below `m²` (both coordinates masked) and `row_avx2` checked that `cands`
-        // holds `m²` pairs of five-u32 candidates.
+        // texels are below `w·h` (both coordinates wrapped) and `row_avx2` checked that
+        // `cands` holds `w·h` pairs of five-u32 candidates.
         unsafe { _mm256_storeu_si256(texel[1..].as_mut_ptr() as *mut __m256i, t) };
         // Candidate pairs are 40 bytes apart; `coord` lies at the same offset in each.
         let base = unsafe { (self.cands.as_ptr() as *const u8).add(std::mem::offset_of!(Candidate, coord)) };
@@ -217,13 +229,15 @@ impl Kernel<'_> {
     fn near_edge_avx2(&self, v: std::arch::x86_64::__m256i) -> u32 {
         use std::arch::x86_64::*;
         let b = _mm256_set1_epi32((2 * self.h) as i32);
-        // `v − 2h < m − 4h` (unsigned) ⇔ `min(v − 2h, m − 4h − 1) = v − 2h`.
-        let last = _mm256_set1_epi32((self.m as u32 - 4 * self.h - 1) as i32);
+        // `v − 2h < w − 4h` (unsigned) ⇔ `min(v − 2h, w − 4h − 1) = v − 2h` (`row_avx2` checked
+        // that `w, h > 4h`).
+        let last_x = _mm256_set1_epi32((self.ew - 4 * self.h - 1) as i32);
+        let last_y = _mm256_set1_epi32((self.eh - 4 * self.h - 1) as i32);
         let x = _mm256_sub_epi32(_mm256_and_si256(v, _mm256_set1_epi32(0xFFFF)), b);
         let y = _mm256_sub_epi32(_mm256_srli_epi32(v, 16), b);
         let inside = _mm256_and_si256(
-            _mm256_cmpeq_epi32(_mm256_min_epu32(x, last), x),
-            _mm256_cmpeq_epi32(_mm256_min_epu32(y, last), y),
+            _mm256_cmpeq_epi32(_mm256_min_epu32(x, last_x), x),
+            _mm256_cmpeq_epi32(_mm256_min_epu32(y, last_y), y),
         );
         !(_mm256_movemask_ps(_mm256_castsi256_ps(inside)) as u32) & 0xFF
     }
@@ -279,9 +293,14 @@ struct Neighbours {
     w: usize,
     subx: std::arch::x86_64::__m256i,
     suby: std::arch::x86_64::__m256i,
-    mask: std::arch::x86_64::__m256i,
+    /// The exemplar's width and height, and each less one.
+    w_side: std::arch::x86_64::__m256i,
+    h_side: std::arch::x86_64::__m256i,
+    last_x: std::arch::x86_64::__m256i,
+    last_y: std::arch::x86_64::__m256i,
     low: std::arch::x86_64::__m256i,
-    log2m: std::arch::x86_64::__m128i,
+    /// `log2` of a power-of-two width.
+    log2w: Option<std::arch::x86_64::__m128i>,
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -298,9 +317,12 @@ impl Neighbours {
             w: k.nb_off[7].0.unsigned_abs(),
             subx: lane(&|n| n.1 as i32),
             suby: lane(&|n| n.2 as i32),
-            mask: _mm256_set1_epi32(k.mask as i32),
+            w_side: _mm256_set1_epi32(k.ew as i32),
+            h_side: _mm256_set1_epi32(k.eh as i32),
+            last_x: _mm256_set1_epi32(k.ew as i32 - 1),
+            last_y: _mm256_set1_epi32(k.eh as i32 - 1),
             low: _mm256_set1_epi32(0xFFFF),
-            log2m: _mm_cvtsi32_si128(k.m.trailing_zeros() as i32),
+            log2w: k.ew.is_power_of_two().then(|| _mm_cvtsi32_si128(k.ew.trailing_zeros() as i32)),
         }
     }
 }
@@ -310,8 +332,9 @@ impl Neighbours {
 struct Coherence {
     /// Per row of taps, the shifts of its five taps (lanes 5–7 unused).
     shift: [std::arch::x86_64::__m256i; 5],
-    /// Both packed coordinates' masks.
-    mask: std::arch::x86_64::__m256i,
+    /// Both packed coordinates' largest values (`w − 1 | (h − 1) << 16`) and sides.
+    last: std::arch::x86_64::__m256i,
+    sides: std::arch::x86_64::__m256i,
     /// Lanes 0–4 of a row: loaded and compared.
     lanes: std::arch::x86_64::__m256i,
 }
@@ -327,7 +350,8 @@ impl Coherence {
         };
         Coherence {
             shift: std::array::from_fn(|r| load(std::array::from_fn(|c| if c < 5 { k.shift[5 * r + c] } else { 0 }))),
-            mask: _mm256_set1_epi32((k.mask | k.mask << 16) as i32),
+            last: _mm256_set1_epi32((k.ew - 1 | (k.eh - 1) << 16) as i32),
+            sides: _mm256_set1_epi32((k.ew | k.eh << 16) as i32),
             lanes: load(std::array::from_fn(|c| if c < 5 { u32::MAX } else { 0 })),
         }
     }
@@ -345,7 +369,9 @@ impl Coherence {
             let Some(run) = s.get(at..at + 5) else { return k.coherent(idx, s) };
             // SAFETY: only lanes 0–4 are read (`lanes`), all inside `run`.
             let got = unsafe { _mm256_maskload_epi32(run.as_ptr() as *const i32, self.lanes) };
-            let want = _mm256_and_si256(_mm256_add_epi32(v, self.shift[r]), self.mask);
+            // Both 16-bit halves wrapped once (each below 2¹⁰: the signed compare is right).
+            let sum = _mm256_add_epi32(v, self.shift[r]);
+            let want = _mm256_sub_epi16(sum, _mm256_and_si256(_mm256_cmpgt_epi16(sum, self.last), self.sides));
             if _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(got, want))) & 0x1F != 0x1F {
                 return false;
             }

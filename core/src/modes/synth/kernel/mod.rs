@@ -46,7 +46,8 @@ fn partial_weight(inner: &InnerTaps) -> u64 {
 pub(crate) struct Kernel<'a> {
     /// Buffer offsets of the 5×5 neighbourhood, raster order.
     pub taps: [isize; TAPS5],
-    /// Buffer offset and exemplar shift `−h·Δ mod m` (x, y) of the 9 candidate neighbours.
+    /// Buffer offset and exemplar shift `−h·Δ` (x mod the width, y mod the height) of the 9
+    /// candidate neighbours.
     pub nb_off: [(isize, u32, u32); 9],
     /// Projection widened to i32, `[tap][channel][dim]`.
     pub proj: &'a [i32],
@@ -57,32 +58,50 @@ pub(crate) struct Kernel<'a> {
     /// and then (2, 3), one row of `(left, right)` weights per dimension for each channel.
     pub run_pairs: [[i16; 2 * RUNTIME_DIMS]; 30],
     pub cands: &'a [[Candidate; 2]],
-    pub m: usize,
-    pub mask: u32,
+    /// Exemplar width.
+    pub ew: u32,
+    /// Exemplar height.
+    pub eh: u32,
     pub phi: [u64; 2],
     /// Stride `h` of the level.
     pub h: u32,
     /// Whether the exemplar has edges (not toroidal): candidates within `2h` of one are
     /// compared over their real texels only.
     pub edged: bool,
-    /// Per exemplar coordinate `v` along either axis, the first and one past the last tap (of
-    /// five, stride `h`) around `v` inside the exemplar (read only when `edged`).
-    pub span: Vec<[u8; 2]>,
-    /// Per tap `Δ` (raster order), the packed exemplar shift `hΔ mod m` that a coherent
+    /// Per exemplar column `x`, the first and one past the last tap (of five, stride `h`)
+    /// around `x` inside the exemplar (read only when `edged`).
+    pub span_x: Vec<[u8; 2]>,
+    /// The same per exemplar row.
+    pub span_y: Vec<[u8; 2]>,
+    /// Per tap `Δ` (raster order), the packed exemplar shift `hΔ` (wrapped) that a coherent
     /// neighbourhood shows there ([`tap_shifts`]).
     pub shift: [u32; TAPS5],
 }
 
-/// [`Kernel::shift`] for an `m × m` exemplar at stride `h`: `(h·dx mod m) | (h·dy mod m) << 16`
-/// for the taps `(dx, dy)` of the 5×5 neighbourhood in raster order.
-pub(crate) fn tap_shifts(m: u32, h: u32) -> [u32; TAPS5] {
-    let at = |d: i64| (d * h as i64).rem_euclid(m as i64) as u32;
-    std::array::from_fn(|t| at(t as i64 % 5 - 2) | at(t as i64 / 5 - 2) << 16)
+/// [`Kernel::shift`] for a `w × h` exemplar at stride `stride`: `(s·dx mod w) | (s·dy mod h)
+/// << 16` for the taps `(dx, dy)` of the 5×5 neighbourhood in raster order.
+pub(crate) fn tap_shifts((w, h): (u32, u32), stride: u32) -> [u32; TAPS5] {
+    let at = |d: i64, n: u32| (d * stride as i64).rem_euclid(n as i64) as u32;
+    std::array::from_fn(|t| at(t as i64 % 5 - 2, w) | at(t as i64 / 5 - 2, h) << 16)
 }
 
-/// [`Kernel::span`] for an `m × m` exemplar at stride `h`.
-pub(crate) fn tap_spans(m: u32, h: u32) -> Vec<[u8; 2]> {
-    (0..m).map(|v| InnerTaps::around(v, 0, h, m)).map(|t| [t.c0, t.c1]).collect()
+/// [`Kernel::span_x`] (or `span_y`) for an axis of `n` texels at stride `h`.
+pub(crate) fn tap_spans(n: u32, h: u32) -> Vec<[u8; 2]> {
+    (0..n).map(|v| InnerTaps::around(v, 0, h, (n, n))).map(|t| [t.c0, t.c1]).collect()
+}
+
+/// `a + b` for packed coordinates `x | y << 16` with each part below the exemplar's side
+/// (`w`, `h`): the sum of the parts, wrapped once.
+#[inline(always)]
+pub(crate) fn add_wrapped(a: u32, b: u32, w: u32, h: u32) -> u32 {
+    let mut t = a + b;
+    if t & 0xFFFF >= w {
+        t -= w;
+    }
+    if t >> 16 >= h {
+        t -= h << 16;
+    }
+    t
 }
 
 // The gathers of `Kernel::candidates_avx2` address candidate pairs 40 bytes apart.
@@ -109,7 +128,7 @@ impl Kernel<'_> {
     }
 
     /// Whether the 5×5 neighbourhood of the pixel at buffer index `idx` is coherent: every tap
-    /// `Δ` holds `s[idx] + hΔ` (mod `m`). Such a pixel keeps its texel, exactly as the search
+    /// `Δ` holds `s[idx] + hΔ` (wrapped). Such a pixel keeps its texel, exactly as the search
     /// would decide: its neighbourhood's feature is the stored feature of `s[idx]` (the same
     /// colours and integer sums, over the same taps near an edge), so that candidate's
     /// distance is 0; and the first candidates of its 3×3 neighbours, which come first in the
@@ -119,9 +138,11 @@ impl Kernel<'_> {
     #[inline(always)]
     pub(super) fn coherent(&self, idx: usize, s: &[u32]) -> bool {
         let v = s[idx];
-        let both = self.mask | self.mask << 16;
-        // `x + (h·dx mod m) < 2m ≤ 2¹⁶`: the sum of packed coordinates carries nothing across.
-        self.taps.iter().zip(&self.shift).all(|(&off, &sh)| s[(idx as isize + off) as usize] == (v + sh) & both)
+        // `x + (h·dx mod w) < 2w ≤ 2¹⁶`: the sum of packed coordinates carries nothing across.
+        self.taps
+            .iter()
+            .zip(&self.shift)
+            .all(|(&off, &sh)| s[(idx as isize + off) as usize] == add_wrapped(v, sh, self.ew, self.eh))
     }
 }
 

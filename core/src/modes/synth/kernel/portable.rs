@@ -38,8 +38,9 @@ impl Kernel<'_> {
     #[inline(always)]
     pub(super) fn near_edge(&self, coord: u32) -> bool {
         let (x, y) = (coord & 0xFFFF, coord >> 16);
-        let (b, inner) = (2 * self.h, self.m as u32 - 4 * self.h);
-        self.edged & ((x.wrapping_sub(b) >= inner) | (y.wrapping_sub(b) >= inner))
+        let b = 2 * self.h;
+        let (inner_x, inner_y) = (self.ew.saturating_sub(4 * self.h), self.eh.saturating_sub(4 * self.h));
+        self.edged & ((x.wrapping_sub(b) >= inner_x) | (y.wrapping_sub(b) >= inner_y))
     }
 
     /// Which taps a candidate at packed exemplar coordinate `coord` is compared over: `None`
@@ -53,7 +54,7 @@ impl Kernel<'_> {
     /// non-toroidal exemplar ([`InnerTaps::around`], looked up per axis).
     #[inline(always)]
     pub(super) fn inner_of(&self, coord: u32) -> InnerTaps {
-        let ([r0, r1], [c0, c1]) = (self.span[(coord >> 16) as usize], self.span[(coord & 0xFFFF) as usize]);
+        let ([r0, r1], [c0, c1]) = (self.span_y[(coord >> 16) as usize], self.span_x[(coord & 0xFFFF) as usize]);
         InnerTaps { r0, r1, c0, c1 }
     }
 
@@ -65,10 +66,8 @@ impl Kernel<'_> {
         let mut best = (u64::MAX, s[idx]);
         for (k, &phi_k) in self.phi.iter().enumerate() {
             for &(off, subx, suby) in &self.nb_off {
-                let v = s[(idx as isize + off) as usize];
-                let vx = ((v & 0xFFFF) + subx) & self.mask;
-                let vy = ((v >> 16) + suby) & self.mask;
-                let cand = &self.cands[vy as usize * self.m + vx as usize][k];
+                let v = add_wrapped(s[(idx as isize + off) as usize], subx | suby << 16, self.ew, self.eh);
+                let cand = &self.cands[(v >> 16) as usize * self.ew as usize + (v & 0xFFFF) as usize][k];
                 let (q, weight) = match self.inner_taps(cand.coord) {
                     None => (ns, FULL_WEIGHT),
                     Some(t) => (
