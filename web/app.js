@@ -228,7 +228,7 @@ function control(name, spec) {
     // Synth's spatial controls: noise, features dragged from the thumbnail, painted strokes
     // (web/controls.js).
     box.append(TextileControls.editor({
-      map, side: meta.exemplar.width, scale: 2 ** native(), thumb: $('thumb'), value: given, slider, changed,
+      map, width: meta.exemplar.width, height: meta.exemplar.height, scale: 2 ** native(), thumb: $('thumb'), value: given, slider, changed,
       set: (v) => { if (v) state.p[name] = v; else delete state.p[name]; },
     }));
   } else if (spec.type === 'choice') {
@@ -366,11 +366,18 @@ function drawLatticeOn(ctx, side, k, lat) {
 
 function showStructure() {
   const canvas = $('thumblattice');
+  // The thumbnail keeps the exemplar's shape: its longer side 64 px, the overlay at twice that.
+  const [w, h] = meta ? [meta.exemplar.width, meta.exemplar.height] : [1, 1];
+  const [tw, th] = [Math.round((64 * w) / Math.max(w, h)), Math.round((64 * h) / Math.max(w, h))];
+  $('thumb').width = tw;
+  $('thumb').height = th;
+  Object.assign(canvas.style, { width: `${tw}px`, height: `${th}px` });
+  [canvas.width, canvas.height] = [2 * tw, 2 * th];
   const ctx = canvas.getContext('2d');
   ctx.clearRect(0, 0, canvas.width, canvas.height);
   const st = meta && meta.structure;
-  const side = meta ? meta.exemplar.width : 1;
-  const k = canvas.width / side;
+  const side = Math.max(w, h);
+  const k = canvas.width / w;
   ctx.lineWidth = 2;
   let text = '';
   if (!st) {

@@ -43,7 +43,7 @@ window.TextileControls = (() => {
   }
 
   /**
-   * Build the editor for the current texture. `o`: map, side (exemplar texels), scale
+   * Build the editor for the current texture. `o`: map, width and height (exemplar texels), scale
    * (texels per map unit), thumb (the exemplar image element), value (the parameter as given),
    * set(value|null) (store it, no refresh), changed() (refresh the tiles, debounced) and
    * slider(...) (the panel's slider maker). Returns the panel element.
@@ -55,7 +55,7 @@ window.TextileControls = (() => {
     const ctl = decode(o.value);
     // Features of another exemplar (a larger one) cannot be served here.
     const given = ctl.features.length;
-    ctl.features = ctl.features.filter((f) => f.source && f.source[0] < o.side && f.source[1] < o.side);
+    ctl.features = ctl.features.filter((f) => f.source && f.source[0] < o.width && f.source[1] < o.height);
     const overlay = L.layerGroup().addTo(o.map);
     const toLatLng = (x, y) => L.latLng(-y / o.scale, x / o.scale);
     const texel = (ll) => [Math.round(ll.lng * o.scale), Math.round(-ll.lat * o.scale)];
@@ -118,8 +118,8 @@ window.TextileControls = (() => {
     on(o.thumb, 'pointerdown', (e) => {
       e.preventDefault();
       const r = o.thumb.getBoundingClientRect();
-      const u = Math.min(o.side - 1, Math.max(0, Math.floor(((e.clientX - r.left) / r.width) * o.side)));
-      const v = Math.min(o.side - 1, Math.max(0, Math.floor(((e.clientY - r.top) / r.height) * o.side)));
+      const u = Math.min(o.width - 1, Math.max(0, Math.floor(((e.clientX - r.left) / r.width) * o.width)));
+      const v = Math.min(o.height - 1, Math.max(0, Math.floor(((e.clientY - r.top) / r.height) * o.height)));
       picked = [u, v];
       o.thumb.setPointerCapture(e.pointerId);
       document.body.classList.add('placing');

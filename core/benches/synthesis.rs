@@ -2,7 +2,9 @@
 //! 256×256 native window (full padded pyramid, nothing cached) and its coordinates alone (the
 //! difference is the seam blend), the same with a randomness
 //! mask and with request controls (noise and 64 strokes), a zoomed-out tile, a tile magnified one zoom step beyond native, and a 1024×1024 window (report its time ÷ 16 as the cost per 256² of output); chaos-mosaic 256² and
-//! 512² windows; cold 256² umbrella tiles from native zoom to the exemplar's minzoom.
+//! 512² windows; cold 256² umbrella tiles from native zoom to the exemplar's minzoom; and cold
+//! 256² native windows from exemplars of other shapes (`shape/128x128`, `shape/100x100`,
+//! `shape/300x200`: the cost per output pixel of an exemplar at its own size).
 //!
 //! `cargo bench -p textile-core --bench synthesis`
 
@@ -16,6 +18,10 @@ use textile_core::modes::synth::{render, synthesize, Synth, SynthParams};
 use textile_core::{Analysis, Exemplar, ExemplarOptions, Mode, NoProgress, Pyramid, Rect, Source};
 
 fn exemplar(side: u32) -> Exemplar {
+    shaped(side, side)
+}
+
+fn shaped(w: u32, h: u32) -> Exemplar {
     // The 256² gravel of the development set, area-resampled to the side wanted.
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/exemplars/gravel_256.png");
     let bytes = std::fs::read(&path)
@@ -28,9 +34,26 @@ fn exemplar(side: u32) -> Exemplar {
         })
         .expect("an exemplar");
     let img = image::load_from_memory(&bytes).expect("decode").to_rgba8();
-    let img = image::imageops::resize(&img, side, side, image::imageops::FilterType::Triangle);
+    let img = image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle);
     let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
-    Exemplar::from_rgba(side, side, &px, &ExemplarOptions::default())
+    Exemplar::from_rgba(w, h, &px, &ExemplarOptions::default())
+}
+
+fn shapes(c: &mut Criterion) {
+    let mut g = c.benchmark_group("shape");
+    g.sample_size(30).measurement_time(Duration::from_secs(10));
+    let p = SynthParams::default();
+    for (w, h) in [(128u32, 128u32), (100, 100), (300, 200)] {
+        let an = Analysis::build(&shaped(w, h), &NoProgress);
+        let mut i = 0i64;
+        g.bench_function(format!("{w}x{h}"), |b| {
+            b.iter(|| {
+                i += 1;
+                render(&an, &p, 0, Rect::new(256 * i, -256 * i, 256, 256)).unwrap()
+            })
+        });
+    }
+    g.finish();
 }
 
 fn analysis(c: &mut Criterion) {
@@ -176,5 +199,5 @@ fn umbrella(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, analysis, windows, mosaic, umbrella);
+criterion_group!(benches, analysis, windows, mosaic, umbrella, shapes);
 criterion_main!(benches);

@@ -37,6 +37,11 @@ fn main() {
         });
         let class = d.class().name();
         let found = d.lattice.map_or("none".to_string(), |l| l.to_string());
-        println!("{path} ({}x{}): {class}:{repeat} {found} | ridges {} | {ms:.0} ms", ex.width, ex.height, ridges.join("; "));
+        println!(
+            "{path} ({}x{}): {class}:{repeat} {found} | ridges {} | {ms:.0} ms",
+            ex.width,
+            ex.height,
+            ridges.join("; ")
+        );
     }
 }

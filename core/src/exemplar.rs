@@ -403,7 +403,8 @@ pub fn prepared_size(w: u32, h: u32) -> (u32, u32) {
     if long <= MAX_SIDE {
         return (w, h);
     }
-    let scale = |s: u32| ((s as u64 * MAX_SIDE as u64 + long as u64 / 2) / long as u64).max(MIN_INPUT_SIDE as u64) as u32;
+    let scale =
+        |s: u32| ((s as u64 * MAX_SIDE as u64 + long as u64 / 2) / long as u64).max(MIN_INPUT_SIDE as u64) as u32;
     (scale(w), scale(h))
 }
 

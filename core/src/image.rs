@@ -142,8 +142,10 @@ impl Integral {
     pub(crate) fn mean_around(&self, x: usize, y: usize) -> [u8; 3] {
         let (f, sw) = (self.f, self.w + self.f + 1);
         let half = (f / 2) as i64;
-        let (x0, y0) =
-            ((x as i64 - half).rem_euclid(self.w as i64) as usize, (y as i64 - half).rem_euclid(self.h as i64) as usize);
+        let (x0, y0) = (
+            (x as i64 - half).rem_euclid(self.w as i64) as usize,
+            (y as i64 - half).rem_euclid(self.h as i64) as usize,
+        );
         let at = |x: usize, y: usize| self.sums[y * sw + x];
         let (a, b, c, d) = (at(x0, y0), at(x0 + f, y0), at(x0, y0 + f), at(x0 + f, y0 + f));
         // `f` is a power of two: dividing by the area is a shift.

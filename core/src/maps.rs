@@ -284,7 +284,8 @@ mod tests {
         assert!(MaterialMap::new("normal", (64, 64), flat, None, Some(NormalConvention::OpenGl)).is_ok());
         // All black (the hostile run's upload), all white, and pointing down.
         for c in [[0, 0, 0], [255, 255, 255], [128, 128, 20]] {
-            let e = MaterialMap::new("normal", (64, 64), vec![c; 64 * 64], None, Some(NormalConvention::OpenGl)).unwrap_err();
+            let e = MaterialMap::new("normal", (64, 64), vec![c; 64 * 64], None, Some(NormalConvention::OpenGl))
+                .unwrap_err();
             assert!(e.to_string().contains("normal") && e.to_string().contains("100 %"), "{c:?}: {e}");
         }
         // A few wrong texels are tolerated; a height map is not checked as one.

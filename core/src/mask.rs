@@ -146,7 +146,8 @@ mod tests {
                         for dy in -h / 2..(h - h / 2) {
                             for dx in -h / 2..(h - h / 2) {
                                 let at = |v: i64, n: i64| if toroidal { v.rem_euclid(n) } else { v.clamp(0, n - 1) };
-                                best = best.min(values[(at(y + dy, rows as i64) * m as i64 + at(x + dx, m as i64)) as usize]);
+                                best = best
+                                    .min(values[(at(y + dy, rows as i64) * m as i64 + at(x + dx, m as i64)) as usize]);
                             }
                         }
                         assert_eq!(mask.at(l, x as u32, y as u32), best, "l {l} ({x}, {y}) toroidal {toroidal}");

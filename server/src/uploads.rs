@@ -343,7 +343,9 @@ pub fn analysis_bytes(texels: u64) -> u64 {
 pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
     tokio::spawn(async move {
         let Ok(_permit) = st.analyses.clone().acquire_owned().await else { return };
-        let Some(_memory) = st.reserve_patiently(analysis_bytes(tex.exemplar.pixels.len() as u64)).await else { return };
+        let Some(_memory) = st.reserve_patiently(analysis_bytes(tex.exemplar.pixels.len() as u64)).await else {
+            return;
+        };
         if tex.removed.is_set() || st.stopping.is_set() {
             return;
         }

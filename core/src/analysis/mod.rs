@@ -260,7 +260,8 @@ impl Analysis {
                 Ok(())
             };
             let h = 1 << (levels - l);
-            let phase = ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, ex.width.max(ex.height)));
+            let phase =
+                ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, ex.width.max(ex.height)));
             let rules = CandidateRules::new(dims, ex.toroidal).with_phase(phase).without_copies(ex.repeat.as_ref());
             corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search, &between)?);
         }

@@ -142,7 +142,8 @@ pub fn patch_points(coords: &[u32], (w, h): (u32, u32), k: u32, rect: Rect) -> U
             let fx = 2 * x + 1 - ((2 * qx) << k);
             let v = coords[(qy - src.y0) as usize * sw + (qx - src.x0) as usize];
             let (sx, sy) = ((v & 0xFFFF) as i64, (v >> 16) as i64);
-            let at = |s: i64, f: i64, m: u32| (s * UV_SCALE as i64 + f * unit).clamp(0, (m * UV_SCALE) as i64 - 1) as u16;
+            let at =
+                |s: i64, f: i64, m: u32| (s * UV_SCALE as i64 + f * unit).clamp(0, (m * UV_SCALE) as i64 - 1) as u16;
             uv.push([at(sx, fx, w), at(sy, fy, h)]);
         }
     }

@@ -107,7 +107,7 @@ pub struct AnalyzeArgs {
     #[arg(long, default_value_t = 1024)]
     pub max_side: u32,
     /// The lattice of a near-regular exemplar: auto (detected), none, NX,NY cells of a
-    /// rectified exemplar (powers of two dividing its side; implies toroidal), or
+    /// rectified exemplar (counts dividing its width and height; implies toroidal), or
     /// PERIOD@ANGLE[,PERIOD@ANGLE] waves (texels, degrees of the normal).
     #[arg(long, value_name = "LATTICE", default_value = "auto", value_parser = lattice_choice)]
     pub lattice: LatticeChoice,
@@ -157,7 +157,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "auto", value_parser = index_choice, requires = "exemplar")]
     pub index: IndexChoice,
     /// The lattice of a near-regular exemplar (with --exemplar): auto (detected), none, NX,NY
-    /// cells of a rectified exemplar (powers of two dividing its side; implies toroidal), or
+    /// cells of a rectified exemplar (counts dividing its width and height; implies toroidal), or
     /// PERIOD@ANGLE[,PERIOD@ANGLE] waves (texels, degrees of the normal); the output keeps it.
     #[arg(long, value_name = "LATTICE", default_value = "auto", value_parser = lattice_choice, requires = "exemplar")]
     pub lattice: LatticeChoice,

@@ -350,7 +350,7 @@ impl Coherence {
         };
         Coherence {
             shift: std::array::from_fn(|r| load(std::array::from_fn(|c| if c < 5 { k.shift[5 * r + c] } else { 0 }))),
-            last: _mm256_set1_epi32((k.ew - 1 | (k.eh - 1) << 16) as i32),
+            last: _mm256_set1_epi32(((k.ew - 1) | ((k.eh - 1) << 16)) as i32),
             sides: _mm256_set1_epi32((k.ew | k.eh << 16) as i32),
             lanes: load(std::array::from_fn(|c| if c < 5 { u32::MAX } else { 0 })),
         }
