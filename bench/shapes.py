@@ -75,9 +75,10 @@ for i, n in enumerate(names):
     x = 0
     for src in (n + "_tile", n):
         ex = Image.open(os.path.join(ex_dir, src + ".png")).convert("RGB")
+        label = f"{src} {ex.width}x{ex.height}"
         ex = ex.resize((ex.width * 3 // 2, ex.height * 3 // 2), Image.NEAREST)
         sheet.paste(ex, (x, y + 20))
-        draw.text((x, y + 4), f"{src} {ex.width * 2 // 3}x{ex.height * 2 // 3}", fill="black")
+        draw.text((x, y + 4), label, fill="black")
         x += 200
     for src in (n + "_tile", n):
         sheet.paste(Image.open(os.path.join(out, f"{src}-0.png")).crop((0, 0, 256, 256)), (x, y + 20))
@@ -88,3 +89,4 @@ for i, n in enumerate(names):
         draw.text((x, y + 4), f"{src}: 2 zooms out", fill="black")
         x += 264
 sheet.save(os.path.join(out, "shapes-sheet.png"))
+sheet.save("docs/shapes-sheet.jpg", quality=85) if os.path.isdir("docs") else None
