@@ -221,10 +221,34 @@ async fn a_tileset_with_relief_serves_displaced_content() {
     let tileset = s.json("/3dtiles/flagstones/tileset.json?relief=8").await;
     let uri = tileset["root"]["content"]["uri"].as_str().unwrap_or_default().to_string();
     assert!(uri.contains("relief=8"), "content URIs carry the relief: {uri}");
-    let (status, bytes) = s.get_bytes("/3dtiles/flagstones/tiles/2/1/1.glb?relief=8").await;
-    assert_eq!(status, 200);
-    let (json, _) = common::parse_glb(&bytes);
-    assert_eq!(json["accessors"][0]["count"], 257 * 257, "a displaced grid");
+    // The root box holds the relief: from the skirts' foot below the ground to 8 above.
+    let b: Vec<f64> =
+        tileset["root"]["boundingVolume"]["box"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let (z0, z1) = (b[2] - b[11], b[2] + b[11]);
+    assert!(z0 <= -0.5 && z1 >= 8.0 && z1 <= 8.5, "the box's height {z0}..{z1} holds the relief");
+    let (x0, y0, side) = (b[0] - b[3], b[1] - b[7], 2.0 * b[3]);
+    for (level, x, y) in [(2u32, 1i64, 1i64), (5, 3, 30), (8, 200, 17), (9, 0, 511)] {
+        let (status, bytes) = s.get_bytes(&format!("/3dtiles/flagstones/tiles/{level}/{x}/{y}.glb?relief=8")).await;
+        assert_eq!(status, 200);
+        // Compact: a 33² grid with skirts, 16-bit indices, beside the tile's images.
+        assert!(bytes.len() <= 600_000, "{level}/{x}/{y}: {} bytes", bytes.len());
+        let (json, bin) = common::parse_glb(&bytes);
+        let prim = &json["meshes"][0]["primitives"][0];
+        assert_eq!(json["accessors"][0]["count"], 33 * 33 + 4 * 33, "a displaced grid with its skirts");
+        assert_eq!(json["accessors"][prim["indices"].as_u64().unwrap() as usize]["componentType"], 5123);
+        // Every vertex, Y-up turned Z-up ((x, y, z) → (x, −z, y)), lies inside the implicit
+        // tile's box (the root's, split `level` times across).
+        let t: Vec<f64> =
+            json["nodes"][0]["translation"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let w = side / (1u64 << level) as f64;
+        let (bx0, by0) = (x0 + w * x as f64, y0 + w * y as f64);
+        let pos = common::f32s(&json, &bin, prim["attributes"]["POSITION"].as_u64().unwrap() as usize);
+        for v in pos.chunks(3) {
+            let (px, py, pz) = (t[0] + v[0] as f64, -(t[2] + v[2] as f64), t[1] + v[1] as f64);
+            let inside = (bx0..=bx0 + w).contains(&px) && (by0..=by0 + w).contains(&py) && (z0..=z1).contains(&pz);
+            assert!(inside, "{level}/{x}/{y}: vertex ({px}, {py}, {pz}) outside its box");
+        }
+    }
     // A texture without a height map has no relief.
     assert_error(&s, "/3dtiles/gravel/tileset.json?relief=8", 400, "invalid_parameter").await;
 }

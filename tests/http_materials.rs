@@ -295,7 +295,9 @@ async fn relief(s: &Server, path: &str) -> (usize, Vec<[f32; 3]>) {
     let pos = f32s(&json, &bin, prim["attributes"]["POSITION"].as_u64().unwrap() as usize);
     let world: Vec<[f32; 3]> = pos.chunks(3).map(|p| [p[0] + t[0], p[1] + t[1], p[2] + t[2]]).collect();
     assert!(prim["attributes"]["TANGENT"].is_u64(), "a relief with a normal map has tangents");
-    ((world.len() as f64).sqrt() as usize, world)
+    // The grid's side, from the vertices besides the skirts (`n² + 4n`).
+    let n = (1..=257).find(|n| n * n + 4 * n == world.len()).unwrap_or(0);
+    (n, world)
 }
 
 #[tokio::test]
@@ -307,21 +309,28 @@ async fn relief_meshes_are_displaced_by_the_height_map_and_neighbours_share_thei
     let (n, a) = relief(&s, &format!("/gltf/flagstones/8/3/-2.glb?{q}")).await;
     let (_, right) = relief(&s, &format!("/gltf/flagstones/8/4/-2.glb?{q}")).await;
     let (_, below) = relief(&s, &format!("/gltf/flagstones/8/3/-1.glb?{q}")).await;
-    assert_eq!(n, 257, "a vertex per texel centre and the neighbours' first");
+    assert_eq!(n, 33, "a vertex per corner of 8-texel cells, exactly over the tile");
     for k in 0..n {
         // A's last column is its right neighbour's first, A's last row its lower neighbour's first.
         assert_eq!(a[k * n + n - 1], right[k * n], "shared vertical edge, row {k}");
         assert_eq!(a[(n - 1) * n + k], below[k], "shared horizontal edge, column {k}");
     }
-    // Heights are the height tile's texels, 12 texels for white, at texel centres.
+    // Heights are the height tile's 8×8 texels around each corner, 12 texels for white.
     let height = s.image("/tiles/flagstones/8/3/-2.png?seed=3&map=height").await;
-    for (i, j) in [(0u32, 0u32), (17, 200), (255, 255), (128, 3)] {
+    for (i, j) in [(1u32, 1u32), (2, 25), (31, 31), (16, 3)] {
         let v = a[j as usize * n + i as usize];
-        assert_eq!([v[0], v[2]], [768.0 + i as f32 + 0.5, -512.0 + j as f32 + 0.5]);
-        let h = 12.0 * height.get_pixel(i, j).0[0] as f32 / 255.0;
+        assert_eq!([v[0], v[2]], [768.0 + 8.0 * i as f32, -512.0 + 8.0 * j as f32]);
+        let sum: u32 = (8 * j - 4..8 * j + 4)
+            .flat_map(|y| (8 * i - 4..8 * i + 4).map(move |x| (x, y)))
+            .map(|(x, y)| height.get_pixel(x, y).0[0] as u32)
+            .sum();
+        let h = 12.0 * sum as f32 / (255.0 * 64.0);
         assert!((v[1] - h).abs() < 1e-4, "vertex ({i},{j}) at {} not {h}", v[1]);
     }
-    assert!(a.iter().map(|v| v[1]).fold(0.0, f32::max) > 6.0, "the relief rises");
+    assert!(a[..n * n].iter().map(|v| v[1]).fold(0.0, f32::max) > 5.0, "the relief rises");
+    // The skirts hang below the ground along every edge.
+    assert_eq!(a.len(), n * n + 4 * n);
+    assert!(a[n * n..].iter().all(|v| v[1] == -0.5), "skirt vertices at the skirt's foot");
     // Where a mesh has no relief, or a texture no height: clear errors.
     for (path, code) in [
         ("/gltf/flagstones/8/3/-2.gltf?relief=12", "invalid_parameter"),
@@ -334,7 +343,7 @@ async fn relief_meshes_are_displaced_by_the_height_map_and_neighbours_share_thei
     }
     // Every mode has a height map to displace by, umbrella patches included.
     let (n, _) = relief(&s, "/gltf/flagstones/8/3/-2.glb?relief=12&mode=umbrella").await;
-    assert_eq!(n, 257);
+    assert_eq!(n, 33);
 }
 
 #[tokio::test]

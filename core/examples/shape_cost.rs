@@ -14,7 +14,8 @@ fn main() {
         .filter_map(|a| a.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?))))
         .collect();
     let shapes = if shapes.is_empty() { vec![(128, 128), (100, 100), (300, 200)] } else { shapes };
-    let tiles: i64 = std::env::var("TILES").ok().and_then(|v| v.parse().ok()).unwrap_or(if shapes.len() == 1 { 8 } else { 40 });
+    let tiles: i64 =
+        std::env::var("TILES").ok().and_then(|v| v.parse().ok()).unwrap_or(if shapes.len() == 1 { 8 } else { 40 });
     let rounds = if shapes.len() == 1 { 1 } else { 5 };
     let p = SynthParams::default();
     let analyses: Vec<Analysis> = shapes
@@ -39,6 +40,10 @@ fn main() {
         let mut t = times[k].clone();
         t.sort_by(f64::total_cmp);
         let cost = synthesis_cost(an, &p, an.levels(), Rect::new(0, 0, 262, 262));
-        println!("{w}x{h}: levels {}, {cost} px computed per tile, {:.2} ms per cold 256² tile (median of {rounds})", an.levels(), t[t.len() / 2]);
+        println!(
+            "{w}x{h}: levels {}, {cost} px computed per tile, {:.2} ms per cold 256² tile (median of {rounds})",
+            an.levels(),
+            t[t.len() / 2]
+        );
     }
 }

@@ -34,9 +34,9 @@ pub struct Quad {
 /// grid as one big texture's. It costs 27 % more texels than the bare tile.
 pub const BORDER: u32 = 16;
 
-/// Version of the documents' layout (border, texture coordinates, samplers, viewpoints): part of
+/// Version of the documents' layout (border, texture coordinates, samplers, viewpoints, relief mesh): part of
 /// every 3D asset's cache key, so a change of layout changes their ETags.
-pub const LAYOUT: u32 = 2;
+pub const LAYOUT: u32 = 3;
 
 /// Side of a tile's image in the 3D assets, border included.
 pub fn image_side() -> u32 {
@@ -127,11 +127,22 @@ fn document(quads: &[Quad], generator: &str, views: Vec<Value>, accessors: Vec<V
     })
 }
 
-/// A displaced mesh (`relief=SCALE`): one vertex per texel centre of the tile and one more
-/// row and column — the neighbouring tiles' first texel centres — so that neighbours share
-/// their edge vertices, heights included.
+/// Tile pixels per cell of a relief mesh: a tile's mesh is a grid of 32 × 32 cells (33² vertices),
+/// its density following the tile's level like its texels do (a tile is refined once its texels
+/// would cover more than a pixel, so a cell never spans more than 8 screen pixels).
+pub const RELIEF_STEP: u32 = 8;
+
+/// How far below the lowest height (0, the height map's black) a relief's skirts reach, in
+/// world units: a tile's edge and a finer neighbour's meet along different polylines, and the
+/// skirt hanging from each edge down past every height closes the gap between them.
+pub const SKIRT_DEPTH: f32 = 0.5;
+
+/// A displaced mesh (`relief=SCALE`): one vertex per corner of a grid of [`RELIEF_STEP`]-pixel
+/// cells over the tile, exactly its extent, so that neighbours share their edge vertices,
+/// heights included; each vertex's height is the mean of the [`RELIEF_STEP`]² height texels
+/// around it (the height filtered to the mesh's density: texel noise does not become spikes).
 pub struct Relief {
-    /// Vertices per side (tile pixels + 1).
+    /// Vertices per side.
     pub n: usize,
     /// Heights in world units (native texels), row-major.
     pub heights: Vec<f32>,
@@ -139,60 +150,88 @@ pub struct Relief {
 
 impl Relief {
     /// The relief of a tile from its bordered height image ([`image_side`]²): white is `scale`
-    /// texels high.
+    /// texels high. Corner `(i, j)` of the grid lies at tile pixel corner `(8i, 8j)`; its
+    /// height averages pixels `8i − 4 .. 8i + 4` across and down, inside the border.
     pub fn from_border_image(img: &image::GrayImage, scale: f32) -> Relief {
-        let n = TILE_SIZE as usize + 1;
-        let b = BORDER;
+        let step = RELIEF_STEP as usize;
+        let n = TILE_SIZE as usize / step + 1;
+        let b = BORDER as usize;
+        let w = img.width() as usize;
+        let px = img.as_raw();
+        let at = |x: usize, y: usize| px.get(y * w + x).copied().unwrap_or(0) as u32;
         let mut heights = Vec::with_capacity(n * n);
-        for j in 0..n as u32 {
-            for i in 0..n as u32 {
-                let v = img.get_pixel_checked(b + i, b + j).map_or(0, |p| p.0[0]);
-                heights.push(scale * v as f32 / 255.0);
+        for j in 0..n {
+            for i in 0..n {
+                let (x0, y0) = (b + step * i - step / 2, b + step * j - step / 2);
+                let sum: u32 = (y0..y0 + step).flat_map(|y| (x0..x0 + step).map(move |x| at(x, y))).sum();
+                heights.push(scale * sum as f32 / (255 * step * step) as f32);
             }
         }
         Relief { n, heights }
     }
 }
 
-/// The displaced grid of a `size × size` tile: vertex `(i, j)` at the centre of tile pixel
-/// `(i, j)` (pixels of `size / 256` units), at its height; normals up (the normal map shades
-/// the relief), texture coordinates on the image's texel centres; `u32` indices. The accessors
-/// are in [`geometry`]'s order.
+/// The displaced grid of a `size × size` tile: vertex `(i, j)` at grid corner `(i, j)` (cells of
+/// `size / 32` units), at its height; along every edge a skirt down to `−`[`SKIRT_DEPTH`] (faces
+/// both ways), so no gap opens where a coarser or finer neighbour's edge runs at other heights;
+/// normals up (the normal map shades the relief), texture coordinates on the image's pixel
+/// corners; `u16` indices. The accessors are in [`geometry`]'s order.
 fn relief_geometry(size: f32, r: &Relief) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
     let n = r.n;
-    let step = size / TILE_SIZE as f32;
-    let side = image_side() as f32;
-    let mut pos = Vec::with_capacity(n * n * 3);
-    let mut uv = Vec::with_capacity(n * n * 2);
-    let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+    let cell = size / (n - 1) as f32;
+    let (side, px) = (image_side() as f32, RELIEF_STEP as f32);
+    let mut pos = Vec::with_capacity((n * n + 4 * n) * 3);
+    let mut uv = Vec::with_capacity((n * n + 4 * n) * 2);
+    let mut hi = 0f32;
+    let vertex = |i: usize, j: usize, y: f32, pos: &mut Vec<f32>, uv: &mut Vec<f32>| {
+        pos.extend([i as f32 * cell, y, j as f32 * cell]);
+        uv.extend([(BORDER as f32 + i as f32 * px) / side, (BORDER as f32 + j as f32 * px) / side]);
+    };
     for j in 0..n {
         for i in 0..n {
             let h = r.heights[j * n + i];
-            (lo, hi) = (lo.min(h), hi.max(h));
-            pos.extend([(i as f32 + 0.5) * step, h, (j as f32 + 0.5) * step]);
-            uv.extend([(BORDER as f32 + i as f32 + 0.5) / side, (BORDER as f32 + j as f32 + 0.5) / side]);
+            hi = hi.max(h);
+            vertex(i, j, h, &mut pos, &mut uv);
         }
     }
-    let nrm: Vec<f32> = (0..n * n).flat_map(|_| [0.0, 1.0, 0.0]).collect();
-    let mut idx: Vec<u32> = Vec::with_capacity((n - 1) * (n - 1) * 6);
+    let mut idx: Vec<u16> = Vec::with_capacity((n - 1) * (n - 1) * 6 + 4 * (n - 1) * 12);
     for j in 0..n - 1 {
         for i in 0..n - 1 {
-            let (a, b) = ((j * n + i) as u32, (j * n + i + 1) as u32);
-            let (c, d) = (((j + 1) * n + i + 1) as u32, ((j + 1) * n + i) as u32);
+            let (a, b) = ((j * n + i) as u16, (j * n + i + 1) as u16);
+            let (c, d) = (((j + 1) * n + i + 1) as u16, ((j + 1) * n + i) as u16);
             idx.extend([a, c, b, a, d, c]);
         }
     }
+    // The skirts: each edge's vertices again, lowered, joined to the edge by quads facing both ways.
+    let edges: [Vec<(usize, usize)>; 4] = [
+        (0..n).map(|i| (i, 0)).collect(),
+        (0..n).map(|i| (i, n - 1)).collect(),
+        (0..n).map(|j| (0, j)).collect(),
+        (0..n).map(|j| (n - 1, j)).collect(),
+    ];
+    for edge in &edges {
+        let first = (pos.len() / 3) as u16;
+        for &(i, j) in edge {
+            vertex(i, j, -SKIRT_DEPTH, &mut pos, &mut uv);
+        }
+        for (k, w) in edge.windows(2).enumerate() {
+            let (a, b) = ((w[0].1 * n + w[0].0) as u16, (w[1].1 * n + w[1].0) as u16);
+            let (c, d) = (first + k as u16 + 1, first + k as u16);
+            idx.extend([a, b, c, a, c, d, a, c, b, a, d, c]);
+        }
+    }
+    let count = pos.len() / 3;
+    let nrm: Vec<f32> = (0..count).flat_map(|_| [0.0, 1.0, 0.0]).collect();
     let (mut b, mut views) = (Vec::new(), Vec::new());
     push_view(&mut b, &mut views, &le(&pos), Some(34962));
     push_view(&mut b, &mut views, &le(&nrm), Some(34962));
     push_view(&mut b, &mut views, &le(&uv), Some(34962));
     push_view(&mut b, &mut views, &idx.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>(), Some(34963));
-    let (v0, v1) = (0.5 * step, (n as f32 - 0.5) * step);
     let accessors = vec![
-        json!({ "bufferView": 0, "componentType": 5126, "count": n * n, "type": "VEC3", "min": [v0, lo, v0], "max": [v1, hi, v1] }),
-        json!({ "bufferView": 1, "componentType": 5126, "count": n * n, "type": "VEC3" }),
-        json!({ "bufferView": 2, "componentType": 5126, "count": n * n, "type": "VEC2" }),
-        json!({ "bufferView": 3, "componentType": 5125, "count": idx.len(), "type": "SCALAR" }),
+        json!({ "bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3", "min": [0.0, -SKIRT_DEPTH, 0.0], "max": [size, hi, size] }),
+        json!({ "bufferView": 1, "componentType": 5126, "count": count, "type": "VEC3" }),
+        json!({ "bufferView": 2, "componentType": 5126, "count": count, "type": "VEC2" }),
+        json!({ "bufferView": 3, "componentType": 5123, "count": idx.len(), "type": "SCALAR" }),
     ];
     (b, views, accessors)
 }

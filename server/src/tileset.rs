@@ -78,13 +78,21 @@ pub fn enu_to_ecef(lon: f64, lat: f64, height: f64) -> [f64; 16] {
 }
 
 /// The tileset JSON. `query` is the request's query string (mode and its parameters, without
-/// the anchoring ones), carried into the content URIs; `transform` anchors the root.
-pub fn tileset(tree: &Tree, query: &str, transform: Option<[f64; 16]>, generator: &str) -> Value {
+/// the anchoring ones), carried into the content URIs; `transform` anchors the root; `relief`
+/// the height of a displaced mesh's highest point, which the bounding volumes contain (from its
+/// skirts' foot, [`crate::assets::SKIRT_DEPTH`] below the ground, to `relief` above).
+pub fn tileset(tree: &Tree, query: &str, transform: Option<[f64; 16]>, relief: Option<f32>, generator: &str) -> Value {
     let h = tree.root_side() / 2.0;
     let sep = if query.is_empty() { "" } else { "?" };
+    // The vertical extent: a flat quad lies in the ground (one texel thick around it).
+    let (z0, z1) = match relief {
+        Some(r) => (-(crate::assets::SKIRT_DEPTH as f64), r as f64),
+        None => (-0.5, 0.5),
+    };
+    let (zc, zh) = ((z0 + z1) / 2.0, (z1 - z0) / 2.0);
     let mut root = json!({
-        // Centre, then the x, y and z half-axes: the root square, one texel thick.
-        "boundingVolume": { "box": [h, -h, 0.0, h, 0.0, 0.0, 0.0, h, 0.0, 0.0, 0.0, 0.5] },
+        // Centre, then the x, y and z half-axes: the root square, as thick as its content.
+        "boundingVolume": { "box": [h, -h, zc, h, 0.0, 0.0, 0.0, h, 0.0, 0.0, 0.0, zh] },
         "geometricError": tree.geometric_error(0),
         "refine": "REPLACE",
         "content": { "uri": format!("tiles/{{level}}/{{x}}/{{y}}.glb{sep}{query}") },

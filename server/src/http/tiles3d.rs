@@ -99,15 +99,15 @@ pub async fn tileset_json(
     };
     // Everything else is the tiles' query: validated here, carried into the content URIs.
     let pairs = without_anchoring(raw.as_deref());
-    let (p, _) = params_with_relief(&tex, ParamReader::request(pairs.clone())?)?;
+    let (p, relief) = params_with_relief(&tex, ParamReader::request(pairs.clone())?)?;
     // Sorted: one URI (and cache entry) per set of parameters, however they were ordered.
     let query = query_string(&pairs.into_iter().collect::<std::collections::BTreeMap<_, _>>());
-    let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset|{query}|{transform:?}")));
+    let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset{}|{query}|{transform:?}", crate::assets::LAYOUT)));
     let cc = &st.cache_control;
     if if_none_match(&headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }
-    let doc = tileset(&tree(&tex), &query, transform, &generator());
+    let doc = tileset(&tree(&tex), &query, transform, relief, &generator());
     let body = serde_json::to_vec(&doc).map_err(|e| ApiError::internal(e.to_string()))?;
     Ok(image(body.into(), "application/json", &etag, cc, false))
 }
