@@ -11,8 +11,9 @@ const $ = (id) => document.getElementById(id);
 const num = (v) => String(Number(Number(v).toFixed(3)));
 
 // t: texture, m: mode, seed, p: mode parameters as given, cam: eye and target, sun: the sun's
-// direction in degrees (materials with normals).
-const state = { t: null, m: null, seed: '0', p: {}, cam: null, sun: 135 };
+// direction in degrees (materials with normals), relief: the height map's white in texels
+// (textures with a height map; 0: flat tiles).
+const state = { t: null, m: null, seed: '0', p: {}, cam: null, sun: 135, relief: 0 };
 let catalog = null, meta = null, tiles = null, debounce = null, retry = null;
 // Every content tile the renderer asked for, by level (the test and the readout use them).
 const requested = [];
@@ -26,6 +27,8 @@ function readHash() {
   for (const [k, v] of h) if (k.startsWith('p.')) state.p[k.slice(2)] = v;
   const sun = Number(h.get('sun'));
   if (h.has('sun') && Number.isFinite(sun)) state.sun = ((Math.round(sun) % 360) + 360) % 360;
+  const relief = Number(h.get('relief'));
+  state.relief = h.has('relief') && Number.isFinite(relief) ? Math.min(32, Math.max(0, Math.round(relief))) : 0;
   const cam = (h.get('cam') || '').split(',').map(Number);
   state.cam = cam.length === 6 && cam.every(Number.isFinite) ? cam : null;
 }
@@ -37,6 +40,7 @@ function writeHash() {
   h.set('seed', state.seed);
   for (const [k, v] of Object.entries(state.p)) h.set(`p.${k}`, v);
   if (lit()) h.set('sun', state.sun);
+  if (raised()) h.set('relief', state.relief);
   const e = camera.position, g = controls.target;
   h.set('cam', [e.x, e.y, e.z, g.x, g.y, g.z].map(num).join(','));
   history.replaceState(null, '', `#${h.toString().replace(/%2C/g, ',')}`);
@@ -49,6 +53,7 @@ function tilesetUrl() {
   if (state.m !== meta.default_mode) q.set('mode', state.m);
   if (state.seed !== '0') q.set('seed', state.seed);
   for (const [k, v] of Object.entries(state.p)) q.set(k, v);
+  if (raised()) q.set('relief', state.relief);
   const qs = q.toString();
   return `/3dtiles/${encodeURIComponent(state.t)}/tileset.json${qs ? `?${qs}` : ''}`;
 }
@@ -67,6 +72,16 @@ const ambient = new THREE.AmbientLight(0xffffff, Math.PI);
 const sun = new THREE.DirectionalLight(0xffffff, 0);
 scene.add(ambient, sun, sun.target);
 
+/** Whether the texture has a height map the mode renders: its tiles can be displaced. */
+function hasHeight() {
+  return Boolean(meta && (meta.maps || []).some((m) => m.name === 'height' && (m.modes || []).includes(state.m)));
+}
+
+/** Whether the tiles are displaced: a relief asked for, on a texture with a height map. */
+function raised() {
+  return hasHeight() && state.relief > 0;
+}
+
 /** Whether the current texture and mode show a lit material (a normal map the mode renders). */
 function lit() {
   return Boolean(meta && (meta.maps || []).some((m) => m.kind === 'normal' && m.modes.includes(state.m)));
@@ -75,6 +90,7 @@ function lit() {
 function placeSun() {
   const on = lit();
   $('sunrow').hidden = !on;
+  $('reliefrow').hidden = !hasHeight();
   ambient.intensity = on ? 0.9 : Math.PI;
   sun.intensity = on ? 2.6 : 0;
   // Azimuth from east, counter-clockwise seen from above (north is −Z).
@@ -195,6 +211,7 @@ async function selectTexture(id, keepView) {
   state.m = window.TextileModes.fill($('mode'), meta, state.m);
   buildParams();
   $('sun').value = state.sun;
+  $('relief').value = state.relief;
   placeSun();
   if (!keepView) state.cam = null;
   placeCamera();
@@ -227,6 +244,7 @@ async function main() {
   sel.addEventListener('change', () => { state.p = {}; selectTexture(sel.value, false); });
   $('mode').addEventListener('change', () => { state.m = $('mode').value; buildParams(); placeSun(); changed(); });
   $('sun').addEventListener('input', () => { state.sun = Number($('sun').value); placeSun(); writeHash(); });
+  $('relief').addEventListener('change', () => { state.relief = Number($('relief').value); changed(); });
   $('seed').addEventListener('change', () => { state.seed = String(Math.max(0, Math.floor(Number($('seed').value) || 0))); changed(); });
   $('newseed').addEventListener('click', () => {
     state.seed = String(Math.floor(Math.random() * 2 ** 31));

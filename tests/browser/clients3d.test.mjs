@@ -311,6 +311,51 @@ test('/3d.html lights a material with a sun whose direction a slider turns', asy
   await page.close();
 });
 
+test('/3d.html shows relief without cracks: no sky through the ground near, oblique or at the horizon', async () => {
+  const page = await browser.newPage({ viewport: { width: 800, height: 560 } });
+  const errors = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  // Flagstones (65 536 texels across), relief 8 texels high: tiles of several levels meet in
+  // every view, their edges at other heights; the skirts must close every gap.
+  await page.goto(`${BASE}/3d.html#t=flagstones&m=synth&seed=2&relief=8&cam=32768,30,32800,32768,0,32768`);
+  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 30000 });
+  assert.match(await page.evaluate(() => document.querySelector('#tilesetlink').href), /relief=8/);
+  assert.equal(await page.isVisible('#reliefrow'), true, 'a texture with a height map offers relief');
+  assert.equal(await page.inputValue('#relief'), '8');
+  // The scene's background (0xbfd1e5) where the ground should be: the rows below `from` (a
+  // share of the height: the oblique and horizon views show the sky above the horizon).
+  const sky = (from) => page.evaluate((from) => {
+    const c = document.querySelector('#view canvas');
+    const g = document.createElement('canvas');
+    g.width = c.width; g.height = c.height;
+    const ctx = g.getContext('2d');
+    ctx.drawImage(c, 0, 0);
+    const d = ctx.getImageData(0, Math.floor(from * c.height), c.width, c.height - Math.floor(from * c.height)).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      if (Math.abs(d[i] - 191) + Math.abs(d[i + 1] - 209) + Math.abs(d[i + 2] - 229) <= 9) n++;
+    }
+    return n;
+  }, from);
+  const views = [
+    ['near', [32768, 30, 32800], [32768, 0, 32768], 0],
+    ['oblique', [32768, 160, 33100], [32768, 0, 32700], 0.2],
+    ['horizon', [32768, 24, 33600], [32768, 14, 32400], 0.6],
+  ];
+  const found = {};
+  for (const [name, eye, target, from] of views) {
+    await page.evaluate(([e, t]) => window.textile3d.look(e, t), [eye, target]);
+    await settled3d(page);
+    found[name] = await sky(from);
+    save(`3d-relief-${name}.png`, `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
+  }
+  console.log(`3D page, flagstones relief=8: background pixels through the ground ${JSON.stringify(found)}`);
+  assert.deepEqual(found, { near: 0, oblique: 0, horizon: 0 });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('CesiumJS loads the tileset anchored on the globe and requests its content', async () => {
   const { page, errors } = await open(CESIUM_PAGE);
   const failed = [];
