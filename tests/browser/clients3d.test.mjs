@@ -431,3 +431,70 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
   assert.deepEqual(errors, []);
   await page.close();
 });
+
+test('CesiumJS shows relief without cracks: no globe through the ground near, oblique or at the horizon', async () => {
+  const { page, errors } = await open(CESIUM_PAGE);
+  await page.waitForFunction(() => window.Cesium);
+  // Flagstones with relief 8, anchored 35 m above the ellipsoid, whose globe is painted magenta
+  // (no imagery, no ground atmosphere, no fog): a crack between tiles shows it.
+  const failures = await page.evaluate(async (base) => {
+    const viewer = new Cesium.Viewer('globe', {
+      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false, animation: false,
+      homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
+      infoBox: false, selectionIndicator: false, terrainProvider: new Cesium.EllipsoidTerrainProvider(),
+    });
+    viewer.clock.currentTime = Cesium.JulianDate.fromIso8601('2026-06-21T11:50:00Z');
+    viewer.clock.shouldAnimate = false;
+    viewer.scene.globe.baseColor = Cesium.Color.MAGENTA;
+    viewer.scene.globe.showGroundAtmosphere = false;
+    viewer.scene.fog.enabled = false;
+    const failures = [];
+    const tileset = await Cesium.Cesium3DTileset.fromUrl(
+      `${base}/3dtiles/flagstones/tileset.json?lon=2.35&lat=48.85&height=35&seed=2&relief=8`);
+    tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
+    viewer.scene.primitives.add(tileset);
+    window.relief = { viewer, tileset };
+    return failures;
+  }, BASE);
+  // The magenta pixels below row `from` (a share of the height: the sky above the horizon).
+  const magenta = async (from) => {
+    const png = (await page.screenshot()).toString('base64');
+    return [png, await page.evaluate(async ([src, from]) => {
+      const img = new Image();
+      img.src = src;
+      await img.decode();
+      const c = document.createElement('canvas');
+      c.width = img.width; c.height = img.height;
+      const g = c.getContext('2d');
+      g.drawImage(img, 0, 0);
+      const y0 = Math.floor(from * img.height);
+      const d = g.getImageData(0, y0, img.width, img.height - y0).data;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 90 && d[i + 2] > 180) n++;
+      return n;
+    }, [`data:image/png;base64,${png}`, from])];
+  };
+  const views = [['near', 0.3, -1.2, 60, 0], ['oblique', 0.6, -0.5, 400, 0.2], ['horizon', 0.9, -0.1, 300, 0.6]];
+  const found = {};
+  for (const [name, heading, pitch, range, from] of views) {
+    await page.evaluate(async ([heading, pitch, range]) => {
+      const { viewer, tileset } = window.relief;
+      const target = Cesium.Matrix4.multiplyByPoint(tileset.root.computedTransform,
+        new Cesium.Cartesian3(2000, -2000, 0), new Cesium.Cartesian3());
+      viewer.camera.lookAt(target, new Cesium.HeadingPitchRange(heading, pitch, range));
+      await new Promise((resolve) => {
+        const t = setTimeout(resolve, 120000);
+        const done = tileset.allTilesLoaded.addEventListener(() => { clearTimeout(t); done(); resolve(); });
+      });
+      viewer.render();
+    }, [heading, pitch, range]);
+    const [png, n] = await magenta(from);
+    found[name] = n;
+    save(`cesium-relief-${name}.png`, `data:image/png;base64,${png}`);
+  }
+  console.log(`CesiumJS, flagstones relief=8: globe pixels through the ground ${JSON.stringify(found)}`);
+  assert.deepEqual(found, { near: 0, oblique: 0, horizon: 0 });
+  assert.deepEqual(failures, []);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
