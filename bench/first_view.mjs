@@ -1,0 +1,50 @@
+// Where the first 3D view's time goes (issue 61, item 1): opens /3d.html on a server in headless
+// Chromium (SwiftShader, on the same cores as the server), for each view until its tiles have
+// settled, and reports the time, the content tiles requested and, from the server's access log
+// (JSON lines), their count, summed server time and the slowest, by level.
+//
+// Usage (from the repository root, the server started with `--access-log FILE`):
+//   node bench/first_view.mjs URL ACCESS_LOG [HASH …]
+// e.g. node bench/first_view.mjs http://127.0.0.1:8080 /tmp/access.log 't=gravel' 't=flagstones'
+// The libraries are tests/browser's (npm ci there first).
+import { createRequire } from 'node:module';
+import { readFileSync, statSync } from 'node:fs';
+
+const require = createRequire(new URL('../tests/browser/package.json', import.meta.url));
+const { chromium } = require('playwright-core');
+
+const [base, log, ...hashes] = process.argv.slice(2);
+const views = hashes.length ? hashes : ['t=gravel', 't=flagstones'];
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--headless', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
+});
+const size = () => { try { return statSync(log).size; } catch { return 0; } };
+console.log('| view | settled in | content tiles | by level: tiles, server ms summed, slowest ms |');
+console.log('|---|---|---|---|');
+for (const hash of views) {
+  const from = size();
+  const page = await browser.newPage({ viewport: { width: 1000, height: 640 } });
+  const t0 = Date.now();
+  await page.goto(`${base}/3d.html#${hash}`);
+  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 60000 });
+  const settled = () => page.waitForFunction(() => window.textile3d?.settled(), null, { timeout: 300000, polling: 100 });
+  await settled();
+  await page.waitForTimeout(300);
+  await settled();
+  const ms = Date.now() - t0 - 300;
+  const requested = await page.evaluate(() => window.textile3d.requested.length);
+  await page.close();
+  await new Promise((r) => setTimeout(r, 500)); // the log's writer thread
+  const lines = readFileSync(log, 'utf8').slice(from).split('\n').filter(Boolean).map((l) => JSON.parse(l));
+  const by = {};
+  for (const l of lines) {
+    const m = l.path.match(/\/3dtiles\/[^/]+\/tiles\/(\d+)\//);
+    if (!m) continue;
+    const b = (by[m[1]] ??= { n: 0, ms: 0, max: 0 });
+    b.n++; b.ms += l.ms; b.max = Math.max(b.max, l.ms);
+  }
+  const levels = Object.entries(by).map(([k, b]) => `${k}: ${b.n}, ${b.ms.toFixed(0)}, ${b.max.toFixed(0)}`).join('; ');
+  console.log(`| ${hash} | ${(ms / 1000).toFixed(1)} s | ${requested} | ${levels} |`);
+}
+await browser.close();
