@@ -5,6 +5,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::geom::{centred_square, levels_for};
+
 use crate::error::{CoreError, Result};
 use crate::lattice::{Lattice, LatticeChoice, Repeat};
 use crate::maps::{MaterialMap, NormalConvention};
@@ -14,13 +16,6 @@ use crate::mask::RandomnessMask;
 pub const MIN_INPUT_SIDE: u32 = 16;
 /// Largest prepared exemplar side: a larger image is scaled down to it, keeping its shape.
 pub const MAX_SIDE: u32 = 512;
-
-/// Synthesis levels of a `w × h` exemplar: `L = ⌈log2 max(w, h)⌉`, so that one pixel of level
-/// 0 covers the whole exemplar (for a power-of-two square of side `m`, `log2 m`).
-pub fn levels_for(w: u32, h: u32) -> u32 {
-    let m = w.max(h).max(1);
-    32 - (m - 1).leading_zeros()
-}
 
 /// Least colour variation of a synthesizable exemplar: the standard deviation, in 8-bit levels,
 /// of its most varied channel. Below it the image is flat (one colour, or noise of a level or
@@ -357,19 +352,6 @@ impl Exemplar {
         self.repeat = found.repeat;
         Ok(self)
     }
-}
-
-/// The largest centred square of a `w × h` image (itself when square) and its side: what the
-/// analyses that look at a square (structure detection, umbrella extraction) see of a
-/// non-square exemplar.
-pub fn centred_square<T: Copy>(pixels: &[T], (w, h): (usize, usize)) -> (std::borrow::Cow<'_, [T]>, usize) {
-    if w == h {
-        return (std::borrow::Cow::Borrowed(pixels), w);
-    }
-    let side = w.min(h);
-    let (ox, oy) = ((w - side) / 2, (h - side) / 2);
-    let square = (0..side).flat_map(|y| &pixels[(oy + y) * w + ox..][..side]).copied().collect();
-    (std::borrow::Cow::Owned(square), side)
 }
 
 /// The colour variation of `pixels`: the standard deviation, in 8-bit levels, of the most

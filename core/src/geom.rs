@@ -1,5 +1,6 @@
 //! Integer plane geometry: half-open rectangles with `i64` coordinates and the floor/parity
-//! helpers that stay correct for negative coordinates (design note §0).
+//! helpers that stay correct for negative coordinates (design note §0); and the arithmetic of an
+//! exemplar's size: its synthesis levels, wrapping coordinates at its sides, its centred square.
 
 /// `floor(x / 2)` for any sign (arithmetic shift).
 #[inline]
@@ -92,6 +93,26 @@ impl Rect {
     pub fn children(&self) -> Self {
         Rect { x0: self.x0 * 2, y0: self.y0 * 2, x1: self.x1 * 2, y1: self.y1 * 2 }
     }
+}
+
+/// Synthesis levels of a `w × h` exemplar: `L = ⌈log2 max(w, h)⌉`, so that one pixel of level
+/// 0 covers the whole exemplar (for a power-of-two square of side `m`, `log2 m`).
+pub fn levels_for(w: u32, h: u32) -> u32 {
+    let m = w.max(h).max(1);
+    32 - (m - 1).leading_zeros()
+}
+
+/// The largest centred square of a `w × h` image (itself when square) and its side: what the
+/// analyses that look at a square (structure detection, umbrella extraction) see of a
+/// non-square exemplar.
+pub fn centred_square<T: Copy>(pixels: &[T], (w, h): (usize, usize)) -> (std::borrow::Cow<'_, [T]>, usize) {
+    if w == h {
+        return (std::borrow::Cow::Borrowed(pixels), w);
+    }
+    let side = w.min(h);
+    let (ox, oy) = ((w - side) / 2, (h - side) / 2);
+    let square = (0..side).flat_map(|y| &pixels[(oy + y) * w + ox..][..side]).copied().collect();
+    (std::borrow::Cow::Owned(square), side)
 }
 
 /// `v` wrapped onto `0..n` (`n > 0`): a mask when `n` is a power of two, else the Euclidean

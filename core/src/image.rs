@@ -155,11 +155,11 @@ impl Integral {
 }
 
 /// The centred box means of a `w × h` exemplar at every scale: entry `k` (`0..=L`,
-/// [`crate::exemplar::levels_for`]) holds, for each texel, the mean of the `2^k × 2^k` texels
+/// [`crate::geom::levels_for`]) holds, for each texel, the mean of the `2^k × 2^k` texels
 /// centred on it on the torus (see [`Integral::mean_around`]). A zoomed-out pixel whose native
 /// texels are the exemplar's block around one coordinate shows exactly this colour.
 pub fn box_stack(texels: &[[u8; 3]], (w, h): (usize, usize)) -> Vec<Vec<[u8; 3]>> {
-    let levels = crate::exemplar::levels_for(w as u32, h as u32) as usize;
+    let levels = crate::geom::levels_for(w as u32, h as u32) as usize;
     (0..=levels)
         .map(|k| {
             let sums = Integral::new(texels, (w, h), 1 << k);

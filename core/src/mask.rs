@@ -35,7 +35,7 @@ impl RandomnessMask {
                 message: format!("must have {width}×{height} values (the exemplar's size), not {}", values.len()),
             });
         }
-        let levels = crate::exemplar::levels_for(width, height);
+        let levels = crate::geom::levels_for(width, height);
         let rows: Vec<MinTable> = values.chunks_exact(w).map(|r| MinTable::new(r, toroidal)).collect();
         let per_level = (0..=levels)
             .map(|l| {
@@ -135,7 +135,7 @@ mod tests {
 
     fn check_minima(m: u32, rows: u32) {
         let values: Vec<u8> = (0..m * rows).map(|i| ((i * 97 + 13) % 251) as u8).collect();
-        let levels = crate::exemplar::levels_for(m, rows);
+        let levels = crate::geom::levels_for(m, rows);
         for toroidal in [true, false] {
             let mask = RandomnessMask::new(m, rows, values.clone(), toroidal).unwrap();
             for l in 0..=levels {

@@ -16,10 +16,10 @@ pub fn addr(i: i64, m: i64, toroidal: bool) -> usize {
 
 const TAPS: [u32; 5] = [1, 4, 6, 4, 1];
 
-/// Build the stack for a `w × h` exemplar: `L + 1` levels ([`crate::exemplar::levels_for`]),
+/// Build the stack for a `w × h` exemplar: `L + 1` levels ([`crate::geom::levels_for`]),
 /// index `l` = level `l` (0 = coarsest, the exact mean colour; `L` = the exemplar itself).
 pub fn build_stack(pixels: &[[u8; 3]], (w, h): (usize, usize), toroidal: bool) -> Vec<Vec<[u16; 3]>> {
-    let levels = crate::exemplar::levels_for(w as u32, h as u32) as usize;
+    let levels = crate::geom::levels_for(w as u32, h as u32) as usize;
     let mut stack = vec![Vec::new(); levels + 1];
     stack[levels] = pixels.iter().map(|p| p.map(|v| (v as u16) << 8)).collect();
     for l in (1..=levels).rev() {
@@ -68,7 +68,7 @@ fn blur(src: &[[u16; 3]], (w, hh): (usize, usize), h: i64, toroidal: bool) -> Ve
 /// Stack level `L − steps` of a `w × h` image, 8-bit: what [`build_stack`] gives there,
 /// without the coarser levels.
 pub fn low_pass(pixels: &[[u8; 3]], dims: (usize, usize), toroidal: bool, steps: u32) -> Vec<[u8; 3]> {
-    let steps = steps.min(crate::exemplar::levels_for(dims.0 as u32, dims.1 as u32));
+    let steps = steps.min(crate::geom::levels_for(dims.0 as u32, dims.1 as u32));
     let mut level: Vec<[u16; 3]> = pixels.iter().map(|p| p.map(|v| (v as u16) << 8)).collect();
     for s in 0..steps {
         level = blur(&level, dims, 1 << s, toroidal);

@@ -188,7 +188,7 @@ pub(crate) fn parse(bytes: &[u8]) -> Result<Analysis, AnalysisFileProblem> {
     let sides = crate::exemplar::MIN_INPUT_SIDE as usize..=crate::exemplar::MAX_SIDE as usize;
     if !sides.contains(&w)
         || !sides.contains(&h)
-        || header.levels != crate::exemplar::levels_for(header.width, header.height)
+        || header.levels != crate::geom::levels_for(header.width, header.height)
     {
         return Err(AnalysisFileProblem::Corrupt(format!("invalid exemplar size {w}x{h}")));
     }

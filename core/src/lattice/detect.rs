@@ -198,7 +198,7 @@ pub fn describe(summary: &serde_json::Value) -> String {
 /// looked at through its largest centred square: a lattice or a repeat is the same
 /// everywhere in the image, and the square keeps the autocorrelation's lags isotropic.
 pub fn detect(pixels: &[[u8; 3]], w: u32, h: u32) -> Detection {
-    let (square, side) = crate::exemplar::centred_square(pixels, (w as usize, h as usize));
+    let (square, side) = crate::geom::centred_square(pixels, (w as usize, h as usize));
     detect_square(&square, side as u32)
 }
 

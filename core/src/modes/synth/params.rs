@@ -139,7 +139,7 @@ impl ParamValue for Randomness {
 impl SynthParams {
     /// Check the parameters for a `w × h` exemplar (list length, period, ranges).
     pub fn validate(&self, (w, h): (usize, usize)) -> Result<()> {
-        let levels = crate::exemplar::levels_for(w as u32, h as u32);
+        let levels = crate::geom::levels_for(w as u32, h as u32);
         let side = w.max(h) as u32;
         if let Randomness::PerLevel(v) = &self.randomness {
             if v.len() != levels as usize + 1 {

@@ -15,7 +15,8 @@ use super::store::{self, Outcome};
 use crate::progress::Progress;
 use crate::cancel::Cancel;
 use crate::error::{AnalysisFileProblem, CoreError, Result};
-use crate::exemplar::{centred_square, Exemplar};
+use crate::exemplar::Exemplar;
+use crate::geom::centred_square;
 use crate::maps::MaterialMap;
 use crate::prepare::{Input, Preparation, Setting};
 
