@@ -346,10 +346,13 @@ async fn analyses_of_uploads_wait_their_turn_and_stop_on_shutdown() {
     assert!(stray.is_empty(), "{stray:?}");
     // The uploads were kept: the next start analyses them (in the background: the service is
     // ready at once), and serves them.
-    let s = admin_server(data.path(), &[]);
+    // (A cold 256² tile beside the other tests' servers on two cores may wait long: queued, not
+    // shed.)
+    let s = admin_server(data.path(), &[("TEXTILE_MAX_QUEUE_WAIT_MS", "600000")]);
     until_ready(&s, "/textures/second").await;
-    let (status, _) = s.get_bytes("/tiles/first/8/0/0.png").await;
-    assert_eq!(status, 200);
+    until_ready(&s, "/textures/first").await;
+    let (status, body) = s.get_bytes("/tiles/first/8/0/0.png").await;
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
 }
 
 #[tokio::test]

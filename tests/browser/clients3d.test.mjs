@@ -42,7 +42,22 @@ const CESIUM_PAGE = `<!doctype html><html><head><meta charset="utf-8">
 <script src="/__3d/cesium/Build/Cesium/Cesium.js"></script>
 <link rel="stylesheet" href="/__3d/cesium/Build/Cesium/Widgets/widgets.css">
 <style>html, body, #globe { margin: 0; width: 100%; height: 100%; }</style></head>
-<body><div id="globe"></div></body></html>`;
+<body><div id="globe"></div>
+<script>
+  // The README's recipe: a viewer on the bare ellipsoid, lit by the real sun at the clock's
+  // time, set to midday at the anchor (Paris: solar noon about 11:50 UTC), else a night view
+  // is dark.
+  window.dayViewer = () => {
+    const viewer = new Cesium.Viewer('globe', {
+      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false, animation: false,
+      homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
+      infoBox: false, selectionIndicator: false, terrainProvider: new Cesium.EllipsoidTerrainProvider(),
+    });
+    viewer.clock.currentTime = Cesium.JulianDate.fromIso8601('2026-06-21T11:50:00Z');
+    viewer.clock.shouldAnimate = false;
+    return viewer;
+  };
+</script></body></html>`;
 
 before(async () => {
   assert.ok(BASE, 'TEXTILE_URL must name the server under test');
@@ -365,18 +380,10 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
     if (m) content.add(Number(m[1]));
     if (r.url().includes('/3dtiles/') && r.status() !== 200) failed.push(`${r.status()} ${r.url()}`);
   });
-  await page.waitForFunction(() => window.Cesium);
+  await page.waitForFunction(() => window.Cesium && window.dayViewer);
   // Paris, 35 m above the ellipsoid: 1 texel = 1 m, east-north-up.
   const r = await page.evaluate(async (base) => {
-    const viewer = new Cesium.Viewer('globe', {
-      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false, animation: false,
-      homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
-      infoBox: false, selectionIndicator: false, terrainProvider: new Cesium.EllipsoidTerrainProvider(),
-    });
-    // CesiumJS lights the scene by the real sun at the clock's time: the README's recipe sets
-    // midday at the anchor (Paris: solar noon about 11:50 UTC), else a night view is dark.
-    viewer.clock.currentTime = Cesium.JulianDate.fromIso8601('2026-06-21T11:50:00Z');
-    viewer.clock.shouldAnimate = false;
+    const viewer = window.dayViewer();
     const failures = [];
     const tileset = await Cesium.Cesium3DTileset.fromUrl(`${base}/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=4`);
     tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
@@ -434,17 +441,11 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
 
 test('CesiumJS shows relief without cracks: no globe through the ground near, oblique or at the horizon', async () => {
   const { page, errors } = await open(CESIUM_PAGE);
-  await page.waitForFunction(() => window.Cesium);
+  await page.waitForFunction(() => window.Cesium && window.dayViewer);
   // Flagstones with relief 8, anchored 35 m above the ellipsoid, whose globe is painted magenta
   // (no imagery, no ground atmosphere, no fog): a crack between tiles shows it.
   const failures = await page.evaluate(async (base) => {
-    const viewer = new Cesium.Viewer('globe', {
-      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false, animation: false,
-      homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
-      infoBox: false, selectionIndicator: false, terrainProvider: new Cesium.EllipsoidTerrainProvider(),
-    });
-    viewer.clock.currentTime = Cesium.JulianDate.fromIso8601('2026-06-21T11:50:00Z');
-    viewer.clock.shouldAnimate = false;
+    const viewer = window.dayViewer();
     viewer.scene.globe.baseColor = Cesium.Color.MAGENTA;
     viewer.scene.globe.showGroundAtmosphere = false;
     viewer.scene.fog.enabled = false;
