@@ -224,9 +224,7 @@ impl Exemplar {
             });
         }
         let (width, height) = (big_w / 2, big_h / 2);
-        let (bw, bh) = (2 * width as usize, 2 * height as usize);
-        let big: Vec<[u8; 3]> = (0..bh).flat_map(|y| &hires.pixels[y * big_w as usize..][..bw]).copied().collect();
-        let pixels = area_resample(&big, (bw, bh), (width as usize, height as usize));
+        let (big, pixels) = halve(&hires.pixels, (big_w, big_h));
         let seam_ratio = seam_ratio(&pixels, width as usize, height as usize);
         let forced = hires.preparation.toroidal_forced;
         let toroidal = if forced { hires.toroidal } else { seam_ratio <= 1.5 };
@@ -292,8 +290,8 @@ impl Exemplar {
         }
         let (texels, hires) = match &self.hires {
             Some(_) => {
-                let reduced = Exemplar::from_hires(image.clone())?;
-                (reduced.pixels, reduced.hires)
+                let (big, reduced) = halve(&image.pixels, (image.width, image.height));
+                (reduced, Some(big))
             }
             None => (image.pixels.clone(), None),
         };
@@ -375,6 +373,15 @@ fn check_size(w: u32, h: u32, max: u32) -> Result<()> {
         return Err(CoreError::ExemplarSize { width: w, height: h, min: MIN_INPUT_SIDE, max });
     }
     Ok(())
+}
+
+/// A `w × h` image made even (an odd last row or column dropped) and its exact 2×2 box
+/// reduction: what [`Exemplar::from_hires`] keeps and uses, for the colour and every map alike.
+fn halve(pixels: &[[u8; 3]], (w, h): (u32, u32)) -> (Vec<[u8; 3]>, Vec<[u8; 3]>) {
+    let (bw, bh) = (w as usize / 2 * 2, h as usize / 2 * 2);
+    let big: Vec<[u8; 3]> = (0..bh).flat_map(|y| &pixels[y * w as usize..][..bw]).copied().collect();
+    let reduced = area_resample(&big, (bw, bh), (bw / 2, bh / 2));
+    (big, reduced)
 }
 
 /// The prepared size of a `w × h` image: the same, unless a side exceeds [`MAX_SIDE`]; then

@@ -94,6 +94,35 @@ function save(name, dataUrl) {
   writeFileSync(join(ARTEFACTS, name), Buffer.from(dataUrl.split(',')[1], 'base64'));
 }
 
+/** A screenshot of the page (base64 PNG) and the RGBA pixels of a part of it: `[x, y, w, h]`
+ * as shares of its width and height. */
+async function screenshot(page, [fx, fy, fw, fh]) {
+  const png = (await page.screenshot()).toString('base64');
+  const data = await page.evaluate(async ([src, fx, fy, fw, fh]) => {
+    const img = new Image();
+    img.src = src;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width; c.height = img.height;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const [x, y] = [Math.floor(fx * img.width), Math.floor(fy * img.height)];
+    return Array.from(g.getImageData(x, y, Math.floor(fw * img.width), Math.floor(fh * img.height)).data);
+  }, [`data:image/png;base64,${png}`, fx, fy, fw, fh]);
+  return { png, data };
+}
+
+/** /3d.html at `hash` in a page of its own, once its tileset has loaded; its console errors. */
+async function open3d(hash) {
+  const page = await browser.newPage({ viewport: { width: 800, height: 560 } });
+  const errors = [];
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(`${BASE}/3d.html#${hash}`);
+  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 30000 });
+  return { page, errors };
+}
+
 function fmt(s) {
   return `edges ${s.edges.mean.toFixed(2)} levels (${(100 * s.edges.over8).toFixed(2)} % > 8, ${s.edges.pixels} px), ` +
     `elsewhere ${s.elsewhere.mean.toFixed(2)} (${(100 * s.elsewhere.over8).toFixed(2)} % > 8, ${s.elsewhere.pixels} px)`;
@@ -292,12 +321,7 @@ test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the ca
 });
 
 test('/3d.html lights a material with a sun whose direction a slider turns', async () => {
-  const page = await browser.newPage({ viewport: { width: 800, height: 560 } });
-  const errors = [];
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  page.on('pageerror', (e) => errors.push(String(e)));
-  await page.goto(`${BASE}/3d.html#t=flagstones&m=synth&seed=2&sun=0&cam=32768,200,32868,32768,0,32768`);
-  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 30000 });
+  const { page, errors } = await open3d('t=flagstones&m=synth&seed=2&sun=0&cam=32768,200,32868,32768,0,32768');
   await settled3d(page);
   assert.equal(await page.isVisible('#sunrow'), true, 'a material with normals offers the sun');
   const grab = () => page.evaluate(() => {
@@ -327,14 +351,9 @@ test('/3d.html lights a material with a sun whose direction a slider turns', asy
 });
 
 test('/3d.html shows relief without cracks: no sky through the ground near, oblique or at the horizon', async () => {
-  const page = await browser.newPage({ viewport: { width: 800, height: 560 } });
-  const errors = [];
-  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
-  page.on('pageerror', (e) => errors.push(String(e)));
   // Flagstones (65 536 texels across), relief 8 texels high: tiles of several levels meet in
   // every view, their edges at other heights; the skirts must close every gap.
-  await page.goto(`${BASE}/3d.html#t=flagstones&m=synth&seed=2&relief=8&cam=32768,30,32800,32768,0,32768`);
-  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 30000 });
+  const { page, errors } = await open3d('t=flagstones&m=synth&seed=2&relief=8&cam=32768,30,32800,32768,0,32768');
   assert.match(await page.evaluate(() => document.querySelector('#tilesetlink').href), /relief=8/);
   assert.equal(await page.isVisible('#reliefrow'), true, 'a texture with a height map offers relief');
   assert.equal(await page.inputValue('#relief'), '8');
@@ -405,23 +424,13 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
       lon: Cesium.Math.toDegrees(where.longitude), lat: Cesium.Math.toDegrees(where.latitude),
     };
   }, BASE);
-  const png = (await page.screenshot()).toString('base64');
-  save('cesium.png', `data:image/png;base64,${png}`);
   // The middle of the view is the texture, lit by day: about as bright as the tile itself (a
   // night-time clock gave 45–66 against the tile's 130).
-  const lit = await page.evaluate(async (src) => {
-    const img = new Image();
-    img.src = src;
-    await img.decode();
-    const c = document.createElement('canvas');
-    c.width = img.width; c.height = img.height;
-    const g = c.getContext('2d');
-    g.drawImage(img, 0, 0);
-    const d = g.getImageData(img.width * 3 / 8, img.height * 3 / 8, img.width / 4, img.height / 4).data;
-    let sum = 0;
-    for (let i = 0; i < d.length; i += 4) sum += (d[i] + d[i + 1] + d[i + 2]) / 3;
-    return sum / (d.length / 4);
-  }, `data:image/png;base64,${png}`);
+  const { png, data: d } = await screenshot(page, [3 / 8, 3 / 8, 1 / 4, 1 / 4]);
+  save('cesium.png', `data:image/png;base64,${png}`);
+  let sum = 0;
+  for (let i = 0; i < d.length; i += 4) sum += (d[i] + d[i + 1] + d[i + 2]) / 3;
+  const lit = sum / (d.length / 4);
   console.log(`CesiumJS: the middle of the view at midday has mean luminance ${lit.toFixed(1)}`);
   assert.ok(lit > 85, `the texture is lit by day: mean ${lit}`);
   const levels = [...content].sort((a, b) => a - b);
@@ -459,21 +468,10 @@ test('CesiumJS shows relief without cracks: no globe through the ground near, ob
   }, BASE);
   // The magenta pixels below row `from` (a share of the height: the sky above the horizon).
   const magenta = async (from) => {
-    const png = (await page.screenshot()).toString('base64');
-    return [png, await page.evaluate(async ([src, from]) => {
-      const img = new Image();
-      img.src = src;
-      await img.decode();
-      const c = document.createElement('canvas');
-      c.width = img.width; c.height = img.height;
-      const g = c.getContext('2d');
-      g.drawImage(img, 0, 0);
-      const y0 = Math.floor(from * img.height);
-      const d = g.getImageData(0, y0, img.width, img.height - y0).data;
-      let n = 0;
-      for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 90 && d[i + 2] > 180) n++;
-      return n;
-    }, [`data:image/png;base64,${png}`, from])];
+    const { png, data: d } = await screenshot(page, [0, from, 1, 1 - from]);
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 90 && d[i + 2] > 180) n++;
+    return [png, n];
   };
   const views = [['near', 0.3, -1.2, 60, 0], ['oblique', 0.6, -0.5, 400, 0.2], ['horizon', 0.9, -0.1, 300, 0.6]];
   const found = {};

@@ -16,6 +16,8 @@
 
 use rayon::prelude::*;
 
+use crate::geom::wrap;
+
 use crate::analysis::FineDetail;
 
 /// Radius of the blend, texels: a pixel reads the coordinates within this Chebyshev distance.
@@ -89,10 +91,10 @@ pub(crate) fn blend(coords: &[u32], (w, h): (usize, usize), src: &Texels, fade: 
     let mut padded = vec![0u64; pm * ph];
     padded.par_chunks_exact_mut(pm).enumerate().for_each(|(py, row)| {
         let y = py as i64 - R as i64;
-        let y = if toroidal { y.rem_euclid(ehi) } else { y.clamp(0, ehi - 1) } as usize;
+        let y = if toroidal { wrap(y, ehi) } else { y.clamp(0, ehi - 1) } as usize;
         for (px, out) in row.iter_mut().enumerate() {
             let x = px as i64 - R as i64;
-            let x = if toroidal { x.rem_euclid(ewi) } else { x.clamp(0, ewi - 1) } as usize;
+            let x = if toroidal { wrap(x, ewi) } else { x.clamp(0, ewi - 1) } as usize;
             *out = pack(low[y * ew + x]);
         }
     });
@@ -105,7 +107,7 @@ pub(crate) fn blend(coords: &[u32], (w, h): (usize, usize), src: &Texels, fade: 
     let mut trans = vec![0isize; bw * bh];
     trans.par_chunks_exact_mut(bw).zip(coords.par_chunks_exact(bw)).enumerate().for_each(|(y, (row_t, row_c))| {
         for (x, (t, &v)) in row_t.iter_mut().zip(row_c).enumerate() {
-            let (sx, sy) = (((v & 0xFFFF) as i64).rem_euclid(ewi), ((v >> 16) as i64).rem_euclid(ehi));
+            let (sx, sy) = (wrap((v & 0xFFFF) as i64, ewi), wrap((v >> 16) as i64, ehi));
             *t = ((sy as usize + R) * pm + sx as usize + R) as isize - lin(x, y);
         }
     });
@@ -115,7 +117,7 @@ pub(crate) fn blend(coords: &[u32], (w, h): (usize, usize), src: &Texels, fade: 
     let next = |v: u32, dx: i64, dy: i64| -> u32 {
         let (x, y) = ((v & 0xFFFF) as i64 + dx, (v >> 16) as i64 + dy);
         if toroidal {
-            (x.rem_euclid(ewi) | (y.rem_euclid(ehi) << 16)) as u32
+            crate::geom::pack_wrapped(x, y, (ewi, ehi))
         } else {
             (x | y << 16) as u32
         }
