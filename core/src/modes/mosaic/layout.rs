@@ -49,7 +49,61 @@ pub(super) struct Layout {
     period_tiles: Option<(i64, i64)>,
     /// The exemplar's lattice: block offsets are snapped to its translations.
     lattice: LevelLattice,
+    /// Where the background's tiles lie when they are laid on lattice translations.
+    tiles_on_lattice: Option<LatticeTiles>,
     pub(super) p: MosaicParams,
+}
+
+/// The background of a near-regular exemplar whose sides are not lattice translations (brick's
+/// columns every 17.97 texels across 256): its tiles are laid on the lattice translations `lx`
+/// and `ly` nearest the sides (at most the sides), so the phase runs on across every tile
+/// border instead of jumping by the side's remainder. A point's tile is the cell of the
+/// `lx, ly` lattice holding it; the few texels of a sheared cell that fall outside the exemplar
+/// wrap by its sides.
+#[derive(Debug, Clone, Copy)]
+struct LatticeTiles {
+    lx: (i64, i64),
+    ly: (i64, i64),
+    /// `[lx ly]⁻¹`, for a sheared cell's tile.
+    inv: [[f64; 2]; 2],
+}
+
+impl LatticeTiles {
+    /// The tiles for an `ew × eh` exemplar of lattice `l`; `None` where the sides are lattice
+    /// translations already (the plain tiling keeps the phase) or no translation near a side
+    /// fits in it.
+    fn new(l: &LevelLattice, ew: i64, eh: i64) -> Option<LatticeTiles> {
+        // A side that is a translation (a free axis of stripes, or a whole number of cells)
+        // stays; another is the translation nearest the side less half the longest period.
+        let side = |v: (i64, i64), less: (i64, i64)| if l.translation(v) == v { v } else { l.translation(less) };
+        let (lx, ly) = (side((ew, 0), (ew - l.reach, 0)), side((0, eh), (0, eh - l.reach)));
+        if (lx, ly) == ((ew, 0), (0, eh)) {
+            return None;
+        }
+        let fits = |(x, y): (i64, i64), along: i64, across: i64| x > along / 2 && x <= along && y.abs() < across / 4;
+        let det = (lx.0 * ly.1 - lx.1 * ly.0) as f64;
+        if !fits(lx, ew, eh) || !fits((ly.1, ly.0), eh, ew) || det <= 0.0 {
+            return None;
+        }
+        let inv = [[ly.1 as f64 / det, -ly.0 as f64 / det], [-lx.1 as f64 / det, lx.0 as f64 / det]];
+        Some(LatticeTiles { lx, ly, inv })
+    }
+
+    /// The tile holding texel `d` (its indices `a, b`: origin `a·lx + b·ly`) and `d`'s offset
+    /// from its origin, not yet wrapped into the exemplar.
+    #[inline]
+    fn locate(&self, d: (i64, i64)) -> ((i64, i64), (i64, i64)) {
+        let (a, b) = if self.lx.1 == 0 && self.ly.0 == 0 {
+            (d.0.div_euclid(self.lx.0), d.1.div_euclid(self.ly.1))
+        } else {
+            let (x, y) = (d.0 as f64, d.1 as f64);
+            (
+                (self.inv[0][0] * x + self.inv[0][1] * y).floor() as i64,
+                (self.inv[1][0] * x + self.inv[1][1] * y).floor() as i64,
+            )
+        };
+        ((a, b), (d.0 - a * self.lx.0 - b * self.ly.0, d.1 - a * self.lx.1 - b * self.ly.1))
+    }
 }
 
 impl Layout {
@@ -68,7 +122,34 @@ impl Layout {
         }
         let keys = [key(TAG_MOSAIC_BLOCK, p.seed), key(TAG_MOSAIC_PRIO, p.seed)];
         let lattice = lattice.map_or(LevelLattice::FREE, Lattice::whole);
-        Layout { ew, eh, tiles, span, q, cat, keys, period_tiles, lattice, p: p.clone() }
+        // A periodic world keeps the plain tiling, which its period repeats.
+        let tiles_on_lattice = match (lattice.is_free(), period_tiles) {
+            (false, None) => LatticeTiles::new(&lattice, ew, eh),
+            _ => None,
+        };
+        Layout { ew, eh, tiles, span, q, cat, keys, period_tiles, lattice, tiles_on_lattice, p: p.clone() }
+    }
+
+    /// Whether the background's tiles lie on lattice translations rather than at the sides.
+    pub(super) fn tiles_on_lattice(&self) -> bool {
+        self.tiles_on_lattice.is_some()
+    }
+
+    /// The background at texel `d`: its tile's indices and the exemplar texel it shows, not
+    /// yet wrapped into the exemplar (in phase with `d`'s neighbours on the lattice).
+    #[inline]
+    fn background_unwrapped(&self, d: (i64, i64)) -> ((i64, i64), (i64, i64)) {
+        match &self.tiles_on_lattice {
+            Some(t) => t.locate(d),
+            None => ((d.0.div_euclid(self.ew), d.1.div_euclid(self.eh)), (d.0.rem_euclid(self.ew), d.1.rem_euclid(self.eh))),
+        }
+    }
+
+    /// The background at texel `d`: its tile's indices and the exemplar texel it shows.
+    #[inline]
+    pub(super) fn background(&self, d: (i64, i64)) -> ((i64, i64), (i64, i64)) {
+        let (tile, (x, y)) = self.background_unwrapped(d);
+        (tile, (x.rem_euclid(self.ew), y.rem_euclid(self.eh)))
     }
 
     /// The block of tile `(a1, a2)` of super-tile `(s1, s2)`: absolute tile
@@ -124,16 +205,15 @@ impl Layout {
         let s = (a.wrapping_mul(x0).wrapping_add(b.wrapping_mul(y0))) & mask;
         let t = (c.wrapping_mul(x0).wrapping_add(d.wrapping_mul(y0))) & mask;
         let (k1, k2) = (s1 * self.tiles.0 + a1, s2 * self.tiles.1 + a2);
-        let (mut s, mut t) = (from_q(s as i64, span_x), from_q(t as i64, span_y));
+        let (mut dx, mut dy) = (s1 * span_x + from_q(s as i64, span_x), s2 * span_y + from_q(t as i64, span_y));
         if !self.lattice.is_free() {
-            // A near-regular exemplar's block moves by a lattice translation from where the
-            // tiled exemplar shows its source, so rows and gaps continue across its border
-            // (measured within the super-tile, which the tiled exemplar repeats: a periodic
-            // world stays periodic).
-            let (tx, ty) = self.lattice.translation((s - sx, t - sy));
-            (s, t) = (sx + tx, sy + ty);
+            // A near-regular exemplar's block moves to the nearest place where the background
+            // shows texels of its source's phase, so rows and gaps continue across its border
+            // (the background repeats with the world's period: a periodic world stays periodic).
+            let (mx, my) = self.lattice.snap(self.background_unwrapped((dx, dy)).1, (sx, sy));
+            (dx, dy) = (dx + mx, dy + my);
         }
-        Block { sx, sy, w, h, dx: s1 * span_x + s, dy: s2 * span_y + t, prio: (prio, k2, k1) }
+        Block { sx, sy, w, h, dx, dy, prio: (prio, k2, k1) }
     }
 
     /// The blocks of super-tile `(s1, s2)` that meet `r`, appended to `out`. Hashes, sides and
@@ -240,6 +320,41 @@ mod tests {
                     assert_eq!((b.sx, b.sy, b.w, b.h, b.dx, b.dy, b.prio), (r.sx, r.sy, r.w, r.h, r.dx, r.dy, r.prio));
                 }
             }
+        }
+    }
+
+    /// A near-regular exemplar whose side is no multiple of its period (stripes every 17.97
+    /// texels across 256, and a bond 61.3 × 28.4 at half a brick's stagger): across every
+    /// border of the background's tiles the texels shown keep their lattice phase within half a
+    /// texel, where the plain tiling jumps by the side's remainder (4.4 texels for the stripes).
+    #[test]
+    fn background_tiles_keep_the_phase_across_their_borders() {
+        use crate::lattice::Wave;
+        // The bond's translations (61.3, 0) and (30.65, 28.4): courses, and the wave whose
+        // vector (1/61.3, −0.5/28.4) is whole on both.
+        let (kx, ky): (f64, f64) = (1.0 / 61.3, -0.5 / 28.4);
+        let bond = [Wave::new(28.4, 90.0), Wave::new(1.0 / kx.hypot(ky), ky.atan2(kx).to_degrees())];
+        for waves in [vec![Wave::new(17.97, 0.0)], bond.to_vec()] {
+            let lattice = Lattice::given(waves, 256).unwrap();
+            let l = Layout::new((256, 256), &MosaicParams::default(), Some(&lattice));
+            assert!(l.tiles_on_lattice());
+            let whole = lattice.whole();
+            let off_phase = |d: (i64, i64)| {
+                let (m, n) = whole.snap(d, (0, 0));
+                m.abs().max(n.abs())
+            };
+            let mut borders = 0;
+            for y in (-3000..3000).step_by(37) {
+                for x in -3000..3000 {
+                    let (ta, a) = l.background((x, y));
+                    let (tb, b) = l.background((x + 1, y));
+                    if ta != tb {
+                        borders += 1;
+                        assert!(off_phase((b.0 - a.0 - 1, b.1 - a.1)) <= 1, "{x},{y}: {a:?} → {b:?}");
+                    }
+                }
+            }
+            assert!(borders > 1000, "{borders}");
         }
     }
 

@@ -32,7 +32,7 @@ pub struct Mosaic;
 
 impl Mode for Mosaic {
     const NAME: &'static str = "mosaic";
-    const VERSION: u32 = 2;
+    const VERSION: u32 = 3;
     const SUMMARY: &'static str = "chaos mosaic (Xu, Guo & Shum): the tiled exemplar with blocks moved by the cat map; cheap";
     const NEEDS: Needs = Needs::Exemplar;
     const COST: Cost = Cost::Light;

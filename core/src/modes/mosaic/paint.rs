@@ -80,6 +80,17 @@ fn background(layout: &Layout, rect: Rect, toroidal: bool, step: i64, offset: i6
     let mut src = vec![0u32; w * h];
     // Tile and texel within it along an axis of `n`-texel tiles.
     let split = |v: i64, n: i64| ((v.div_euclid(n) & 0x7FFF) as u32, v.rem_euclid(n) as u32);
+    if layout.tiles_on_lattice() {
+        for j in 0..h {
+            let y = (rect.y0 + j as i64) * step + offset;
+            for i in 0..w {
+                let ((tx, ty), (sx, sy)) = layout.background(((rect.x0 + i as i64) * step + offset, y));
+                label[j * w + i] = (1 << 31) | ((ty & 0x7FFF) as u32) << 15 | (tx & 0x7FFF) as u32;
+                src[j * w + i] = (sy as u32) << 16 | sx as u32;
+            }
+        }
+        return (label, src);
+    }
     let cols: Vec<(u32, u32)> = (rect.x0..rect.x1).map(|i| split(i * step + offset, ew)).collect();
     for j in 0..h {
         let (ty, sy) = split((rect.y0 + j as i64) * step + offset, eh);
