@@ -38,7 +38,7 @@ fn the_defaults_keep_their_canonical_text() {
         got,
         [
             "mode=synth;v6;seed=0;r=default;passes=2;sub=4;kappa=65536;period=none",
-            "mode=mosaic;v2;seed=0;it=10;area=500,750;smooth=3;period=none",
+            "mode=mosaic;v3;seed=0;it=10;area=500,750;smooth=3;period=none",
             "mode=tiling;v1;",
             "mode=umbrella;v13;seed=0;density=100;scale=850,1150;shape=32768;colour=65536;shadow=19660,2;k=8;bg=mosaic;period=none",
         ]
@@ -66,7 +66,7 @@ fn every_parameter_set_keeps_its_canonical_text() {
             "mosaic",
             &[("seed", "3"), ("world", "1"), ("iterations", "5"), ("block_area", "0.25,0.5"), ("smoothing", "1")]
         ),
-        "mode=mosaic;v2;seed=3;it=5;area=250,500;smooth=1;period=256"
+        "mode=mosaic;v3;seed=3;it=5;area=250,500;smooth=1;period=256"
     );
     assert_eq!(requested("tiling", &[("seed", "3"), ("world", "2")]), "mode=tiling;v1;");
     assert_eq!(
