@@ -2,7 +2,8 @@
 //! than against our own code: the tileset's required properties and implicit-tiling rules, every
 //! subtree's binary header and availability layout (sizes of the bitstreams, counts, which
 //! levels and child subtrees exist), content URIs that resolve to the glTF tile of the flipped
-//! row and lie inside their implicit tile's bounding box, the root transform, ETags, bad input.
+//! row and lie inside their implicit tile's bounding box, a world of 2^26 texels a side whose
+//! levels above zoom 0 show zoom 0's colour, the root transform, ETags, bad input.
 
 mod common;
 
@@ -100,7 +101,18 @@ async fn tileset_and_subtrees_follow_the_specification() {
     let t: Value = r.json().await.unwrap();
     let (sl, levels) = check_tileset(&t);
     let meta = s.json("/textures/gravel").await;
-    assert_eq!(levels as u64, meta["maxzoom"].as_u64().unwrap() + 1, "one level per zoom 0..=maxzoom");
+    // The world has no edge a viewer reaches: 2^26 texels a side around texel (0, 0), levels
+    // above zoom 0 to cover it, then one level per zoom 0..=maxzoom.
+    let lift = t["extras"]["level_of_zoom_0"].as_u64().unwrap();
+    let side = t["extras"]["world_texels"].as_f64().unwrap();
+    let b = &t["root"]["boundingVolume"]["box"];
+    assert_eq!(
+        (b[0].as_f64(), b[1].as_f64(), b[3].as_f64(), b[7].as_f64()),
+        (Some(0.0), Some(0.0), Some(side / 2.0), Some(side / 2.0))
+    );
+    assert_eq!(side, (256u64 << (meta["native_zoom"].as_u64().unwrap() + lift)) as f64, "the root is zoom 0 lifted");
+    assert!(side >= 67_108_864.0, "a world of {side} texels");
+    assert_eq!(levels as u64, lift + meta["maxzoom"].as_u64().unwrap() + 1, "one level per zoom 0..=maxzoom");
     // Every subtree root level: the availability says exactly which levels exist.
     for root in (0..levels).step_by(sl as usize) {
         let n = 1i64 << root;
@@ -134,20 +146,36 @@ async fn content_tiles_are_the_gltf_tiles_inside_their_boxes() {
     // The root box is axis-aligned here: its x and y extent.
     let (x0, y0, side) = (b[0] - b[3], b[1] - b[7], 2.0 * b[3]);
     assert_eq!(b[3], b[7]);
-    for (level, x, y) in [(0u32, 0i64, 0i64), (3, 2, 5), (7, 100, 3), (9, 511, 0)] {
+    let lift = t["extras"]["level_of_zoom_0"].as_u64().unwrap() as u32;
+    let l = |d: u32| lift + d;
+    let zoom0 = s.get_bytes("/tiles/gravel/0/0/0.png?seed=4&mode=mosaic").await.1;
+    let zoom0 = image::load_from_memory(&zoom0).unwrap().to_rgb8();
+    let tiles =
+        [(0u32, 0i64, 0i64), (3, 2, 5), (lift - 1, 1 << (lift - 2), 0), (l(0), 1 << (lift - 1), (1 << (lift - 1)) - 1)];
+    let tiles = tiles.into_iter().chain([(l(3), 2, 5), (l(7), 100 << lift, 3 << lift), (l(9), 511 << lift, 0)]);
+    for (level, x, y) in tiles {
         let uri = template
             .replace("{level}", &level.to_string())
             .replace("{x}", &x.to_string())
             .replace("{y}", &y.to_string());
         let (status, glb) = s.get_bytes(&format!("/3dtiles/gravel/{uri}")).await;
         assert_eq!(status, 200, "{uri}");
-        // The same bytes as the XYZ tile of the flipped row.
-        let row = (1i64 << level) - 1 - y;
-        let xyz = s.get_bytes(&format!("/gltf/gravel/{level}/{x}/{row}.glb?seed=4&mode=mosaic")).await.1;
-        assert!(glb == xyz, "{uri} is /gltf/gravel/{level}/{x}/{row}.glb");
+        let (json, bin) = common::parse_glb(&glb);
+        if level >= lift {
+            // The same bytes as the XYZ tile of the flipped row, the root centred on texel 0.
+            let half = 1i64 << (level - 1);
+            let (z, col, row) = (level - lift, x - half, half - 1 - y);
+            let xyz = s.get_bytes(&format!("/gltf/gravel/{z}/{col}/{row}.glb?seed=4&mode=mosaic")).await.1;
+            assert!(glb == xyz, "{uri} is /gltf/gravel/{z}/{col}/{row}.glb");
+        } else {
+            // Above zoom 0: zoom 0's colour, uniform.
+            let png = common::glb_image(&json, &bin, 0);
+            let img = image::load_from_memory(&png).unwrap().to_rgb8();
+            assert!(img.pixels().all(|p| p == zoom0.get_pixel(0, 0)), "{uri} shows zoom 0's colour");
+        }
         // CesiumJS carries the tileset's query (anchoring included) into content URLs.
         let carried = s.get_bytes(&format!("/3dtiles/gravel/{uri}&lon=2.35&lat=48.85&height=35")).await.1;
-        assert!(carried == xyz, "{uri} with the anchoring parameters");
+        assert!(carried == glb, "{uri} with the anchoring parameters");
         // Its quad, Y-up turned Z-up ((x, y, z) → (x, −z, y)), covers the implicit tile.
         let jl = u32le(&glb, 12) as usize;
         let json: Value = serde_json::from_slice(&glb[20..20 + jl]).unwrap();
@@ -192,7 +220,7 @@ async fn bad_3dtiles_requests_are_json_4xx() {
         ("/3dtiles/gravel/tileset.json?lon=x&lat=1", 400, "invalid_parameter"),
         ("/3dtiles/gravel/tileset.json?bogus=1", 400, "unknown_parameter"),
         ("/3dtiles/nosuch/tileset.json", 404, "unknown_texture"),
-        ("/3dtiles/gravel/tiles/11/0/0.glb", 400, "invalid_coordinate"),
+        ("/3dtiles/gravel/tiles/99/0/0.glb", 400, "invalid_coordinate"),
         ("/3dtiles/gravel/tiles/2/4/0.glb", 400, "invalid_coordinate"),
         ("/3dtiles/gravel/tiles/2/0/-1.glb", 400, "invalid_coordinate"),
         ("/3dtiles/gravel/tiles/2/0/0.png", 400, "invalid_format"),
@@ -227,7 +255,10 @@ async fn a_tileset_with_relief_serves_displaced_content() {
     let (z0, z1) = (b[2] - b[11], b[2] + b[11]);
     assert!(z0 <= -0.5 && (8.0..=8.5).contains(&z1), "the box's height {z0}..{z1} holds the relief");
     let (x0, y0, side) = (b[0] - b[3], b[1] - b[7], 2.0 * b[3]);
-    for (level, x, y) in [(2u32, 1i64, 1i64), (5, 3, 30), (8, 200, 17), (9, 0, 511)] {
+    let lift = tileset["extras"]["level_of_zoom_0"].as_u64().unwrap() as u32;
+    for (level, x, y) in
+        [(2u32, 1i64, 1i64), (lift + 2, 1, 1), (lift + 5, 3, 30), (lift + 8, 200, 17), (lift + 9, 0, 511)]
+    {
         let (status, bytes) = s.get_bytes(&format!("/3dtiles/flagstones/tiles/{level}/{x}/{y}.glb?relief=8")).await;
         assert_eq!(status, 200);
         // Compact: a 33² grid with skirts, 16-bit indices, beside the tile's images.

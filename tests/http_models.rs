@@ -24,9 +24,7 @@ fn crop(img: &image::RgbImage, x: u32, y: u32, w: u32, h: u32) -> image::RgbImag
 }
 
 fn image_bytes(json: &Value, bin: &[u8], i: usize) -> Vec<u8> {
-    let view = &json["bufferViews"][json["images"][i]["bufferView"].as_u64().unwrap() as usize];
-    let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
-    bin[o..o + l].to_vec()
+    common::glb_image(json, bin, i)
 }
 
 #[tokio::test]

@@ -98,12 +98,29 @@ function placeSun() {
   sun.target.position.copy(g);
   sun.position.set(g.x + Math.cos(a) * 0.82, 0.57, g.z - Math.sin(a) * 0.82);
 }
-const camera = new THREE.PerspectiveCamera(50, 1, 0.5, 4e6);
+// The world (server/src/tileset.rs): a square of 2^26 texels around texel (0, 0), seen from at
+// most MAX_HEIGHT above the ground and out to FAR; the target stays within PAN of the centre,
+// so the ground's far end is always beyond the far plane: no edge in view, and the far plane
+// cuts the ground within a hundredth of a degree of the horizon.
+const WORLD = 2 ** 26, MAX_HEIGHT = 20000, FAR = 3e7;
+const PAN = WORLD / 2 - FAR - MAX_HEIGHT;
+const camera = new THREE.PerspectiveCamera(50, 1, 0.5, FAR);
 const controls = new MapControls(camera, renderer.domElement);
 controls.screenSpacePanning = false;
 controls.maxPolarAngle = Math.PI / 2 - 0.02;
 controls.minDistance = 2;
+controls.maxDistance = MAX_HEIGHT;
 controls.addEventListener('end', () => { clearTimeout(debounce); debounce = setTimeout(writeHash, 200); });
+/** Keep the target within PAN of the world's centre, moving the camera with it. */
+function keepInWorld() {
+  const t = controls.target;
+  const dx = Math.min(PAN, Math.max(-PAN, t.x)) - t.x, dz = Math.min(PAN, Math.max(-PAN, t.z)) - t.z;
+  if (dx || dz) {
+    t.x += dx; t.z += dz;
+    camera.position.x += dx; camera.position.z += dz;
+  }
+}
+controls.addEventListener('change', keepInWorld);
 
 function resize() {
   const el = $('view');
@@ -123,7 +140,8 @@ function loadTiles() {
   tiles = new TilesRenderer(url);
   tiles.registerPlugin(new ImplicitTilingPlugin());
   // A few requests at a time: a burst of hundreds would only queue (or be shed) at the server.
-  tiles.downloadQueue.maxJobsPerOrigin = 4;
+  tiles.downloadQueue.maxJobsPerOrigin = 8;
+  tiles.loadAncestors = false;
   tiles.group.rotation.x = -Math.PI / 2;
   tiles.setCamera(camera);
   tiles.setResolutionFromRenderer(camera, renderer);
@@ -137,6 +155,9 @@ function loadTiles() {
     }
   });
   tiles.addEventListener('load-tileset', () => { document.body.dataset.ready = '1'; });
+  tiles.addEventListener('needs-update', () => { needsUpdate = true; });
+  for (const type of ['load-model', 'dispose-model', 'tile-visibility-change']) tiles.addEventListener(type, () => { needsRender = true; });
+  invalidate();
   scene.add(tiles.group);
   writeHash();
 }
@@ -147,6 +168,7 @@ function placeCamera() {
   const [ex, ey, ez, tx, ty, tz] = state.cam ?? [side / 2, 700, side / 2 + 700, side / 2, 0, side / 2];
   camera.position.set(ex, ey, ez);
   controls.target.set(tx, ty, tz);
+  keepInWorld();
   controls.update();
 }
 
@@ -218,16 +240,37 @@ async function selectTexture(id, keepView) {
   loadTiles();
 }
 
-function frame() {
+// Frames are drawn when something changed, not 60 times a second: the tiles are traversed when
+// the camera moved or a tile arrived ('needs-update'), and the scene drawn after that, at most
+// every RENDER_GAP ms while tiles are still loading. A software renderer (SwiftShader, as in
+// headless Chromium) shares the cores with the server; drawing an unchanged scene over and
+// over took most of them while the first view loaded (bench/README.md, "The first 3D view").
+const RENDER_GAP = 300;
+let needsUpdate = true, needsRender = true, lastRender = 0;
+/** Traverse the tiles and draw again. */
+function invalidate() {
+  needsUpdate = true;
+  needsRender = true;
+}
+for (const type of ['input', 'change', 'pointermove', 'wheel']) document.addEventListener(type, invalidate, true);
+window.addEventListener('resize', invalidate);
+
+function frame(now) {
   requestAnimationFrame(frame);
-  controls.update();
-  camera.updateMatrixWorld();
-  if (sun.intensity > 0) placeSun();
-  if (tiles) {
+  if (controls.update()) invalidate();
+  if (tiles && needsUpdate) {
+    needsUpdate = false;
+    camera.updateMatrixWorld();
+    if (sun.intensity > 0) placeSun();
     tiles.update();
-    const s = tiles.stats;
-    $('tilestats').textContent = `${s.visible ?? '–'} visible, ${s.downloading ?? 0} loading`;
+    needsRender = true;
   }
+  const s = tiles?.stats;
+  const loading = s && (s.downloading > 0 || s.parsing > 0);
+  if (!needsRender || (loading && now - lastRender < RENDER_GAP)) return;
+  needsRender = false;
+  lastRender = now;
+  if (s) $('tilestats').textContent = `${s.visible ?? '–'} visible, ${s.downloading ?? 0} loading`;
   $('readout').textContent = `height ${num(camera.position.y)}`;
   renderer.render(scene, camera);
 }
@@ -252,7 +295,7 @@ async function main() {
     changed();
   });
   await selectTexture(state.t, true);
-  frame();
+  requestAnimationFrame(frame);
 }
 
 // Content requests by level, for the readout and the browser test.
@@ -270,7 +313,9 @@ window.textile3d = {
   look(eye, target) {
     camera.position.set(...eye);
     controls.target.set(...target);
+    keepInWorld();
     controls.update();
+    invalidate();
     writeHash();
   },
   /** The levels of the tiles on screen, with how many of each. */

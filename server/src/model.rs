@@ -48,7 +48,14 @@ pub struct Model {
     pub params: ModeParams,
     /// `relief=SCALE`: a GLB's mesh displaced by the height map, white `SCALE` texels high.
     pub relief: Option<f32>,
+    /// Above zoom 0 (3D Tiles' levels over the XYZ pyramid): the quad spans `2^span` zoom-0
+    /// tiles a side from `spec`'s, and shows zoom 0's uniform colour. 0 for a tile.
+    pub span: u32,
 }
+
+/// Side of the image of a tile above zoom 0: its colour is uniform (a zoom-0 pixel already
+/// covers the whole exemplar), so a few texels show it exactly.
+const LIFTED_IMAGE: i64 = 8;
 
 impl Model {
     /// Tile `spec` of `tex` (a patch of `tiles` from it) with the parameters `r` reads (its
@@ -73,13 +80,19 @@ impl Model {
             ));
         }
         let (params, relief) = params_with_relief(&tex, r)?;
-        Ok(Model { tex, spec, tiles, query, params, relief })
+        Ok(Model { tex, spec, tiles, query, params, relief, span: 0 })
     }
 
     /// Tile `spec` of `tex` with the request parameters of the query's `pairs`.
     pub fn request(tex: Arc<Texture>, spec: TileSpec, pairs: Vec<(String, String)>) -> Result<Model, ApiError> {
         let r = ParamReader::request(pairs.clone())?;
         Model::read(tex, spec, 1, r, pairs.into_iter().collect())
+    }
+
+    /// This zoom-0 tile's model spanning `2^span` zoom-0 tiles a side (3D Tiles' levels above
+    /// zoom 0).
+    pub fn lifted(self, span: u32) -> Model {
+        Model { span, ..self }
     }
 
     /// Refuse `relief` where the answer has no mesh to displace.
@@ -103,9 +116,14 @@ impl Model {
     pub fn quad(&self, t: &TileSpec) -> Quad {
         // Native texels per tile side (a fraction of a tile when magnified).
         let size = TILE_SIZE as f64 * 2f64.powi(self.tex.native_zoom() as i32 - t.z as i32);
+        let origin = (size * t.x as f64, size * t.y as f64);
+        if self.span > 0 {
+            let name = format!("tiles_0_{}_{}_span_{}", t.x, t.y, self.span);
+            return Quad { name, origin, size: size * 2f64.powi(self.span as i32) };
+        }
         // `tile_z_x_y`: names clients keep as they are (three.js would fold "tile 7/1/11" and
         // "tile 7/11/1" into one).
-        Quad { name: format!("tile_{}_{}_{}", t.z, t.x, t.y), origin: (size * t.x as f64, size * t.y as f64), size }
+        Quad { name: format!("tile_{}_{}_{}", t.z, t.x, t.y), origin, size }
     }
 
     /// The image of the (top-left) tile.
@@ -117,13 +135,16 @@ impl Model {
     /// of the tile and [`BORDER`] texels around it, at the tile's zoom.
     pub fn image_at(&self, spec: TileSpec) -> ImageJob {
         let (b, side) = (BORDER as i64, image_side() as i64);
-        let window = WindowSpec {
-            z: spec.z,
-            x: TILE_SIZE * spec.x - b,
-            y: TILE_SIZE * spec.y - b,
-            w: side,
-            h: side,
-            format: Format::Png,
+        let window = match self.span {
+            0 => WindowSpec {
+                z: spec.z,
+                x: TILE_SIZE * spec.x - b,
+                y: TILE_SIZE * spec.y - b,
+                w: side,
+                h: side,
+                format: Format::Png,
+            },
+            _ => WindowSpec { z: 0, x: 0, y: 0, w: LIFTED_IMAGE, h: LIFTED_IMAGE, format: Format::Png },
         };
         ImageJob {
             tex: self.tex.clone(),
@@ -188,7 +209,8 @@ impl Model {
     /// The cache key of this model's answer of `kind`, with `extra`.
     pub fn key(&self, kind: &str, extra: &str) -> String {
         let s = self.spec;
-        cache_key(&self.tex, &self.params, format_args!("{kind}{LAYOUT}|{}|{}|{}|{extra}", s.z, s.x, s.y))
+        let span = if self.span > 0 { format!("|span{}", self.span) } else { String::new() };
+        cache_key(&self.tex, &self.params, format_args!("{kind}{LAYOUT}|{}|{}|{}{span}|{extra}", s.z, s.x, s.y))
     }
 
     /// The tile URL (absolute) with the request's parameters.

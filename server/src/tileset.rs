@@ -7,10 +7,15 @@
 //! z up: texel `(tx, ty)` lies at `(tx, −ty, 0)`. That is an east-north-up frame, the local frame
 //! of [`enu_to_ecef`].
 //!
-//! **Tree.** The root is tile `0/0/0` of the XYZ scheme at the coarsest zoom, covering
-//! `[0, 256·2^native]²` texels; implicit level `l` is zoom `l`, up to the largest zoom served.
-//! Implicit tile coordinates count x east and y north from the root's south-west corner, XYZ rows
-//! count south from its north edge: row = `2^l − 1 − y` ([`xyz_row`]).
+//! **Tree.** The world has no edge a viewer reaches: the root is a square of
+//! [`WORLD_TEXELS`]² native texels centred on texel `(0, 0)` (67 million texels a side, five
+//! times the Earth's diameter in metres), far larger than any view (`/3d.html` sees at most
+//! 30 million texels away, from at most [`MAX_VIEW_HEIGHT`] above the ground). Implicit level
+//! `l` is zoom `l − lift` (`lift` = [`Tree::lift`] levels above zoom 0); XYZ tile `(z, col, row)`
+//! is implicit tile `(z + lift, col + 2^(l−1), 2^(l−1) − 1 − row)` (implicit y counts north from
+//! the root's south-west corner, XYZ rows south: [`Tree::content`]). The levels above zoom 0
+//! show what zoom 0 shows, the texture's mean colour (every pixel of a zoom-0 tile covers the
+//! whole exemplar), on quads that span `2^(lift − l)` zoom-0 tiles a side.
 //!
 //! **Subtrees.** Every tile of every available level exists, so a subtree is constant
 //! availability, except the deepest subtrees, whose last levels lie beyond the tree: their tile
@@ -27,27 +32,71 @@ pub const SUBTREE_LEVELS: u32 = 4;
 /// `maximumScreenSpaceError`, 3DTilesRendererJS `errorTarget`: both 16).
 const DEFAULT_SSE: f64 = 16.0;
 
+/// Side of the world (the root tile), in native texels: 2^26.
+pub const WORLD_TEXELS: f64 = (1u64 << 26) as f64;
+
+/// Highest a viewer's camera goes above the ground, in native texels (`/3d.html`'s
+/// `maxDistance`, the README CesiumJS recipe's `maximumZoomDistance`): from there the ground's
+/// far end, at least half the world away, lies within a hundredth of a degree of the horizon.
+pub const MAX_VIEW_HEIGHT: f64 = 20_000.0;
+
 /// The tree of one texture: its zooms and the root's size.
 #[derive(Debug, Clone, Copy)]
 pub struct Tree {
     /// The texture's native zoom.
     pub native: u32,
-    /// Implicit levels: zooms `0..levels`.
+    /// Implicit levels: zooms `−lift..levels − lift`.
     pub levels: u32,
+    /// Levels above zoom 0, so that the root is [`WORLD_TEXELS`] a side.
+    pub lift: u32,
+}
+
+/// What an implicit tile shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Content {
+    /// XYZ tile `(z, col, row)`.
+    Tile { z: u32, x: i64, y: i64 },
+    /// Above zoom 0: the zoom-0 image on a quad of `2^span` zoom-0 tiles a side whose
+    /// north-west tile is `(col, row)` of zoom 0.
+    Lifted { span: u32, x: i64, y: i64 },
 }
 
 impl Tree {
-    /// Side of the root tile in world units (native texels).
-    pub fn root_side(&self) -> f64 {
-        256.0 * 2f64.powi(self.native as i32)
+    /// The tree of a texture of native zoom `native` served up to zoom `max_zoom`.
+    pub fn new(native: u32, max_zoom: u32) -> Tree {
+        let zoom0 = 256u64 << native.min(40);
+        let lift = (WORLD_TEXELS as u64 / zoom0).max(1).ilog2();
+        Tree { native, levels: lift + max_zoom + 1, lift }
     }
 
-    /// Geometric error of level `l`: the size of a texel of zoom `l` times the clients' default
+    /// Side of the root tile in world units (native texels).
+    pub fn root_side(&self) -> f64 {
+        256.0 * 2f64.powi((self.native + self.lift) as i32)
+    }
+
+    /// Geometric error of level `l`: the size of a texel of its zoom times the clients' default
     /// screen-space error, so that with their defaults a tile is replaced by its children once
     /// its texels would cover more than a pixel. It halves with every level, as implicit tiling
     /// requires.
     pub fn geometric_error(&self, level: u32) -> f64 {
-        DEFAULT_SSE * 2f64.powi(self.native as i32 - level as i32)
+        DEFAULT_SSE * 2f64.powi((self.native + self.lift) as i32 - level as i32)
+    }
+
+    /// What implicit tile `level/x/y` shows (a tile of the tree).
+    pub fn content(&self, level: u32, x: i64, y: i64) -> Content {
+        // Half the tiles across, at this level: the root is centred on texel (0, 0).
+        let half = (1i64 << level) / 2;
+        let (col, row) = (x - half, xyz_row(level, y) - half);
+        match level.checked_sub(self.lift) {
+            Some(z) => Content::Tile { z, x: col, y: row },
+            None => {
+                let span = self.lift - level;
+                // Level 0's one tile starts half a tile west and north of texel (0, 0).
+                let (col, row) = if level == 0 { (-1, -1) } else { (col, row) };
+                let shift = |v: i64| if level == 0 { v << (span - 1) } else { v << span };
+                Content::Lifted { span, x: shift(col), y: shift(row) }
+            }
+        }
     }
 
     /// Whether `level/x/y` is a tile of the tree.
@@ -91,8 +140,9 @@ pub fn tileset(tree: &Tree, query: &str, transform: Option<[f64; 16]>, relief: O
     };
     let (zc, zh) = ((z0 + z1) / 2.0, (z1 - z0) / 2.0);
     let mut root = json!({
-        // Centre, then the x, y and z half-axes: the root square, as thick as its content.
-        "boundingVolume": { "box": [h, -h, zc, h, 0.0, 0.0, 0.0, h, 0.0, 0.0, 0.0, zh] },
+        // Centre, then the x, y and z half-axes: the root square around texel (0, 0), as thick
+        // as its content.
+        "boundingVolume": { "box": [0.0, 0.0, zc, h, 0.0, 0.0, 0.0, h, 0.0, 0.0, 0.0, zh] },
         "geometricError": tree.geometric_error(0),
         "refine": "REPLACE",
         "content": { "uri": format!("tiles/{{level}}/{{x}}/{{y}}.glb{sep}{query}") },
@@ -110,6 +160,8 @@ pub fn tileset(tree: &Tree, query: &str, transform: Option<[f64; 16]>, relief: O
         "asset": { "version": "1.1", "generator": generator },
         "geometricError": 2.0 * tree.geometric_error(0),
         "root": root,
+        // How implicit levels and tiles map to the XYZ tiles (module comment).
+        "extras": { "level_of_zoom_0": tree.lift, "world_texels": tree.root_side() },
     })
 }
 
@@ -194,7 +246,7 @@ mod tests {
 
     #[test]
     fn deepest_subtrees_clear_the_levels_beyond_the_tree() {
-        let tree = Tree { native: 7, levels: 11 };
+        let tree = Tree { native: 7, levels: 11, lift: 0 };
         // Subtrees at 0, 4 and 8; the one at 8 holds levels 8, 9 and 10 of its four.
         let b = subtree(&tree, 8);
         let jl = u64::from_le_bytes(b[8..16].try_into().unwrap()) as usize;
@@ -204,5 +256,34 @@ mod tests {
         let set = (0..85).filter(|i| bits[i / 8] >> (i % 8) & 1 == 1).count();
         assert_eq!(set, 21);
         assert_eq!(xyz_row(3, 0), 7);
+    }
+
+    /// Every level's tiles cover the root square exactly once: zoom 0's tile (0, 0) starts at
+    /// texel (0, 0), each implicit tile's content covers its box, and lifted tiles tile the
+    /// zoom-0 grid.
+    #[test]
+    fn implicit_tiles_map_onto_the_xyz_grid() {
+        let tree = Tree::new(7, 10);
+        assert_eq!((tree.lift, tree.levels, tree.root_side()), (11, 22, WORLD_TEXELS));
+        let zoom0 = 256.0 * 128.0;
+        // Level l, tile (x, y): texel x0 = x·w − half and north edge (2^l − 1 − y)·w − half.
+        for level in [0u32, 1, 2, 5, 10, 11, 12, 21] {
+            let n = 1i64 << level;
+            let w = WORLD_TEXELS / n as f64;
+            for (x, y) in [(0, 0), (n - 1, 0), (n / 2, (n / 2 - 1).max(0)), (n / 3, n - 1)] {
+                let (x0, y0) = (x as f64 * w - WORLD_TEXELS / 2.0, (n - 1 - y) as f64 * w - WORLD_TEXELS / 2.0);
+                let got = match tree.content(level, x, y) {
+                    Content::Tile { z, x, y } => {
+                        let t = 256.0 * 2f64.powi(7 - z as i32);
+                        (x as f64 * t, y as f64 * t, t)
+                    }
+                    Content::Lifted { span, x, y } => {
+                        (x as f64 * zoom0, y as f64 * zoom0, zoom0 * 2f64.powi(span as i32))
+                    }
+                };
+                assert_eq!(got, (x0, y0, w), "{level}/{x}/{y}");
+            }
+        }
+        assert_eq!(tree.content(11, 1024, 1023), Content::Tile { z: 0, x: 0, y: 0 });
     }
 }

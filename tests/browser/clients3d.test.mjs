@@ -55,6 +55,7 @@ const CESIUM_PAGE = `<!doctype html><html><head><meta charset="utf-8">
     });
     viewer.clock.currentTime = Cesium.JulianDate.fromIso8601('2026-06-21T11:50:00Z');
     viewer.clock.shouldAnimate = false;
+    viewer.scene.screenSpaceCameraController.maximumZoomDistance = 20000;
     return viewer;
   };
 </script></body></html>`;
@@ -292,7 +293,7 @@ test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the ca
   const visible = async () => page.evaluate(() => window.textile3d.visibleLevels());
   const finest = (v) => Math.max(...Object.keys(v).map(Number));
   const views = [await visible()];
-  for (const h of [1200, 8000, 40000]) {
+  for (const h of [1200, 5000, 14000]) {
     await page.evaluate((h) => window.textile3d.look([16384, h, 16384 + h], [16384, 0, 16384]), h);
     await settled3d(page);
     views.push(await visible());
@@ -300,7 +301,7 @@ test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the ca
   save('3d-page-high.png', `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
   const requested = await page.evaluate(() => window.textile3d.requested.length);
   console.log(`3D page: ${requested} content tiles requested; tiles on screen by level as the camera rises ` +
-    `(150, 1200, 8000, 40000): ${views.map((v) => JSON.stringify(v)).join(' → ')}`);
+    `(150, 1200, 5000, 14000): ${views.map((v) => JSON.stringify(v)).join(' → ')}`);
   const shown = new Set(views.flatMap((v) => Object.keys(v)));
   assert.ok(shown.size >= 3, `tiles of ${shown.size} levels shown: ${[...shown]}`);
   for (let i = 1; i < views.length; i++) {
@@ -310,7 +311,7 @@ test('3DTilesRendererJS on /3d.html: the tileset streams, and LOD follows the ca
   assert.deepEqual(failed, []);
   assert.deepEqual(errors, []);
   // The permalink holds the view.
-  assert.match(page.url(), /cam=16384,40000,56384,16384,0,16384/);
+  assert.match(page.url(), /cam=16384,14000,30384,16384,0,16384/);
   // The mode's parameters are offered (synth: its randomness, one value for every level), and
   // moving one reloads the tileset with it.
   assert.ok(await page.$('#p-randomness'), `synth's parameters on the 3D page: ${await page.innerText('#controls')}`);
@@ -390,6 +391,52 @@ test('/3d.html shows relief without cracks: no sky through the ground near, obli
   await page.close();
 });
 
+test('/3d.html: the world has no edge, from the highest the page allows and at the end of panning', async () => {
+  // The page's limits: the camera at most 20 000 texels from its target, the target panned at
+  // most about 3.5 million texels from the world's centre. Each view asks for more than that
+  // (the page clamps it) and looks across the ground: straight down, at 60°, at the horizon
+  // (0.02 rad below it: the horizon 12 px above the middle row), and at the horizon outwards
+  // from the farthest the target can be. The old world (32 768 texels) ended 16 384 texels
+  // beyond its middle: sky where its ground stopped.
+  const { page, errors } = await open3d('t=gravel&m=synth&seed=4');
+  const views = [
+    ['down', [16384, 90000, 16384.5], [16384, 0, 16384]],
+    ['60°', [16384, 50000, 16384 + 86600], [16384, 0, 16384]],
+    ['horizon', [16384, 800, 16384 + 4e6], [16384, 0, 16384]],
+    ['farthest', [1e9 - 3e6, 800, 1e9 - 3e6], [1e9, 0, 1e9]],
+  ];
+  const found = {};
+  for (const [name, eye, target] of views) {
+    await page.evaluate(([e, t]) => window.textile3d.look(e, t), [eye, target]);
+    await settled3d(page);
+    const r = await page.evaluate(() => {
+      const { camera, controls } = window.textile3d;
+      const c = document.querySelector('#view canvas');
+      const g = document.createElement('canvas');
+      g.width = c.width; g.height = c.height;
+      const ctx = g.getContext('2d');
+      ctx.drawImage(c, 0, 0);
+      // The ground's part: below the middle row and a margin (every view here looks down at
+      // least 0.02 rad, so the horizon is above the middle).
+      const from = Math.floor(c.height / 2) + 4;
+      const d = ctx.getImageData(0, from, c.width, c.height - from).data;
+      let sky = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        if (Math.abs(d[i] - 191) + Math.abs(d[i + 1] - 209) + Math.abs(d[i + 2] - 229) <= 9) sky++;
+      }
+      return { sky, height: camera.position.y, distance: camera.position.distanceTo(controls.target), target: [controls.target.x, controls.target.z] };
+    });
+    found[name] = r.sky;
+    console.log(`3D page, ${name}: camera ${r.height.toFixed(0)} up, ${r.distance.toFixed(0)} from the target at ` +
+      `(${r.target.map((v) => v.toFixed(0)).join(', ')}); sky pixels in the ground's part ${r.sky}`);
+    assert.ok(r.distance <= 20001, `the page keeps the camera within 20 000 of its target: ${r.distance}`);
+    save(`3d-world-${name.replace('°', '')}.png`, `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
+  }
+  assert.deepEqual(found, { down: 0, '60°': 0, horizon: 0, farthest: 0 });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('CesiumJS loads the tileset anchored on the globe and requests its content', async () => {
   const { page, errors } = await open(CESIUM_PAGE);
   const failed = [];
@@ -438,9 +485,8 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
     `${r.lon.toFixed(4)}°, ${r.lat.toFixed(4)}°; root transform ${r.anchor.toFixed(3)} m from the anchor`);
   assert.ok(r.loaded, 'every tile of the view loaded');
   assert.ok(r.anchor < 0.01, 'the root transform sits at lon, lat, height');
-  // The anchor is texel (0, 0), the root square's north-west corner; the square spans 32768 m
-  // east and south of it, so its centre is about 16 km south-east.
-  assert.ok(r.lon > 2.5 && r.lon < 2.65 && r.lat < 48.75 && r.lat > 48.65, `${r.lon}, ${r.lat}`);
+  // The anchor is texel (0, 0), the centre of the root square (2^26 m a side).
+  assert.ok(Math.abs(r.lon - 2.35) < 0.001 && Math.abs(r.lat - 48.85) < 0.001, `${r.lon}, ${r.lat}`);
   assert.ok(levels.length >= 2, `content requested at levels [${levels}]`);
   assert.deepEqual(r.failures, []);
   assert.deepEqual(failed, []);

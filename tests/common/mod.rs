@@ -396,6 +396,13 @@ pub fn parse_glb(b: &[u8]) -> (serde_json::Value, Vec<u8>) {
     (json, bin)
 }
 
+/// The bytes of image `i` embedded in a GLB.
+pub fn glb_image(json: &serde_json::Value, bin: &[u8], i: usize) -> Vec<u8> {
+    let view = &json["bufferViews"][json["images"][i]["bufferView"].as_u64().unwrap() as usize];
+    let (o, l) = (view["byteOffset"].as_u64().unwrap() as usize, view["byteLength"].as_u64().unwrap() as usize);
+    bin[o..o + l].to_vec()
+}
+
 /// The floats of accessor `accessor` of a GLB.
 pub fn f32s(json: &serde_json::Value, bin: &[u8], accessor: usize) -> Vec<f32> {
     let a = &json["accessors"][accessor];

@@ -22,7 +22,7 @@ use crate::pipeline::{cache_key, etag_for};
 use crate::request::{query_pairs, query_string, TileSpec};
 use crate::state::AppState;
 use crate::textures::Texture;
-use crate::tileset::{enu_to_ecef, subtree, tileset, xyz_row, Tree, SUBTREE_LEVELS};
+use crate::tileset::{enu_to_ecef, subtree, tileset, Content, Tree, SUBTREE_LEVELS};
 use textile_core::ParamReader;
 
 /// The tileset's anchoring parameters. Content requests accept and ignore them: CesiumJS carries
@@ -34,9 +34,9 @@ fn without_anchoring(raw: Option<&str>) -> Vec<(String, String)> {
     query_pairs(raw).into_iter().filter(|(k, _)| !ANCHORING.contains(&k.as_str())).collect()
 }
 
-/// The tileset's tree for a texture: zooms `0..=max_zoom`.
+/// The tileset's tree for a texture: zooms `0..=max_zoom` below the levels above zoom 0.
 fn tree(tex: &Texture) -> Tree {
-    Tree { native: tex.native_zoom(), levels: tex.max_zoom() + 1 }
+    Tree::new(tex.native_zoom(), tex.max_zoom())
 }
 
 fn number(name: &str, v: &str, lo: f64, hi: f64) -> Result<f64, ApiError> {
@@ -143,11 +143,12 @@ pub async fn subtree_file(
     Ok(image(subtree(&tree, level).into(), "application/octet-stream", &etag, cc, false))
 }
 
-/// A content tile of the tileset: the GLB of XYZ tile `level / x / 2^level − 1 − y` (the
+/// A content tile of the tileset: the GLB of XYZ tile `level − lift / x − 2^(level−1) /
+/// 2^(level−1) − 1 − y`, or above zoom 0 a quad of zoom 0's colour ([`Tree::content`]; the
 /// tileset's anchoring parameters, if a client carries them along, are ignored).
 #[utoipa::path(get, path = "/3dtiles/{id}/tiles/{level}/{x}/{y}.glb", tag = "3d",
-    params(("id" = String, Path, description = "texture id"), ("level" = u32, Path, description = "implicit level = zoom"),
-           ("x" = i64, Path, description = "implicit x (east) = column"), ("y" = i64, Path, description = "implicit y (north) = 2^level − 1 − row")),
+    params(("id" = String, Path, description = "texture id"), ("level" = u32, Path, description = "implicit level = zoom + lift (the tileset's extras.level_of_zoom_0)"),
+           ("x" = i64, Path, description = "implicit x (east) = column + 2^(level−1)"), ("y" = i64, Path, description = "implicit y (north) = 2^(level−1) − 1 − row")),
     responses((status = 200, description = "model/gltf-binary"), (status = 304, description = "not modified"),
               (status = 400, description = "not a tile of the tileset, or bad parameters"), (status = 404, description = "unknown texture")))]
 pub async fn content_tile(
@@ -160,8 +161,14 @@ pub async fn content_tile(
     let Path((id, level, x, y)) = path.map_err(path_error)?;
     let tex = texture(&reg, &id)?;
     let (y, _) = split_ext(&y, &["glb"])?;
-    let (level, x, y) = implicit(&tree(&tex), &level, &x, y)?;
-    let spec = TileSpec { z: level, x, y: xyz_row(level, y), scale: 1, format: Format::Png };
-    let model = Model::request(tex, spec, without_anchoring(raw.as_deref()))?;
+    let tree = tree(&tex);
+    let (level, x, y) = implicit(&tree, &level, &x, y)?;
+    let pairs = without_anchoring(raw.as_deref());
+    let model = match tree.content(level, x, y) {
+        Content::Tile { z, x, y } => Model::request(tex, TileSpec { z, x, y, scale: 1, format: Format::Png }, pairs)?,
+        Content::Lifted { span, x, y } => {
+            Model::request(tex, TileSpec { z: 0, x, y, scale: 1, format: Format::Png }, pairs)?.lifted(span)
+        }
+    };
     answer(&st, &headers, Output::Glb(model)).await
 }
