@@ -494,6 +494,50 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
   await page.close();
 });
 
+test('CesiumJS with the README recipe: no edge of the world from the highest the recipe allows', async () => {
+  const { page, errors } = await open(CESIUM_PAGE);
+  await page.waitForFunction(() => window.Cesium && window.dayViewer);
+  // Gravel anchored in Paris, the globe painted magenta; the camera at the recipe's largest
+  // distance, 20 km, looking straight down, at 60° and just below the horizon. The old world
+  // (32 768 m) ended 16 km from its middle: the globe showed beyond it.
+  const failures = await page.evaluate(async (base) => {
+    const viewer = window.dayViewer();
+    viewer.scene.globe.baseColor = Cesium.Color.MAGENTA;
+    viewer.scene.globe.showGroundAtmosphere = false;
+    viewer.scene.fog.enabled = false;
+    const failures = [];
+    const tileset = await Cesium.Cesium3DTileset.fromUrl(`${base}/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=4`);
+    tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
+    viewer.scene.primitives.add(tileset);
+    window.world = { viewer, tileset };
+    return failures;
+  }, BASE);
+  const views = [['down', 0, -1.5, 0], ['60°', 0.4, -0.52, 0], ['horizon', 0.9, -0.03, 0.6]];
+  const found = {};
+  for (const [name, heading, pitch, from] of views) {
+    await page.evaluate(async ([heading, pitch]) => {
+      const { viewer, tileset } = window.world;
+      const target = Cesium.Matrix4.multiplyByPoint(tileset.root.computedTransform, new Cesium.Cartesian3(0, 0, 0), new Cesium.Cartesian3());
+      viewer.camera.lookAt(target, new Cesium.HeadingPitchRange(heading, pitch, viewer.scene.screenSpaceCameraController.maximumZoomDistance));
+      await new Promise((resolve) => {
+        const t = setTimeout(resolve, 120000);
+        const done = tileset.allTilesLoaded.addEventListener(() => { clearTimeout(t); done(); resolve(); });
+      });
+      viewer.render();
+    }, [heading, pitch]);
+    const { png, data: d } = await screenshot(page, [0, from, 1, 1 - from]);
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 90 && d[i + 2] > 180) n++;
+    found[name] = n;
+    save(`cesium-world-${name.replace('°', '')}.png`, `data:image/png;base64,${png}`);
+  }
+  console.log(`CesiumJS, the recipe's highest views: globe pixels in the ground's part ${JSON.stringify(found)}`);
+  assert.deepEqual(found, { down: 0, '60°': 0, horizon: 0 });
+  assert.deepEqual(failures, []);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
 test('CesiumJS shows relief without cracks: no globe through the ground near, oblique or at the horizon', async () => {
   const { page, errors } = await open(CESIUM_PAGE);
   await page.waitForFunction(() => window.Cesium && window.dayViewer);
