@@ -34,9 +34,10 @@ pub struct Quad {
 /// grid as one big texture's. It costs 27 % more texels than the bare tile.
 pub const BORDER: u32 = 16;
 
-/// Version of the documents' layout (border, texture coordinates, samplers, viewpoints, relief mesh): part of
-/// every 3D asset's cache key, so a change of layout changes their ETags.
-pub const LAYOUT: u32 = 3;
+/// Version of the documents' layout (border, texture coordinates, samplers, viewpoints, relief
+/// mesh, X3D lights): part of every 3D asset's cache key, so a change of layout changes their
+/// ETags.
+pub const LAYOUT: u32 = 4;
 
 /// Side of a tile's image in the 3D assets, border included.
 pub fn image_side() -> u32 {
@@ -421,7 +422,11 @@ fn xml_escape(s: &str) -> String {
 /// them in a square view. A quad without material images (`maps[i]` empty) has no `Material`:
 /// X3D then shows the texture unlit, as it is. One with them (its normal, occlusion or packed
 /// metallic-roughness images, by slot) has an X3D 4 `PhysicalMaterial` — the glTF material
-/// model — lit by the headlight; the specular map has no X3D field and is left out.
+/// model — lit from straight above by a `DirectionalLight` of intensity π, the headlight off:
+/// a physical material reflects `albedo / π` of a light's intensity (X_ITE's headlight, of
+/// intensity 1, showed flagstones at 92 against their albedo's 158), so π shows a level
+/// surface at its albedo; X3D 4 lets intensity exceed 1. The specular map has no X3D field and
+/// is left out.
 pub fn x3d(quads: &[Quad], image_urls: &[String], maps: &[Vec<(Slot, String)>], generator: &str) -> String {
     let s = quads.first().map(|q| q.size).unwrap_or(1.0);
     let (mut x0, mut z0, mut x1, mut z1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
@@ -496,10 +501,16 @@ pub fn x3d(quads: &[Quad], image_urls: &[String], maps: &[Vec<(Slot, String)>], 
         );
     }
     // PhysicalMaterial is X3D 4; Tangent, Rendering level 5.
-    let (version, components) = if maps.iter().any(|m| !m.is_empty()) {
-        ("4.0", "\n    <component name=\"Rendering\" level=\"5\"/>")
+    let physical = maps.iter().any(|m| !m.is_empty());
+    let (version, components) =
+        if physical { ("4.0", "\n    <component name=\"Rendering\" level=\"5\"/>") } else { ("3.3", "") };
+    let light = if physical {
+        format!(
+            "headlight=\"false\"/>\n    <DirectionalLight direction=\"0 -1 0\" intensity=\"{}\" global=\"true\"/>",
+            std::f64::consts::PI
+        )
     } else {
-        ("3.3", "")
+        "headlight=\"true\"/>".to_string()
     };
     let names = quads.iter().map(|q| q.name.as_str()).collect::<Vec<_>>().join(", ");
     format!(
@@ -511,7 +522,7 @@ pub fn x3d(quads: &[Quad], image_urls: &[String], maps: &[Vec<(Slot, String)>], 
     <meta name="description" content="{names}: ground quads (Y up, X east, Z south, 1 unit = 1 native texel)"/>
   </head>
   <Scene>
-    <NavigationInfo type='"EXAMINE" "ANY"' headlight="true"/>
+    <NavigationInfo type='"EXAMINE" "ANY"' {light}
     <Viewpoint description="top down" position="{cx} {h} {cz}" orientation="1 0 0 -1.5707963267948966" fieldOfView="0.9272952180016122" centerOfRotation="{cx} 0 {cz}"/>
 {shapes}  </Scene>
 </X3D>
