@@ -511,40 +511,63 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
   await page.close();
 });
 
-test('CesiumJS with the README recipe: no edge of the world from the highest the recipe allows', async () => {
+/** The README recipe's CesiumJS viewer on a globe painted magenta (no imagery, ground
+ * atmosphere or fog: wherever the ground is missing, the globe shows), with the tileset at
+ * `path` (anchored in Paris, 35 m above the ellipsoid) kept as `window.globe`. */
+async function onMagentaGlobe(path) {
   const { page, errors } = await open(CESIUM_PAGE);
   await page.waitForFunction(() => window.Cesium && window.dayViewer);
-  // Gravel anchored in Paris, the globe painted magenta; the camera at the recipe's largest
-  // distance, 20 km, looking straight down, at 60° and just below the horizon. The old world
-  // (32 768 m) ended 16 km from its middle: the globe showed beyond it.
-  const failures = await page.evaluate(async (base) => {
+  const failures = await page.evaluate(async (url) => {
     const viewer = window.dayViewer();
     viewer.scene.globe.baseColor = Cesium.Color.MAGENTA;
     viewer.scene.globe.showGroundAtmosphere = false;
     viewer.scene.fog.enabled = false;
     const failures = [];
-    const tileset = await Cesium.Cesium3DTileset.fromUrl(`${base}/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=4`);
+    const tileset = await Cesium.Cesium3DTileset.fromUrl(url);
     tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
     viewer.scene.primitives.add(tileset);
-    window.world = { viewer, tileset };
+    window.globe = { viewer, tileset };
     return failures;
-  }, BASE);
+  }, BASE + path);
+  return { page, errors, failures };
+}
+
+/** Look at texel `(x, y)` of `window.globe`'s tileset from `heading`, `pitch` and `range`
+ * (metres), wait until its tiles are loaded, and count the magenta pixels below `from` (a
+ * share of the height: the sky above the horizon is left out). Returns [PNG, count]. */
+async function magentaSeen(page, [x, y], [heading, pitch, range], from) {
+  await page.evaluate(async ([x, y, heading, pitch, range]) => {
+    const { viewer, tileset } = window.globe;
+    const target = Cesium.Matrix4.multiplyByPoint(tileset.root.computedTransform, new Cesium.Cartesian3(x, -y, 0), new Cesium.Cartesian3());
+    viewer.camera.lookAt(target, new Cesium.HeadingPitchRange(heading, pitch, range));
+    // Settled: ten frames in a row with every tile of the view loaded, counted from the third
+    // frame after the move (`allTilesLoaded` can fire for the view before it).
+    await new Promise((resolve) => {
+      const t0 = performance.now();
+      let frames = 0, loaded = 0;
+      const done = viewer.scene.postRender.addEventListener(() => {
+        frames++;
+        loaded = frames > 2 && tileset.tilesLoaded ? loaded + 1 : 0;
+        if (loaded >= 10 || performance.now() - t0 > 120000) { done(); resolve(); }
+      });
+    });
+    viewer.render();
+  }, [x, y, heading, pitch, range]);
+  const { png, data: d } = await screenshot(page, [0, from, 1, 1 - from]);
+  let n = 0;
+  for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 90 && d[i + 2] > 180) n++;
+  return [png, n];
+}
+
+test('CesiumJS with the README recipe: no edge of the world from the highest the recipe allows', async () => {
+  // Gravel, the camera at the recipe's largest distance, 20 km, looking straight down, at 60°
+  // and just below the horizon. The old world (32 768 m) ended 16 km from its anchor: the globe
+  // showed beyond it.
+  const { page, errors, failures } = await onMagentaGlobe('/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=4');
   const views = [['down', 0, -1.5, 0], ['60°', 0.4, -0.52, 0], ['horizon', 0.9, -0.03, 0.6]];
   const found = {};
   for (const [name, heading, pitch, from] of views) {
-    await page.evaluate(async ([heading, pitch]) => {
-      const { viewer, tileset } = window.world;
-      const target = Cesium.Matrix4.multiplyByPoint(tileset.root.computedTransform, new Cesium.Cartesian3(0, 0, 0), new Cesium.Cartesian3());
-      viewer.camera.lookAt(target, new Cesium.HeadingPitchRange(heading, pitch, viewer.scene.screenSpaceCameraController.maximumZoomDistance));
-      await new Promise((resolve) => {
-        const t = setTimeout(resolve, 120000);
-        const done = tileset.allTilesLoaded.addEventListener(() => { clearTimeout(t); done(); resolve(); });
-      });
-      viewer.render();
-    }, [heading, pitch]);
-    const { png, data: d } = await screenshot(page, [0, from, 1, 1 - from]);
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 90 && d[i + 2] > 180) n++;
+    const [png, n] = await magentaSeen(page, [0, 0], [heading, pitch, 20000], from);
     found[name] = n;
     save(`cesium-world-${name.replace('°', '')}.png`, `data:image/png;base64,${png}`);
   }
@@ -556,45 +579,12 @@ test('CesiumJS with the README recipe: no edge of the world from the highest the
 });
 
 test('CesiumJS shows relief without cracks: no globe through the ground near, oblique or at the horizon', async () => {
-  const { page, errors } = await open(CESIUM_PAGE);
-  await page.waitForFunction(() => window.Cesium && window.dayViewer);
-  // Flagstones with relief 8, anchored 35 m above the ellipsoid, whose globe is painted magenta
-  // (no imagery, no ground atmosphere, no fog): a crack between tiles shows it.
-  const failures = await page.evaluate(async (base) => {
-    const viewer = window.dayViewer();
-    viewer.scene.globe.baseColor = Cesium.Color.MAGENTA;
-    viewer.scene.globe.showGroundAtmosphere = false;
-    viewer.scene.fog.enabled = false;
-    const failures = [];
-    const tileset = await Cesium.Cesium3DTileset.fromUrl(
-      `${base}/3dtiles/flagstones/tileset.json?lon=2.35&lat=48.85&height=35&seed=2&relief=8`);
-    tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
-    viewer.scene.primitives.add(tileset);
-    window.relief = { viewer, tileset };
-    return failures;
-  }, BASE);
-  // The magenta pixels below row `from` (a share of the height: the sky above the horizon).
-  const magenta = async (from) => {
-    const { png, data: d } = await screenshot(page, [0, from, 1, 1 - from]);
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 90 && d[i + 2] > 180) n++;
-    return [png, n];
-  };
+  // Flagstones with relief 8: a crack between tiles shows the globe.
+  const { page, errors, failures } = await onMagentaGlobe('/3dtiles/flagstones/tileset.json?lon=2.35&lat=48.85&height=35&seed=2&relief=8');
   const views = [['near', 0.3, -1.2, 60, 0], ['oblique', 0.6, -0.5, 400, 0.2], ['horizon', 0.9, -0.1, 300, 0.6]];
   const found = {};
   for (const [name, heading, pitch, range, from] of views) {
-    await page.evaluate(async ([heading, pitch, range]) => {
-      const { viewer, tileset } = window.relief;
-      const target = Cesium.Matrix4.multiplyByPoint(tileset.root.computedTransform,
-        new Cesium.Cartesian3(2000, -2000, 0), new Cesium.Cartesian3());
-      viewer.camera.lookAt(target, new Cesium.HeadingPitchRange(heading, pitch, range));
-      await new Promise((resolve) => {
-        const t = setTimeout(resolve, 120000);
-        const done = tileset.allTilesLoaded.addEventListener(() => { clearTimeout(t); done(); resolve(); });
-      });
-      viewer.render();
-    }, [heading, pitch, range]);
-    const [png, n] = await magenta(from);
+    const [png, n] = await magentaSeen(page, [2000, 2000], [heading, pitch, range], from);
     found[name] = n;
     save(`cesium-relief-${name}.png`, `data:image/png;base64,${png}`);
   }
