@@ -241,16 +241,18 @@ async function selectTexture(id, keepView) {
 }
 
 // Frames are drawn when something changed, not 60 times a second: the tiles are traversed when
-// the camera moved or a tile arrived ('needs-update'), and the scene drawn after that, at most
-// every RENDER_GAP ms while tiles are still loading. A software renderer (SwiftShader, as in
-// headless Chromium) shares the cores with the server; drawing an unchanged scene over and
-// over took most of them while the first view loaded (bench/README.md, "The first 3D view").
+// the camera moved or a tile arrived ('needs-update'). A move of the camera or a control is
+// drawn at once; arriving tiles at most every RENDER_GAP ms while more are loading. A software
+// renderer (SwiftShader, as in headless Chromium) shares the cores with the server; drawing an
+// unchanged scene over and over took most of them while the first view loaded
+// (bench/README.md, "The first 3D view").
 const RENDER_GAP = 300;
-let needsUpdate = true, needsRender = true, lastRender = 0;
-/** Traverse the tiles and draw again. */
+let needsUpdate = true, needsRender = true, urgent = true, lastRender = 0;
+/** Traverse the tiles and draw again, now. */
 function invalidate() {
   needsUpdate = true;
   needsRender = true;
+  urgent = true;
 }
 for (const type of ['input', 'change', 'pointermove', 'wheel']) document.addEventListener(type, invalidate, true);
 window.addEventListener('resize', invalidate);
@@ -267,8 +269,9 @@ function frame(now) {
   }
   const s = tiles?.stats;
   const loading = s && (s.downloading > 0 || s.parsing > 0);
-  if (!needsRender || (loading && now - lastRender < RENDER_GAP)) return;
+  if (!needsRender || (loading && !urgent && now - lastRender < RENDER_GAP)) return;
   needsRender = false;
+  urgent = false;
   lastRender = now;
   if (s) $('tilestats').textContent = `${s.visible ?? '–'} visible, ${s.downloading ?? 0} loading`;
   $('readout').textContent = `height ${num(camera.position.y)}`;
