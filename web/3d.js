@@ -155,8 +155,8 @@ function loadTiles() {
     }
   });
   tiles.addEventListener('load-tileset', () => { document.body.dataset.ready = '1'; });
+  // A tile loaded or a view to traverse again; what changes on screen, changes in update().
   tiles.addEventListener('needs-update', () => { needsUpdate = true; });
-  for (const type of ['load-model', 'dispose-model', 'tile-visibility-change']) tiles.addEventListener(type, () => { needsRender = true; });
   invalidate();
   scene.add(tiles.group);
   writeHash();

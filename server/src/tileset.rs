@@ -84,17 +84,18 @@ impl Tree {
 
     /// What implicit tile `level/x/y` shows (a tile of the tree).
     pub fn content(&self, level: u32, x: i64, y: i64) -> Content {
-        // Half the tiles across, at this level: the root is centred on texel (0, 0).
-        let half = (1i64 << level) / 2;
-        let (col, row) = (x - half, xyz_row(level, y) - half);
         match level.checked_sub(self.lift) {
-            Some(z) => Content::Tile { z, x: col, y: row },
+            Some(z) => {
+                // Half the tiles across, at this level: the root is centred on texel (0, 0).
+                let half = (1i64 << level) / 2;
+                Content::Tile { z, x: x - half, y: xyz_row(level, y) - half }
+            }
             None => {
+                // 2^span zoom-0 tiles a side; the root's 2^lift start 2^(lift−1) west and north
+                // of texel (0, 0).
                 let span = self.lift - level;
-                // Level 0's one tile starts half a tile west and north of texel (0, 0).
-                let (col, row) = if level == 0 { (-1, -1) } else { (col, row) };
-                let shift = |v: i64| if level == 0 { v << (span - 1) } else { v << span };
-                Content::Lifted { span, x: shift(col), y: shift(row) }
+                let half = 1i64 << (self.lift - 1);
+                Content::Lifted { span, x: (x << span) - half, y: (xyz_row(level, y) << span) - half }
             }
         }
     }
