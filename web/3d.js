@@ -243,10 +243,18 @@ async function selectTexture(id, keepView) {
 // Frames are drawn when something changed, not 60 times a second: the tiles are traversed when
 // the camera moved or a tile arrived ('needs-update'). A move of the camera or a control is
 // drawn at once; arriving tiles at most every RENDER_GAP ms while more are loading. A software
-// renderer (SwiftShader, as in headless Chromium) shares the cores with the server; drawing an
-// unchanged scene over and over took most of them while the first view loaded
-// (bench/README.md, "The first 3D view").
-const RENDER_GAP = 300;
+// renderer (SwiftShader, as in headless Chromium; llvmpipe) shares the cores with the server
+// and draws a frame of this scene in a few hundred milliseconds: drawing an unchanged scene over
+// and over took most of the machine while the first view loaded, and a drawing every 300 ms
+// still a quarter of it (bench/README.md, "The first 3D view"), so it shows arriving tiles once
+// a second. A GPU draws them as they come.
+const RENDER_GAP = softwareRenderer() ? 1000 : 0;
+/** Whether WebGL draws on the CPU. */
+function softwareRenderer() {
+  const gl = renderer.getContext();
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  return /swiftshader|llvmpipe|software/i.test(String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER)));
+}
 let needsUpdate = true, needsRender = true, urgent = true, lastRender = 0;
 /** Traverse the tiles and draw again, now. */
 function invalidate() {
@@ -330,10 +338,11 @@ window.textile3d = {
     }
     return n;
   },
-  /** Whether every tile the view needs is loaded and nothing is in flight. */
+  /** Whether every tile the view needs is loaded and nothing is in flight (and the view shows
+   * tiles: just after the tileset arrives, nothing is in flight yet either). */
   settled() {
     const s = tiles?.stats;
-    return !!s && tiles.root && s.downloading === 0 && s.parsing === 0 && tiles.loadProgress === 1;
+    return !!s && tiles.root && s.downloading === 0 && s.parsing === 0 && tiles.loadProgress === 1 && tiles.visibleTiles.size > 0;
   },
 };
 
