@@ -267,6 +267,14 @@ async fn a_tileset_with_relief_serves_displaced_content() {
         let prim = &json["meshes"][0]["primitives"][0];
         assert_eq!(json["accessors"][0]["count"], 33 * 33 + 4 * 33, "a displaced grid with its skirts");
         assert_eq!(json["accessors"][prim["indices"].as_u64().unwrap() as usize]["componentType"], 5123);
+        // Compact vertex data: normals and tangents as normalized bytes, texture coordinates as
+        // normalized u16 (KHR_mesh_quantization, required), positions as floats.
+        assert_eq!(json["extensionsRequired"], serde_json::json!(["KHR_mesh_quantization"]));
+        for (attribute, component) in [("POSITION", 5126), ("NORMAL", 5120), ("TANGENT", 5120), ("TEXCOORD_0", 5123)] {
+            let a = &json["accessors"][prim["attributes"][attribute].as_u64().unwrap() as usize];
+            assert_eq!(a["componentType"], component, "{level}/{x}/{y}: {attribute}");
+            assert_eq!(a["normalized"].as_bool().unwrap_or(false), component != 5126, "{level}/{x}/{y}: {attribute}");
+        }
         // Every vertex, Y-up turned Z-up ((x, y, z) → (x, −z, y)), lies inside the implicit
         // tile's box (the root's, split `level` times across).
         let t: Vec<f64> =

@@ -35,9 +35,9 @@ pub struct Quad {
 pub const BORDER: u32 = 16;
 
 /// Version of the documents' layout (border, texture coordinates, samplers, viewpoints, relief
-/// mesh, X3D lights): part of every 3D asset's cache key, so a change of layout changes their
+/// mesh and its quantized vertex data, X3D lights): part of every 3D asset's cache key, so a change of layout changes their
 /// ETags.
-pub const LAYOUT: u32 = 4;
+pub const LAYOUT: u32 = 5;
 
 /// Side of a tile's image in the 3D assets, border included.
 pub fn image_side() -> u32 {
@@ -56,6 +56,10 @@ const CHUNK_BIN: u32 = 0x004E_4942;
 const LINEAR: u32 = 9729;
 const LINEAR_MIPMAP_LINEAR: u32 = 9987;
 const CLAMP_TO_EDGE: u32 = 33071;
+// Accessor component types.
+const BYTE: u32 = 5120;
+const UNSIGNED_SHORT: u32 = 5123;
+const FLOAT: u32 = 5126;
 
 fn pad4(v: &mut Vec<u8>, byte: u8) {
     while !v.len().is_multiple_of(4) {
@@ -177,6 +181,11 @@ impl Relief {
 /// both ways), so no gap opens where a coarser or finer neighbour's edge runs at other heights;
 /// normals up (the normal map shades the relief), texture coordinates on the image's pixel
 /// corners; `u16` indices. The accessors are in [`geometry`]'s order.
+///
+/// Its vertex data is compact (`KHR_mesh_quantization`, which the document then requires):
+/// normals as normalized bytes, texture coordinates as normalized `u16` (within 0.002 texel of
+/// the pixel corners), 20 bytes a vertex with the tangent of [`add_tangent`] against 48 in floats.
+/// Positions stay floats, so that neighbours' shared edge vertices are bit for bit the same.
 fn relief_geometry(size: f32, r: &Relief) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
     let n = r.n;
     let cell = size / (n - 1) as f32;
@@ -222,19 +231,39 @@ fn relief_geometry(size: f32, r: &Relief) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
         }
     }
     let count = pos.len() / 3;
-    let nrm: Vec<f32> = (0..count).flat_map(|_| [0.0, 1.0, 0.0]).collect();
+    // Up, as normalized bytes padded to 4 (vertex elements are 4-byte aligned).
+    let nrm: Vec<u8> = (0..count).flat_map(|_| [0, 127, 0, 0]).collect();
+    let uv16: Vec<u8> = uv.iter().flat_map(|&u| unorm16(u).to_le_bytes()).collect();
     let (mut b, mut views) = (Vec::new(), Vec::new());
     push_view(&mut b, &mut views, &le(&pos), Some(34962));
-    push_view(&mut b, &mut views, &le(&nrm), Some(34962));
-    push_view(&mut b, &mut views, &le(&uv), Some(34962));
+    push_view(&mut b, &mut views, &nrm, Some(34962));
+    views[1]["byteStride"] = json!(4);
+    push_view(&mut b, &mut views, &uv16, Some(34962));
     push_view(&mut b, &mut views, &idx.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>(), Some(34963));
     let accessors = vec![
         json!({ "bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3", "min": [0.0, -SKIRT_DEPTH, 0.0], "max": [size, hi, size] }),
-        json!({ "bufferView": 1, "componentType": 5126, "count": count, "type": "VEC3" }),
-        json!({ "bufferView": 2, "componentType": 5126, "count": count, "type": "VEC2" }),
-        json!({ "bufferView": 3, "componentType": 5123, "count": idx.len(), "type": "SCALAR" }),
+        json!({ "bufferView": 1, "componentType": BYTE, "normalized": true, "count": count, "type": "VEC3" }),
+        json!({ "bufferView": 2, "componentType": UNSIGNED_SHORT, "normalized": true, "count": count, "type": "VEC2" }),
+        json!({ "bufferView": 3, "componentType": UNSIGNED_SHORT, "count": idx.len(), "type": "SCALAR" }),
     ];
     (b, views, accessors)
+}
+
+/// `v` in 0..=1 as a normalized `u16` (`v · 65535`, rounded).
+fn unorm16(v: f32) -> u16 {
+    (v.clamp(0.0, 1.0) * 65535.0).round() as u16
+}
+
+/// Add extension `name` to those `doc` uses (and, if `required`, to those it requires).
+fn use_extension(doc: &mut Value, name: &str, required: bool) {
+    let lists: &[&str] = if required { &["extensionsUsed", "extensionsRequired"] } else { &["extensionsUsed"] };
+    for list in lists {
+        let mut names = doc[*list].as_array().cloned().unwrap_or_default();
+        if !names.iter().any(|n| n == name) {
+            names.push(json!(name));
+        }
+        doc[*list] = json!(names);
+    }
 }
 
 /// What a material map is to a glTF material.
@@ -313,15 +342,24 @@ impl Slot {
 
 /// Add a `TANGENT` of +X (increasing u) with w = +1 to the first mesh of `doc`, for a normal
 /// map's tangent space: the bitangent N × T = −Z is north, the image's up, as the maps' +Y.
-fn add_tangent(doc: &mut Value, bin: &mut Vec<u8>) {
+/// `quantized`: as normalized bytes (`KHR_mesh_quantization`), else floats.
+fn add_tangent(doc: &mut Value, bin: &mut Vec<u8>, quantized: bool) {
     let vertices = doc["accessors"][0]["count"].as_u64().unwrap_or(4) as usize;
     let view = doc["bufferViews"].as_array().map_or(0, Vec::len);
     let mut views = std::mem::take(&mut doc["bufferViews"]).as_array().cloned().unwrap_or_default();
-    push_view(bin, &mut views, &le(vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].as_flattened()), Some(34962));
+    let (bytes, tangent) = if quantized {
+        let t =
+            json!({ "bufferView": view, "componentType": BYTE, "normalized": true, "count": vertices, "type": "VEC4" });
+        ([127u8, 0, 0, 127].repeat(vertices), t)
+    } else {
+        let t = json!({ "bufferView": view, "componentType": FLOAT, "count": vertices, "type": "VEC4" });
+        (le(vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].as_flattened()), t)
+    };
+    push_view(bin, &mut views, &bytes, Some(34962));
     doc["bufferViews"] = json!(views);
     let accessor = doc["accessors"].as_array().map_or(0, Vec::len);
     if let Some(a) = doc["accessors"].as_array_mut() {
-        a.push(json!({ "bufferView": view, "componentType": 5126, "count": vertices, "type": "VEC4" }));
+        a.push(tangent);
     }
     doc["meshes"][0]["primitives"][0]["attributes"]["TANGENT"] = json!(accessor);
 }
@@ -340,7 +378,7 @@ fn add_maps(doc: &mut Value, m: usize, maps: &[(Slot, usize)]) {
             Slot::Specular => {
                 mat["extensions"]["KHR_materials_specular"] =
                     json!({ "specularColorTexture": { "index": texture }, "specularFactor": 1.0 });
-                doc["extensionsUsed"] = json!(["KHR_materials_specular"]);
+                use_extension(doc, "KHR_materials_specular", false);
             }
             Slot::MetallicRoughness => {
                 let pbr = &mut mat["pbrMetallicRoughness"];
@@ -375,8 +413,11 @@ pub fn glb(
         push_view(&mut bin, &mut views, bytes, None);
     }
     let mut doc = document(quads, generator, views, accessors, imgs);
+    if relief.is_some() {
+        use_extension(&mut doc, "KHR_mesh_quantization", true);
+    }
     if maps.iter().any(|(s, _)| *s == Slot::Normal) {
-        add_tangent(&mut doc, &mut bin);
+        add_tangent(&mut doc, &mut bin, relief.is_some());
     }
     let slots: Vec<(Slot, usize)> = maps.iter().enumerate().map(|(i, (s, _))| (*s, images.len() + i)).collect();
     add_maps(&mut doc, 0, &slots);
@@ -403,7 +444,7 @@ pub fn gltf_json(quads: &[Quad], image_urls: &[String], maps: &[(Slot, String)],
     let imgs = image_urls.iter().chain(maps.iter().map(|(_, u)| u)).map(|u| json!({ "uri": u })).collect();
     let mut doc = document(quads, generator, views, accessors, imgs);
     if maps.iter().any(|(s, _)| *s == Slot::Normal) {
-        add_tangent(&mut doc, &mut bin);
+        add_tangent(&mut doc, &mut bin, false);
     }
     let slots: Vec<(Slot, usize)> = maps.iter().enumerate().map(|(i, (s, _))| (*s, image_urls.len() + i)).collect();
     add_maps(&mut doc, 0, &slots);
