@@ -4,6 +4,7 @@
 // specs, as the 2D viewer's are. The view and the choices live in the URL hash (the permalink).
 import * as THREE from 'three';
 import { MapControls } from 'three/addons/controls/MapControls.js';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { ImplicitTilingPlugin } from '3d-tiles-renderer/core/plugins';
 
@@ -130,6 +131,37 @@ function resize() {
 }
 window.addEventListener('resize', resize);
 
+/**
+ * GLTFLoader plugin: a GLB's embedded images decoded straight from its buffer
+ * (`createImageBitmap` of a Blob, with the options of three.js's ImageBitmapLoader), where
+ * GLTFLoader makes an object URL of each and fetches it back. A flagstones tile holds three
+ * images; registering and fetching back some 400 object URLs cost the page's main thread and the
+ * browser process about a second of a cold view's CPU (bench/README.md, "The first 3D view").
+ * Images by URI, and browsers without createImageBitmap, take GLTFLoader's own way.
+ */
+class EmbeddedImages {
+  constructor(parser) {
+    this.name = 'textile_embedded_images';
+    const load = parser.loadImageSource.bind(parser);
+    parser.loadImageSource = (index, loader) => {
+      const def = parser.json.images[index];
+      if (def.bufferView === undefined || !loader.isImageBitmapLoader) return load(index, loader);
+      if (!parser.sourceCache[index]) {
+        parser.sourceCache[index] = parser.getDependency('bufferView', def.bufferView)
+          .then((view) => createImageBitmap(new Blob([view], { type: def.mimeType }), { premultiplyAlpha: 'none', colorSpaceConversion: 'none' }))
+          .then((bitmap) => {
+            const texture = new THREE.Texture(bitmap);
+            texture.needsUpdate = true;
+            texture.userData.mimeType = def.mimeType;
+            return texture;
+          });
+        return parser.sourceCache[index];
+      }
+      return parser.sourceCache[index].then((t) => t.clone());
+    };
+  }
+}
+
 function loadTiles() {
   if (tiles) {
     scene.remove(tiles.group);
@@ -139,6 +171,9 @@ function loadTiles() {
   $('tilesetlink').href = url;
   tiles = new TilesRenderer(url);
   tiles.registerPlugin(new ImplicitTilingPlugin());
+  const gltf = new GLTFLoader(tiles.manager);
+  gltf.register((parser) => new EmbeddedImages(parser));
+  tiles.manager.addHandler(/\.(gltf|glb)$/, gltf);
   // A few requests at a time: a burst of hundreds would only queue (or be shed) at the server.
   tiles.downloadQueue.maxJobsPerOrigin = 8;
   tiles.loadAncestors = false;
