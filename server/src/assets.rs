@@ -35,8 +35,8 @@ pub struct Quad {
 pub const BORDER: u32 = 16;
 
 /// Version of the documents' layout (border, texture coordinates, samplers, viewpoints, relief
-/// mesh and its quantized vertex data, X3D lights): part of every 3D asset's cache key, so a change of layout changes their
-/// ETags.
+/// mesh and its quantized vertex data, X3D lights): part of every 3D asset's cache key, so a
+/// change of layout changes their ETags.
 pub const LAYOUT: u32 = 5;
 
 /// Side of a tile's image in the 3D assets, border included.
@@ -184,7 +184,7 @@ impl Relief {
 ///
 /// Its vertex data is compact (`KHR_mesh_quantization`, which the document then requires):
 /// normals as normalized bytes, texture coordinates as normalized `u16` (within 0.002 texel of
-/// the pixel corners), 20 bytes a vertex with the tangent of [`add_tangent`] against 48 in floats.
+/// the pixel corners): 24 bytes a vertex with the tangent of [`add_tangent`], against 48 in floats.
 /// Positions stay floats, so that neighbours' shared edge vertices are bit for bit the same.
 fn relief_geometry(size: f32, r: &Relief) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
     let n = r.n;
@@ -241,7 +241,7 @@ fn relief_geometry(size: f32, r: &Relief) -> (Vec<u8>, Vec<Value>, Vec<Value>) {
     push_view(&mut b, &mut views, &uv16, Some(34962));
     push_view(&mut b, &mut views, &idx.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>(), Some(34963));
     let accessors = vec![
-        json!({ "bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3", "min": [0.0, -SKIRT_DEPTH, 0.0], "max": [size, hi, size] }),
+        json!({ "bufferView": 0, "componentType": FLOAT, "count": count, "type": "VEC3", "min": [0.0, -SKIRT_DEPTH, 0.0], "max": [size, hi, size] }),
         json!({ "bufferView": 1, "componentType": BYTE, "normalized": true, "count": count, "type": "VEC3" }),
         json!({ "bufferView": 2, "componentType": UNSIGNED_SHORT, "normalized": true, "count": count, "type": "VEC2" }),
         json!({ "bufferView": 3, "componentType": UNSIGNED_SHORT, "count": idx.len(), "type": "SCALAR" }),
