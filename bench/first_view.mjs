@@ -4,8 +4,10 @@
 // (JSON lines), their count, summed server time and the slowest, by level.
 //
 // Usage (from the repository root, the server started with `--access-log FILE`):
-//   node bench/first_view.mjs URL ACCESS_LOG [HASH …]
+//   node bench/first_view.mjs URL ACCESS_LOG [HASH | >TEXTURE …]
 // e.g. node bench/first_view.mjs http://127.0.0.1:8080 /tmp/access.log 't=gravel' 't=flagstones'
+// A HASH opens a page of its own; `>TEXTURE` picks that texture in the page before it, as a user
+// switching textures does (e.g. 't=gravel' '>flagstones').
 // The libraries are tests/browser's (npm ci there first).
 import { createRequire } from 'node:module';
 import { readFileSync, statSync } from 'node:fs';
@@ -22,19 +24,29 @@ const browser = await chromium.launch({
 const size = () => { try { return statSync(log).size; } catch { return 0; } };
 console.log('| view | settled in | content tiles | by level: tiles, server ms summed, slowest ms |');
 console.log('|---|---|---|---|');
+let page = null;
 for (const hash of views) {
   const from = size();
-  const page = await browser.newPage({ viewport: { width: 1000, height: 640 } });
   const t0 = Date.now();
-  await page.goto(`${base}/3d.html#${hash}`);
-  await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 60000 });
+  let before = 0;
+  if (hash.startsWith('>') && page) {
+    const id = hash.slice(1);
+    before = await page.evaluate(() => window.textile3d.requested.length);
+    await page.selectOption('#texture', id);
+    // The new tileset replaces the old after the page's debounce.
+    await page.waitForFunction((id) => window.textile3d.tiles?.rootURL?.includes(`/3dtiles/${id}/`), id, { timeout: 60000, polling: 50 });
+  } else {
+    await page?.close();
+    page = await browser.newPage({ viewport: { width: 1000, height: 640 } });
+    await page.goto(`${base}/3d.html#${hash}`);
+    await page.waitForSelector('body[data-ready="1"]', { state: 'attached', timeout: 60000 });
+  }
   const settled = () => page.waitForFunction(() => window.textile3d?.settled(), null, { timeout: 300000, polling: 100 });
   await settled();
   await page.waitForTimeout(300);
   await settled();
   const ms = Date.now() - t0 - 300;
-  const requested = await page.evaluate(() => window.textile3d.requested.length);
-  await page.close();
+  const requested = (await page.evaluate(() => window.textile3d.requested.length)) - before;
   await new Promise((r) => setTimeout(r, 500)); // the log's writer thread
   const lines = readFileSync(log, 'utf8').slice(from).split('\n').filter(Boolean).map((l) => JSON.parse(l));
   const by = {};
@@ -47,4 +59,5 @@ for (const hash of views) {
   const levels = Object.entries(by).map(([k, b]) => `${k}: ${b.n}, ${b.ms.toFixed(0)}, ${b.max.toFixed(0)}`).join('; ');
   console.log(`| ${hash} | ${(ms / 1000).toFixed(1)} s | ${requested} | ${levels} |`);
 }
+await page?.close();
 await browser.close();
