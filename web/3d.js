@@ -146,18 +146,17 @@ class EmbeddedImages {
     parser.loadImageSource = (index, loader) => {
       const def = parser.json.images[index];
       if (def.bufferView === undefined || !loader.isImageBitmapLoader) return load(index, loader);
-      if (!parser.sourceCache[index]) {
-        parser.sourceCache[index] = parser.getDependency('bufferView', def.bufferView)
-          .then((view) => createImageBitmap(new Blob([view], { type: def.mimeType }), { premultiplyAlpha: 'none', colorSpaceConversion: 'none' }))
-          .then((bitmap) => {
-            const texture = new THREE.Texture(bitmap);
-            texture.needsUpdate = true;
-            texture.userData.mimeType = def.mimeType;
-            return texture;
-          });
-        return parser.sourceCache[index];
-      }
-      return parser.sourceCache[index].then((t) => t.clone());
+      // As GLTFLoader does: the first use of an image gets its texture, later ones a clone.
+      const cached = parser.sourceCache[index];
+      if (cached) return cached.then((t) => t.clone());
+      return (parser.sourceCache[index] = parser.getDependency('bufferView', def.bufferView)
+        .then((view) => createImageBitmap(new Blob([view], { type: def.mimeType }), { premultiplyAlpha: 'none', colorSpaceConversion: 'none' }))
+        .then((bitmap) => {
+          const texture = new THREE.Texture(bitmap);
+          texture.needsUpdate = true;
+          texture.userData.mimeType = def.mimeType;
+          return texture;
+        }));
     };
   }
 }

@@ -347,14 +347,15 @@ fn add_tangent(doc: &mut Value, bin: &mut Vec<u8>, quantized: bool) {
     let vertices = doc["accessors"][0]["count"].as_u64().unwrap_or(4) as usize;
     let view = doc["bufferViews"].as_array().map_or(0, Vec::len);
     let mut views = std::mem::take(&mut doc["bufferViews"]).as_array().cloned().unwrap_or_default();
-    let (bytes, tangent) = if quantized {
-        let t =
-            json!({ "bufferView": view, "componentType": BYTE, "normalized": true, "count": vertices, "type": "VEC4" });
-        ([127u8, 0, 0, 127].repeat(vertices), t)
+    let (bytes, component) = if quantized {
+        ([127u8, 0, 0, 127].repeat(vertices), BYTE)
     } else {
-        let t = json!({ "bufferView": view, "componentType": FLOAT, "count": vertices, "type": "VEC4" });
-        (le(vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].as_flattened()), t)
+        (le(vec![[1.0f32, 0.0, 0.0, 1.0]; vertices].as_flattened()), FLOAT)
     };
+    let mut tangent = json!({ "bufferView": view, "componentType": component, "count": vertices, "type": "VEC4" });
+    if quantized {
+        tangent["normalized"] = json!(true);
+    }
     push_view(bin, &mut views, &bytes, Some(34962));
     doc["bufferViews"] = json!(views);
     let accessor = doc["accessors"].as_array().map_or(0, Vec::len);
@@ -413,11 +414,13 @@ pub fn glb(
         push_view(&mut bin, &mut views, bytes, None);
     }
     let mut doc = document(quads, generator, views, accessors, imgs);
-    if relief.is_some() {
+    // A relief's vertex data is quantized ([`relief_geometry`]); a flat quad's is not.
+    let quantized = relief.is_some();
+    if quantized {
         use_extension(&mut doc, "KHR_mesh_quantization", true);
     }
     if maps.iter().any(|(s, _)| *s == Slot::Normal) {
-        add_tangent(&mut doc, &mut bin, relief.is_some());
+        add_tangent(&mut doc, &mut bin, quantized);
     }
     let slots: Vec<(Slot, usize)> = maps.iter().enumerate().map(|(i, (s, _))| (*s, images.len() + i)).collect();
     add_maps(&mut doc, 0, &slots);
