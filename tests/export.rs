@@ -65,7 +65,7 @@ async fn archives_hold_the_servers_tiles() {
     assert!(err.contains("'flagstones?map=normal'") || err.contains("map=normal"), "{err}");
     let s = Server::builder().start();
     for a in [&world, &mosaic, &bbox, &normal] {
-        check(a, &s);
+        check(a, &s, 24);
     }
     // Nothing but the archives was left in the directory.
     let names: Vec<String> =

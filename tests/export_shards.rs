@@ -92,12 +92,14 @@ fn shards_merge_into_the_single_process_archive_and_resume_after_sigkill() {
 
     let one = shards("16", 1, d);
     assert_eq!(merged(&one, &d.join("m1.pmtiles")), want_pm, "1 shard");
+    assert_eq!(merged(&one, &d.join("m1.mbtiles")), want_mb, "1 shard, MBTiles");
     let three = shards("16", 3, d);
     assert_eq!(merged(&three, &d.join("m3.pmtiles")), want_pm, "3 shards, PMTiles");
     assert_eq!(merged(&three, &d.join("m3.mbtiles")), want_mb, "3 shards, MBTiles");
     let mut eight = shards("16", 8, d);
     eight.reverse(); // any order
     assert_eq!(merged(&eight, &d.join("m8.pmtiles")), want_pm, "8 shards");
+    assert_eq!(merged(&eight, &d.join("m8.mbtiles")), want_mb, "8 shards, MBTiles");
     // Nothing but the parts and archives is left: no partial files, no checkpoints.
     let stray: Vec<String> = std::fs::read_dir(d)
         .unwrap()
@@ -130,8 +132,10 @@ fn shards_merge_into_the_single_process_archive_and_resume_after_sigkill() {
         let _ = c.kill();
         let out = c.wait_with_output().unwrap();
         resumed += usize::from(String::from_utf8_lossy(&out.stderr).contains("resuming after"));
-        if !out.status.success() {
-            assert!(!part.exists(), "a killed shard never leaves a part under its name");
+        // Killed at any moment (also between its last rename and its exit), a shard leaves
+        // under its name nothing or the whole part.
+        if part.exists() {
+            assert_eq!(std::fs::read(&part).unwrap(), std::fs::read(&three[1]).unwrap(), "a whole part or none");
         }
     }
     assert!(resumed >= 2, "the shard resumed from its checkpoint after each kill");
@@ -168,9 +172,163 @@ fn shards_merge_into_the_single_process_archive_and_resume_after_sigkill() {
     if !reader_available() {
         return skip("shards_merge_into_the_single_process_archive (readers)", "python3 with the pmtiles package");
     }
+    // Every tile of every merged archive, read back by the independent readers, is the server's.
     let s = Server::builder().start();
-    check(&d.join("m8.pmtiles"), &s);
-    check(&d.join("m3.mbtiles"), &s);
+    for n in [1, 3, 8] {
+        for ext in ["pmtiles", "mbtiles"] {
+            check(&d.join(format!("m{n}.{ext}")), &s, 341);
+        }
+    }
+}
+
+/// A part's records as the documented format lays them out (`export/part.rs`): the offset of
+/// each record, its tile, and where its bytes are.
+struct Record {
+    at: usize,
+    tile: (u8, u32, u32),
+    data: usize,
+    len: usize,
+}
+
+fn records(part: &[u8]) -> Vec<Record> {
+    let mut at = 0;
+    for _ in 0..3 {
+        at += part[at..].iter().position(|b| *b == b'\n').unwrap() + 1;
+    }
+    let le = |i: usize| u32::from_le_bytes(part[i..i + 4].try_into().unwrap());
+    let mut out = Vec::new();
+    while at < part.len() {
+        let len = le(at + 9) as usize;
+        out.push(Record { at, tile: (part[at], le(at + 1), le(at + 5)), data: at + 17, len });
+        at += 17 + len;
+    }
+    out
+}
+
+fn name(t: (u8, u32, u32)) -> String {
+    format!("tile {}/{}/{}", t.0, t.1, t.2)
+}
+
+#[test]
+fn merge_proves_every_record_and_keeps_its_output_safe() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let three = shards("16", 3, d);
+    let want = merged(&three, &d.join("clean.pmtiles"));
+    let middle = std::fs::read(&three[1]).unwrap();
+    let recs = records(&middle);
+    assert_eq!(recs.len(), 114, "shard 1/3 of 341 tiles");
+    let (mid, last) = (&recs[recs.len() / 2], recs.last().unwrap());
+
+    // Each damage makes merge exit non-zero, naming the part and the tile, and write nothing.
+    let damaged = |label: &str, bytes: Vec<u8>, says: &[String]| {
+        let part = d.join(format!("{label}.part"));
+        std::fs::write(&part, bytes).unwrap();
+        let out = d.join(format!("{label}.pmtiles"));
+        let (code, text) = merge(&[three[0].clone(), part.clone(), three[2].clone()], &out);
+        assert_ne!(code, 0, "{label}: {text}");
+        assert!(text.contains(part.to_str().unwrap()), "{label} names the part: {text}");
+        for s in says {
+            assert!(text.contains(s.as_str()), "{label} says {s}: {text}");
+        }
+        assert!(!out.exists(), "{label}: no archive");
+        std::fs::remove_file(&part).unwrap();
+    };
+    let edit = |f: &dyn Fn(&mut Vec<u8>)| {
+        let mut b = middle.clone();
+        f(&mut b);
+        b
+    };
+    damaged("bit", edit(&|b| b[mid.data + mid.len / 2] ^= 0x10), &[name(mid.tile), "checksum mismatch".into()]);
+    damaged("header", edit(&|b| b[30] ^= 0x02), &["header is damaged".into()]);
+    damaged("zoom", edit(&|b| b[last.at] = 9), &[name(last.tile), "record 114 of 114".into()]);
+    damaged("column", edit(&|b| b[mid.at + 1] ^= 1), &[name(mid.tile)]);
+    damaged("row", edit(&|b| b[mid.at + 5] ^= 1), &[name(mid.tile)]);
+    let (a, b) = (&recs[10], &recs[11]);
+    let swapped =
+        [&middle[..a.at], &middle[b.at..b.data + b.len], &middle[a.at..b.at], &middle[b.data + b.len..]].concat();
+    damaged("swapped", swapped, &[name(a.tile), format!("holds {}", name(b.tile))]);
+    let mut data_swapped = middle.clone();
+    let n = a.len.min(b.len);
+    let (x, y) = (middle[a.data..a.data + n].to_vec(), middle[b.data..b.data + n].to_vec());
+    data_swapped[a.data..a.data + n].copy_from_slice(&y);
+    data_swapped[b.data..b.data + n].copy_from_slice(&x);
+    damaged("swapped-data", data_swapped, &[name(a.tile), "checksum mismatch".into()]);
+    damaged("cut-at-record", middle[..last.at].to_vec(), &[name(last.tile), "truncated".into()]);
+    damaged("cut-mid-record", middle[..mid.data + 5].to_vec(), &[name(mid.tile), "truncated".into()]);
+    assert!(middle.starts_with(b"TEXTILE-PART 2\n"));
+    damaged("version-1", edit(&|b| b[13] = b'1'), &["version-1 part".into(), "run its shard again".into()]);
+
+    // The output: never an input, an existing file only with --force, no temporary file left.
+    let as_archive = d.join("p1.pmtiles");
+    std::fs::copy(&three[1], &as_archive).unwrap();
+    for force in [false, true] {
+        let mut args = vec!["merge", three[0].to_str().unwrap(), as_archive.to_str().unwrap()];
+        args.extend([three[2].to_str().unwrap(), "-o", as_archive.to_str().unwrap()]);
+        if force {
+            args.push("--force");
+        }
+        let (code, _, err) = textile(&args);
+        assert_ne!(code, 0, "an input as the output (force {force})");
+        assert!(err.contains("is one of the parts being merged"), "{err}");
+        assert_eq!(std::fs::read(&as_archive).unwrap(), middle, "the input is untouched");
+    }
+    let existing = d.join("existing.pmtiles");
+    std::fs::write(&existing, b"keep me").unwrap();
+    let (code, text) = merge(&three, &existing);
+    assert_ne!(code, 0);
+    assert!(text.contains("exists: give --force"), "{text}");
+    assert_eq!(std::fs::read(&existing).unwrap(), b"keep me");
+    let mut args: Vec<&str> = vec!["merge"];
+    args.extend(three.iter().map(|p| p.to_str().unwrap()));
+    args.extend(["-o", existing.to_str().unwrap(), "--force"]);
+    let (code, _, err) = textile(&args);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(std::fs::read(&existing).unwrap(), want, "replaced with --force");
+    let directory = d.join("directory.pmtiles");
+    std::fs::create_dir(&directory).unwrap();
+    let (code, text) = merge(&three, &directory);
+    assert_ne!(code, 0);
+    assert!(text.contains("is a directory"), "{text}");
+    let stray: Vec<String> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.') || n.contains("partial"))
+        .collect();
+    assert!(stray.is_empty(), "no temporary file is left: {stray:?}");
+}
+
+#[test]
+fn one_shard_has_one_writer() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let clean_dir = d.join("clean");
+    std::fs::create_dir(&clean_dir).unwrap();
+    let clean = shards("16", 1, &clean_dir);
+    let (args, part) = shard("16", 0, 1, d);
+    let partial = d.join("w16-0of1.part.partial");
+    let first = Command::new(binary()).args(&args).stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+    for _ in 0..3000 {
+        if partial.exists() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let a: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, err) = textile(&a);
+    let out = first.wait_with_output().unwrap();
+    let first_err = String::from_utf8_lossy(&out.stderr).into_owned();
+    // One of the two was refused at once, naming the other; the other finished.
+    assert!((code == 0) != out.status.success(), "exactly one run finished: {err}{first_err}");
+    let refused = if code != 0 { err } else { first_err };
+    assert!(
+        refused.contains("is being written by process") && refused.contains("another run of this shard"),
+        "{refused}"
+    );
+    assert_eq!(std::fs::read(&part).unwrap(), std::fs::read(&clean[0]).unwrap(), "byte-identical to a clean run");
+    let names: Vec<String> =
+        std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(names.len(), 2, "the part and the clean run's folder, nothing stale: {names:?}");
 }
 
 #[test]

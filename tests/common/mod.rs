@@ -433,10 +433,15 @@ pub fn reader_available() -> bool {
 }
 
 /// The independent readers (PyPI pmtiles, Python's sqlite3: `tests/export/check_archive.py`)
-/// read every tile of an archive back, equal to the running server's answer for its URL.
-pub fn check_archive(archive: &Path, s: &Server) {
+/// read an archive back: its header against its tiles, and every tile of its lowest zoom plus
+/// `samples` tiles at random (all of them when `samples` is at least its count) equal to the
+/// running server's answer for its URL.
+pub fn check_archive(archive: &Path, s: &Server, samples: usize) {
     let script = format!("{}/../tests/export/check_archive.py", env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("python3").args([&script, archive.to_str().unwrap(), &s.base]).output().expect("python3");
+    let out = Command::new("python3")
+        .args([&script, archive.to_str().unwrap(), &s.base, &samples.to_string()])
+        .output()
+        .expect("python3");
     let report = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}: {report}{}", archive.display(), String::from_utf8_lossy(&out.stderr));
     assert!(report.contains("\"problems\": []"), "{report}");

@@ -280,9 +280,12 @@ pub struct MergeArgs {
     /// The part files of every shard (any order).
     #[arg(required = true, value_name = "PART")]
     pub parts: Vec<PathBuf>,
-    /// Output archive: NAME.pmtiles or NAME.mbtiles.
+    /// Output archive: NAME.pmtiles or NAME.mbtiles (never one of the parts).
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
+    /// Replace the output if it exists (without it, an existing file is refused).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `textile info`.

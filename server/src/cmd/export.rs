@@ -91,7 +91,7 @@ pub fn merge(a: MergeArgs) -> CliResult {
     if !matches!(ext, "pmtiles" | "mbtiles") {
         return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", a.output.display()).into());
     }
-    let r = export::merge::merge(&a.parts, &a.output)?;
+    let r = export::merge::merge(&a.parts, &a.output, a.force)?;
     println!(
         "merged {} parts into {} ({} tiles, {} bytes) in {:.1} s: {:.0} MB/s",
         a.parts.len(),

@@ -1,10 +1,16 @@
 //! `textile merge`: part files ([`super::part`]) laid into one archive, streaming — each part's
 //! tiles copied in order, one tile in memory at a time (the PMTiles writer itself keeps one
 //! directory entry and one content hash per distinct tile: 16 M tiles are a few hundred MB).
-//! The parts must be of one export (equal archive identity and tile count) and cover its tiles
-//! exactly once; a gap, an overlap, a part of another export or a truncated part is an error
-//! naming the parts. Their concatenation is the sequence a single-process export writes, so the
-//! archive's bytes are the same.
+//! The parts must be of one export (equal archive identity, tile count and layout) and cover
+//! its tiles exactly once; a gap, an overlap, a part of another export is an error naming the
+//! parts, and every record is proved as it is read (its checksum, its place in the layout), so
+//! a damaged, truncated or reordered part is an error naming the part, the record and the tile.
+//! Their concatenation is the sequence a single-process export writes, so the archive's bytes
+//! are the same.
+//!
+//! The output is safe: written under a temporary name that is removed after any failure, never
+//! one of the inputs, and an existing file is replaced only when asked (`--force`); otherwise
+//! the archive is linked into place, which fails if a file appeared there meanwhile.
 
 use std::path::{Path, PathBuf};
 
@@ -17,7 +23,7 @@ const IDENTITY: &[&str] = &["world", "texture", "mode", "parameters", "query", "
 /// Why part `b` is not of `a`'s export, if it is not.
 fn differs(a: &(PathBuf, Header), b: &(PathBuf, Header)) -> Option<String> {
     let (ha, hb) = (&a.1, &b.1);
-    if ha.archive == hb.archive && ha.total == hb.total {
+    if ha.archive == hb.archive && ha.total == hb.total && ha.layout == hb.layout {
         return None;
     }
     let (ta, tb) = (&ha.archive["textile"], &hb.archive["textile"]);
@@ -80,40 +86,59 @@ pub fn plan(paths: &[PathBuf]) -> Result<Vec<(PathBuf, Header)>, String> {
     Ok(parts)
 }
 
+/// Refuse an output that cannot be written safely: a directory, one of the `inputs` (also
+/// through another name or link), or an existing file unless `replace`.
+pub fn check_output(inputs: &[PathBuf], output: &Path, replace: bool) -> Result<(), String> {
+    use std::os::unix::fs::MetadataExt;
+    let Ok(out) = std::fs::metadata(output) else { return Ok(()) };
+    if out.is_dir() {
+        return Err(format!("{} is a directory: name the archive file to write", output.display()));
+    }
+    for p in inputs {
+        if std::fs::metadata(p).is_ok_and(|m| m.dev() == out.dev() && m.ino() == out.ino()) {
+            return Err(format!(
+                "{} is one of the parts being merged ({}): write the archive under another name",
+                output.display(),
+                p.display()
+            ));
+        }
+    }
+    if !replace {
+        return Err(format!("{} exists: give --force to replace it, or another name", output.display()));
+    }
+    Ok(())
+}
+
 /// Merge `paths` into the archive `output` (`.pmtiles` or `.mbtiles`), written under a temporary
-/// name and renamed when complete.
-pub fn merge(paths: &[PathBuf], output: &Path) -> Result<Report, String> {
+/// name and put in place when complete: replacing an existing file only if `replace`.
+pub fn merge(paths: &[PathBuf], output: &Path, replace: bool) -> Result<Report, String> {
     let started = std::time::Instant::now();
+    check_output(paths, output, replace)?;
     let parts = plan(paths)?;
     let tmp = textile_core::files::temp_path(output);
-    let written = (|| {
+    let written: Result<u64, String> = (|| {
         let mut sink = open_sink(output, &tmp, &parts[0].1.archive)?;
         let mut tiles = 0u64;
-        let mut last_id = None;
         for (p, _) in &parts {
             let mut r = part::Reader::open(p)?;
             while let Some((z, x, y, bytes)) = r.next_tile()? {
-                let id = super::pmtiles_sink::tile_id(z, x, y);
-                if last_id.is_some_and(|l| l >= id) {
-                    return Err(format!("{}: tile {z}/{x}/{y} out of order: damaged", p.display()));
-                }
-                last_id = Some(id);
                 sink.add(z, x, y, &bytes)?;
                 tiles += 1;
             }
         }
         sink.finish()?;
+        let placed = if replace { std::fs::rename(&tmp, output) } else { std::fs::hard_link(&tmp, output) };
+        placed.map_err(|e| match e.kind() {
+            std::io::ErrorKind::AlreadyExists => {
+                format!("{} appeared while merging: give --force to replace it, or another name", output.display())
+            }
+            _ => format!("{}: {e}", output.display()),
+        })?;
         Ok(tiles)
     })();
-    match written {
-        Ok(tiles) => {
-            std::fs::rename(&tmp, output).map_err(|e| format!("{}: {e}", output.display()))?;
-            let bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
-            Ok(Report { tiles, bytes, secs: started.elapsed().as_secs_f64() })
-        }
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
+    // After a failure, and after a link, the temporary file goes.
+    let _ = std::fs::remove_file(&tmp);
+    let tiles = written?;
+    let bytes = std::fs::metadata(output).map(|m| m.len()).unwrap_or(0);
+    Ok(Report { tiles, bytes, secs: started.elapsed().as_secs_f64() })
 }

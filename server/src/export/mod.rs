@@ -16,6 +16,7 @@
 //! [`Shard`] renders a contiguous range of the tiles into a part of its own: parts of every
 //! shard merge into the bytes of a single process's export.
 
+pub mod layout;
 pub mod mbtiles_sink;
 pub mod merge;
 pub mod part;
@@ -29,6 +30,8 @@ use rayon::prelude::*;
 use serde_json::json;
 use textile_core::maps::MapChoice;
 use textile_core::{ModeParams, ParamReader, Pyramid};
+
+pub use layout::Layout;
 
 use crate::encode::Format;
 use crate::pipeline::{engine_version, ImageJob, Target};
@@ -187,49 +190,37 @@ impl Plan {
         }
     }
 
-    /// The tiles of one archive zoom.
-    fn tiles_at(&self, a: u32) -> (u32, u32, u32, u32) {
-        match self.area {
-            Area::World { .. } => (0, 0, 1 << a, 1 << a),
-            Area::Bbox { x0, y0, x1, y1 } => {
-                let s = self.zooms.1 - a;
-                (x0 >> s, y0 >> s, ((x1 - 1) >> s) + 1, ((y1 - 1) >> s) + 1)
-            }
-        }
+    /// Which archive tiles the export holds, in the order they are written.
+    pub fn layout(&self) -> Layout {
+        let rect = match self.area {
+            Area::World { .. } => None,
+            Area::Bbox { x0, y0, x1, y1 } => Some([x0, y0, x1, y1]),
+        };
+        Layout { zooms: (self.zooms.0 as u8, self.zooms.1 as u8), rect }
     }
 
     /// Number of tiles.
     pub fn count(&self) -> u64 {
-        (self.zooms.0..=self.zooms.1)
-            .map(|a| {
-                let (x0, y0, x1, y1) = self.tiles_at(a);
-                (x1 - x0) as u64 * (y1 - y0) as u64
-            })
-            .sum()
+        self.layout().count()
     }
 
     /// Every tile, in ascending PMTiles tile id (zoom, then Hilbert order within it).
     pub fn entries(&self) -> Vec<Entry> {
+        let layout = self.layout();
         let mut out = Vec::with_capacity(self.count() as usize);
         for a in self.zooms.0..=self.zooms.1 {
-            let (x0, y0, x1, y1) = self.tiles_at(a);
             let z = self.textile_zoom(a);
-            let mut level: Vec<(u64, Entry)> = (y0..y1)
-                .flat_map(|y| (x0..x1).map(move |x| (x, y)))
-                .map(|(x, y)| {
-                    let tile = TileSpec { z, x: x as i64, y: y as i64, scale: 1, format: self.format };
-                    (pmtiles_sink::tile_id(a as u8, x, y), Entry { z: a as u8, x, y, tile })
-                })
-                .collect();
-            level.sort_unstable_by_key(|(id, _)| *id);
-            out.extend(level.into_iter().map(|(_, e)| e));
+            out.extend(layout.zoom_tiles(a as u8).into_iter().map(|(a, x, y)| {
+                let tile = TileSpec { z, x: x as i64, y: y as i64, scale: 1, format: self.format };
+                Entry { z: a, x, y, tile }
+            }));
         }
         out
     }
 
     /// Longitude/latitude bounds of the area.
     pub fn bounds(&self) -> [f64; 4] {
-        let (x0, y0, x1, y1) = self.tiles_at(self.zooms.1);
+        let (x0, y0, x1, y1) = self.layout().tiles_at(self.zooms.1 as u8);
         let n = (1u64 << self.zooms.1) as f64;
         let lon = |x: u32| x as f64 / n * 360.0 - 180.0;
         let lat = |y: u32| (std::f64::consts::PI * (1.0 - 2.0 * y as f64 / n)).sinh().atan().to_degrees();
@@ -334,8 +325,9 @@ pub fn run(plan: &Plan, output: &Path) -> Result<Report, String> {
         return Err(format!("{}: the archive must end in .pmtiles or .mbtiles", output.display()));
     }
     let part = own_part(output);
+    merge::check_output(std::slice::from_ref(&part), output, true)?;
     render_part(plan, Shard { index: 0, count: 1 }, &part)?;
-    let r = merge::merge(std::slice::from_ref(&part), output)?;
+    let r = merge::merge(std::slice::from_ref(&part), output, true)?;
     let _ = std::fs::remove_file(&part);
     Ok(Report { secs: started.elapsed().as_secs_f64(), ..r })
 }
@@ -347,8 +339,13 @@ pub fn render_part(plan: &Plan, shard: Shard, output: &Path) -> Result<Report, S
     let entries = plan.entries();
     let total = entries.len() as u64;
     let (start, end) = shard.range(total);
-    let header =
-        part::Header { archive: plan.metadata(), total, shard: (shard.index, shard.count), range: (start, end) };
+    let header = part::Header {
+        archive: plan.metadata(),
+        total,
+        layout: plan.layout(),
+        shard: (shard.index, shard.count),
+        range: (start, end),
+    };
     let Some(mut w) = part::Writer::open(output, &header)? else {
         eprintln!("{}: already complete", output.display());
         return Ok(Report { tiles: 0, bytes: 0, secs: 0.0 });

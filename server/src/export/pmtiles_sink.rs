@@ -5,15 +5,10 @@
 use std::fs::File;
 use std::path::Path;
 
-use pmtiles::{PmTilesStreamWriter, PmTilesWriter, TileCoord, TileId, TileType};
+use pmtiles::{PmTilesStreamWriter, PmTilesWriter, TileCoord, TileType};
 
 use super::Sink;
 use crate::encode::Format;
-
-/// The PMTiles tile id of archive tile `z/x/y` (zoom, then Hilbert order).
-pub fn tile_id(z: u8, x: u32, y: u32) -> u64 {
-    TileCoord::new(z, x, y).map(|c| TileId::from(c).value()).unwrap_or(u64::MAX)
-}
 
 /// A PMTiles archive being written.
 pub struct PmtilesSink {
