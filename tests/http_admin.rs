@@ -616,3 +616,101 @@ async fn ready_does_not_wait_for_stored_uploads() {
     assert_eq!(after["analysis"]["id"], before["analysis"]["id"], "{after}");
     assert!(s.log_text().contains("texture 'later': loaded analysis"), "read from the pipe, not recomputed");
 }
+
+#[tokio::test]
+async fn no_upload_reads_a_file_on_the_server() {
+    let data = tempfile::tempdir().unwrap();
+    let secret = data.path().join("secret.json");
+    std::fs::write(&secret, br#"{"elements": []}"#).unwrap();
+    let a = admin_server(data.path(), &[]);
+    // A field naming a file is refused by name, whatever the path.
+    for path in [secret.to_str().unwrap(), "../secret.json", "/nonexistent/x.json", "embedded:gravel.png"] {
+        let query = format!("?id=sneaky&umbrella.set={}", path.replace('/', "%2F"));
+        let (status, _, body) = upload(&a, &query, "image/png", brick(), Some(TOKEN)).await;
+        assert_eq!((status, body["error"].as_str()), (400, Some("invalid_upload")), "{path}: {body}");
+        let message = body["message"].as_str().unwrap();
+        assert!(message.contains("'umbrella.set'") && message.contains("reads no file on the server"), "{message}");
+        assert!(!message.contains(path), "the answer repeats no path: {message}");
+    }
+    common::assert_error(&a, "/textures/sneaky", 404, "unknown_texture").await;
+    // A record stored before the rule: kept, failed with the way out, no path shown.
+    let (status, _, body) = upload(&a, "?id=legacy", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    until_ready(&a, "/textures/legacy").await;
+    drop(a);
+    let record = data.path().join("uploads/legacy.toml");
+    let mut text = std::fs::read_to_string(&record).unwrap();
+    text.push_str(&format!("\n[umbrella]\nset = {:?}\n", secret.to_str().unwrap()));
+    std::fs::write(&record, &text).unwrap();
+    let b = admin_server(data.path(), &[]);
+    let mut m = serde_json::Value::Null;
+    for _ in 0..300 {
+        m = b.json("/textures/legacy").await;
+        if m["status"] != "analysing" {
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    assert_eq!(m["status"], "failed", "{m}");
+    let why = m["analysis"]["error"].as_str().unwrap();
+    assert!(why.contains("umbrella.set") && why.contains("upload it again"), "{why}");
+    assert!(!m.to_string().contains(data.path().to_str().unwrap()), "public metadata shows no server path: {m}");
+    let (status, _) = b.get_bytes("/tiles/legacy/7/0/0.png?mode=umbrella").await;
+    assert_ne!(status, 200, "nothing of the named file is drawn");
+    assert!(record.exists() && data.path().join("uploads/legacy.png").exists(), "the stored upload is not deleted");
+    // The way out works: delete it, upload it again.
+    assert_eq!(delete(&b, "legacy", Some(TOKEN)).await.0, 204);
+    let (status, _, body) = upload(&b, "?id=legacy", "image/png", brick(), Some(TOKEN)).await;
+    assert_eq!(status, 202, "{body}");
+    until_ready(&b, "/textures/legacy").await;
+}
+
+/// `img` encoded in `format`.
+fn encoded(img: &image::RgbImage, format: image::ImageFormat) -> Vec<u8> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, format).unwrap();
+    out.into_inner()
+}
+
+#[tokio::test]
+async fn truncated_or_lying_jpeg_and_webp_uploads_are_refused() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[]);
+    let img =
+        image::RgbImage::from_fn(128, 128, |x, y| image::Rgb([(x * 2) as u8, (y * 2) as u8, ((x ^ y) * 3) as u8]));
+    let jpeg = encoded(&img, image::ImageFormat::Jpeg);
+    let webp = encoded(&img, image::ImageFormat::WebP);
+    // Half of each file.
+    let half_jpeg = jpeg[..jpeg.len() / 2].to_vec();
+    let half_webp = webp[..webp.len() / 2].to_vec();
+    // A JPEG whose frame header claims 1000×1000 over the 128² image's data.
+    let mut lying_jpeg = jpeg.clone();
+    let sof = lying_jpeg.windows(2).position(|w| w == [0xFF, 0xC0]).expect("a baseline frame");
+    lying_jpeg[sof + 5..sof + 9].copy_from_slice(&[0x03, 0xE8, 0x03, 0xE8]);
+    // A WebP whose lossless header claims 1000×1000.
+    let mut lying_webp = webp.clone();
+    let at = lying_webp.windows(4).position(|w| w == b"VP8L").expect("a lossless WebP") + 9;
+    let bits = u32::from_le_bytes(lying_webp[at..at + 4].try_into().unwrap());
+    let lie = (bits & !((1 << 28) - 1)) | 999 | (999 << 14);
+    lying_webp[at..at + 4].copy_from_slice(&lie.to_le_bytes());
+    for (what, ct, body) in [
+        ("half a JPEG", "image/jpeg", half_jpeg),
+        ("a lying JPEG", "image/jpeg", lying_jpeg),
+        ("half a WebP", "image/webp", half_webp),
+        ("a lying WebP", "image/webp", lying_webp),
+    ] {
+        let (status, _, got) = upload(&s, "?id=broken", ct, body, Some(TOKEN)).await;
+        assert_eq!((status, got["error"].as_str()), (400, Some("invalid_image")), "{what}: {got}");
+        assert!(got["message"].as_str().is_some_and(|m| !m.is_empty()), "{what}: {got}");
+    }
+    let three_quarters = jpeg[..jpeg.len() * 3 / 4].to_vec();
+    let (status, _, got) = upload(&s, "?id=broken", "image/jpeg", three_quarters, Some(TOKEN)).await;
+    assert_eq!(status, 400, "{got}");
+    assert!(got["message"].as_str().unwrap().contains("truncated"), "the answer says what is wrong: {got}");
+    assert!(files_in(&data.path().join("uploads")).is_empty());
+    // The whole files are accepted.
+    let (status, _, got) = upload(&s, "?id=whole-jpeg", "image/jpeg", jpeg, Some(TOKEN)).await;
+    assert_eq!(status, 202, "{got}");
+    let (status, _, got) = upload(&s, "?id=whole-webp", "image/webp", webp, Some(TOKEN)).await;
+    assert_eq!(status, 202, "{got}");
+}

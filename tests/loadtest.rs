@@ -318,15 +318,21 @@ fn access_logs_replay_once_at_their_pace() {
         assert!(took >= secs - 0.05 && took < secs + 0.6, "--speed {speed}: {took} s, {r}");
         assert_eq!(r["model"], "open", "{r}");
     }
-    // A bad line is named.
+    // A bad line is left out, counted and named; a file of nothing else is an error.
     let bad = dir.path().join("bad.log");
     std::fs::write(&bad, format!("{}\n{}\nnot a request\n", lines[0], lines[1])).unwrap();
+    let r = loadtest(&s.base, &["--pattern", "replay", "--file", bad.to_str().unwrap(), "--once"]);
+    assert_eq!(r["requests"], 2, "{r}");
+    assert_eq!(r["replay_left_out"]["malformed"], 1, "{r}");
+    assert!(r["replay_left_out"]["malformed_lines"][0].as_str().unwrap().contains("bad.log:3:"), "{r}");
+    std::fs::write(&bad, "not a request\n").unwrap();
     let out = Command::new(binary())
         .args(["loadtest", "--url", &s.base, "--pattern", "replay", "--file", bad.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("bad.log:3:"), "{}", String::from_utf8_lossy(&out.stderr));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no requests to replay") && err.contains("bad.log:1:"), "{err}");
     // --speed needs timestamps; --once is for replays.
     let plain = dir.path().join("plain.txt");
     std::fs::write(&plain, "/tiles/grass/7/0/0.png\n").unwrap();
@@ -337,4 +343,86 @@ fn access_logs_replay_once_at_their_pace() {
         let out = Command::new(binary()).args(["loadtest", "--url", &s.base]).args(&args).output().unwrap();
         assert!(!out.status.success() && String::from_utf8_lossy(&out.stderr).contains(says), "{args:?}");
     }
+}
+
+/// A listener on this machine that counts the connections it is offered (and answers none).
+fn trap() -> (u16, std::sync::Arc<std::sync::atomic::AtomicUsize>) {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    let hits = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    let h = hits.clone();
+    std::thread::spawn(move || {
+        for c in listener.incoming() {
+            h.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            drop(c);
+        }
+    });
+    (port, hits)
+}
+
+/// A replay stays on `--url`: lines that name another host (a scheme, `@`, `//`) never reach it,
+/// redirects are counted, not followed, and lines left out are counted by reason.
+#[test]
+fn a_replay_stays_on_its_target() {
+    let s = Server::builder().start();
+    let (port, hits) = trap();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("hostile.txt");
+    let lines = [
+        format!("x:@127.0.0.1:{port}/p"),
+        format!("mailto:@127.0.0.1:{port}/p"),
+        format!("//127.0.0.1:{port}/p"),
+        format!("/@127.0.0.1:{port}/p"),
+        "/tiles/grass/7/0/0.png".to_string(),
+    ];
+    std::fs::write(&file, lines.join("\n")).unwrap();
+    let f = file.to_str().unwrap();
+    let r = loadtest(&s.base, &["--pattern", "replay", "--file", f, "--once", "--verify"]);
+    assert_eq!(r["requests"], 3, "{r}");
+    assert_eq!(r["replay_left_out"]["malformed"], 2, "{r}");
+    assert!(r["replay_left_out"]["malformed_lines"][0].as_str().unwrap().contains("hostile.txt:1:"), "{r}");
+    assert_eq!(r["status"]["200"], 1, "{r}");
+
+    // A server that redirects every tile to the trap: 3xx counted, nothing followed.
+    let redirecting = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let base = format!("http://{}", redirecting.local_addr().unwrap());
+    std::thread::spawn(move || {
+        use std::io::{Read, Write};
+        for c in redirecting.incoming() {
+            let Ok(mut c) = c else { continue };
+            let mut buf = [0u8; 4096];
+            let n = c.read(&mut buf).unwrap_or(0);
+            let head = String::from_utf8_lossy(&buf[..n]);
+            let answer = if head.starts_with("GET /textures/") {
+                let body = r#"{"native_zoom": 7, "minzoom": 0}"#;
+                format!("HTTP/1.1 200 OK\r\ncontent-type: application/json\r\ncontent-length: {}\r\nconnection: close\r\n\r\n{body}", body.len())
+            } else {
+                format!("HTTP/1.1 302 Found\r\nlocation: http://127.0.0.1:{port}/stolen\r\ncontent-length: 0\r\nconnection: close\r\n\r\n")
+            };
+            let _ = c.write_all(answer.as_bytes());
+        }
+    });
+    let plain = dir.path().join("plain.txt");
+    std::fs::write(&plain, "/tiles/grass/7/0/0.png\n/tiles/grass/7/1/0.png\n").unwrap();
+    let r =
+        loadtest(&base, &["--texture", "grass", "--pattern", "replay", "--file", plain.to_str().unwrap(), "--once"]);
+    assert_eq!(r["status"]["302"], 2, "{r}");
+
+    // Times out of range (before 1970, after 2100) are left out and counted, the rest played.
+    let log = dir.path().join("times.log");
+    let mut text: Vec<String> = (0..19)
+        .map(|i| {
+            format!(
+                r#"{{"ts":{},"method":"GET","path":"/tiles/grass/7/{i}/0.png","status":200}}"#,
+                1_765_000_000_000u64 + i * 10
+            )
+        })
+        .collect();
+    text.push(r#"{"ts":-5000,"method":"GET","path":"/tiles/grass/7/0/1.png","status":200}"#.into());
+    text.push(r#"{"ts":253402300799000,"method":"GET","path":"/tiles/grass/7/0/2.png","status":200}"#.into());
+    std::fs::write(&log, text.join("\n")).unwrap();
+    let r = loadtest(&s.base, &["--pattern", "replay", "--file", log.to_str().unwrap(), "--speed", "10"]);
+    assert_eq!(r["requests"], 19, "{r}");
+    assert_eq!(r["replay_left_out"]["time_out_of_range"], 2, "{r}");
+    assert_eq!(hits.load(std::sync::atomic::Ordering::SeqCst), 0, "nothing reached another server");
 }

@@ -22,11 +22,47 @@ pub fn decode_within(bytes: &[u8], max_side: u32, max_alloc: u64) -> ImageResult
     limits.max_image_height = Some(max_side);
     limits.max_alloc = Some(max_alloc);
     r.limits(limits);
+    if r.format() == Some(image::ImageFormat::Jpeg) {
+        jpeg_whole(bytes, max_side).map_err(|message| {
+            image::ImageError::Decoding(image::error::DecodingError::new(
+                image::ImageFormat::Jpeg.into(),
+                format!("{message}: the JPEG is truncated or its header claims more than its data holds"),
+            ))
+        })?;
+    }
     let mut decoder = r.into_decoder()?;
     let orientation = decoder.orientation()?;
     let mut img = DynamicImage::from_decoder(decoder)?;
     img.apply_orientation(orientation);
     Ok(img)
+}
+
+/// Whether a JPEG's data covers its whole image. The image crate's decoder fills what is
+/// missing (a truncated file's lower part, or all but the first rows of a file whose header
+/// claims a larger size) and succeeds; its strict mode says when the data runs out. A
+/// sequential JPEG is checked without its end marker, so that running out of coded data before
+/// the last block is an error rather than a fill; a progressive one needs its end marker to end
+/// its scans, and its refinement scans fail on data that does not fit the size it claims.
+fn jpeg_whole(bytes: &[u8], max_side: u32) -> Result<(), String> {
+    use zune_core::options::DecoderOptions;
+    use zune_jpeg::errors::DecodeErrors;
+    use zune_jpeg::JpegDecoder;
+    let options = DecoderOptions::default()
+        .set_strict_mode(true)
+        .set_max_width(max_side as usize)
+        .set_max_height(max_side as usize);
+    let decode = |data: &[u8]| -> Result<(), DecodeErrors> {
+        JpegDecoder::new_with_options(Cursor::new(data), options).decode().map(drop)
+    };
+    let mut headers = JpegDecoder::new_with_options(Cursor::new(bytes), options);
+    headers.decode_headers().map_err(|e| e.to_string())?;
+    let progressive = headers.info().is_some_and(|i| i.sof.is_progressive());
+    let end = if progressive {
+        bytes.len()
+    } else {
+        bytes.windows(2).rposition(|w| w == [0xFF, 0xD9]).unwrap_or(bytes.len())
+    };
+    decode(&bytes[..end]).map_err(|e| e.to_string())
 }
 
 /// An RGB8 image of a window.

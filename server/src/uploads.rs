@@ -138,6 +138,12 @@ pub fn texture_config(fields: &[(String, String)], maps: &[(String, &str)]) -> R
     t.modes = modes.into_iter().map(|(m, table)| (m, toml::Value::Table(table))).collect();
     t.uploaded = true;
     t.validate("upload").map_err(|(key, msg)| bad(format!("{key}: {msg}")))?;
+    if let Some(field) = t.file_settings().first() {
+        return Err(bad(format!(
+            "field '{field}' names a file, and an upload reads no file on the server; upload without it (the \
+             texture then uses what it derives from its exemplar)"
+        )));
+    }
     Ok(t)
 }
 
@@ -151,6 +157,9 @@ pub enum StoreError {
     /// The data directory refused the files.
     #[error("{0}")]
     Io(#[from] std::io::Error),
+    /// This server may not write in the data directory (removed or replaced while it ran).
+    #[error("{0}")]
+    NotOwned(#[from] crate::textures::lock::NotWritable),
 }
 
 /// Store an upload: its maps' bytes (`maps`: file name and bytes, the names `t.maps` gives),
@@ -166,6 +175,10 @@ pub fn store(
     ext: &str,
     maps: &[(String, Vec<u8>)],
 ) -> Result<(), StoreError> {
+    // Never recreate a data directory that was removed under this server (another may own it).
+    if let Some(data_dir) = dir.parent() {
+        crate::textures::lock::may_write(data_dir)?;
+    }
     std::fs::create_dir_all(dir)?;
     let record = dir.join(format!("{}.toml", t.id));
     let file = format!("{}.{ext}", t.id);
@@ -357,13 +370,20 @@ pub fn analyse_in_background(st: Arc<AppState>, tex: Arc<Texture>) {
                 let budget = std::time::Duration::from_secs(st.config.analysis_timeout_secs);
                 let watch = Watch::new(&tex.config.id, &tex.progress, &tex.removed, &st.stopping, budget);
                 // The upload was just stored beside it, so the data directory is writable (a
-                // failed save is still only a warning).
+                // failed save is still only a warning), unless it was removed since.
+                let storable = match crate::textures::lock::may_write(&data_dir) {
+                    Ok(()) => true,
+                    Err(e) => {
+                        tracing::warn!("texture '{}': {e}", tex.config.id);
+                        false
+                    }
+                };
                 let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                     st.analysis_pool.run(|| {
                         crate::textures::analyse_texture(
                             &st.config,
                             &data_dir,
-                            true,
+                            storable,
                             &tex,
                             &log,
                             &watch,

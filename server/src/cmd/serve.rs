@@ -55,15 +55,15 @@ async fn serve(cfg: Config) -> CliResult {
         shutdown_grace: Duration::from_secs(cfg.shutdown_grace_secs),
     };
     // One server per data directory, taken before anything is written there (uploads, analyses).
-    // A directory that cannot be written is not locked: nothing is stored in it (the registry
-    // says so when it loads).
+    // A directory that cannot be written at all is not locked: nothing is stored in it (the
+    // registry says so when it loads). Any other failure to lock a directory stops the start.
     let _owner = match crate::textures::lock::DataDirLock::acquire(&cfg.data_dir()) {
         Ok(l) => Some(l),
-        Err(e @ crate::textures::lock::LockError::Owned { .. }) => return Err(Box::new(e)),
-        Err(e) => {
+        Err(e @ crate::textures::lock::LockError::Unwritable { .. }) => {
             warn!("{e}");
             None
         }
+        Err(e) => return Err(Box::new(e)),
     };
     let mut state = AppState::new(cfg)?;
     if !state.config.access_log.is_empty() {

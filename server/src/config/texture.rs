@@ -242,6 +242,32 @@ impl TextureConfig {
         }
     }
 
+    /// The per-mode settings that name a file on the server (what a mode's preparation reads,
+    /// e.g. a hand-made element set), as `MODE.KEY`. A configuration may; an upload may not.
+    pub fn file_settings(&self) -> Vec<String> {
+        let modes = textile_core::modes::all();
+        self.mode_tables()
+            .into_iter()
+            .flat_map(|(mode, table)| table.into_iter().map(move |(k, _)| (mode.clone(), k)))
+            .filter(|(mode, k)| modes.iter().any(|m| m.name == mode && m.prepares_with(k)))
+            .map(|(mode, k)| format!("{mode}.{k}"))
+            .collect()
+    }
+
+    /// Why an uploaded texture cannot be served as its record stands, if it cannot: a record
+    /// stored before uploads were refused file settings names a file on the server.
+    pub fn upload_refusal(&self) -> Option<String> {
+        let named = self.file_settings();
+        (self.uploaded && !named.is_empty()).then(|| {
+            format!(
+                "its stored upload names a file on the server in the setting {}, which uploads may no longer do: \
+                 DELETE /admin/textures/{} and upload it again without that field",
+                named.join(", "),
+                self.id
+            )
+        })
+    }
+
     /// The per-mode tables as `key = value` text pairs (lists joined with commas).
     pub fn mode_tables(&self) -> BTreeMap<String, Vec<(String, String)>> {
         self.modes

@@ -254,6 +254,15 @@ pub async fn upload(
                     ),
                 ))
             }
+            Ok(Err(uploads::StoreError::NotOwned(e))) => {
+                tracing::error!("texture '{id}': the upload is not stored: {e}");
+                return Err(ApiError::new(
+                    Kind::InsufficientStorage,
+                    "storage_failed",
+                    "the upload could not be stored: the data directory was removed or taken over while the server \
+                     ran; see the server log",
+                ));
+            }
             // The path stays in the log: an answer names no part of the server's layout.
             Ok(Err(uploads::StoreError::Io(e))) => {
                 tracing::error!("texture '{id}': the upload could not be stored in {}: {e}", dir.display());

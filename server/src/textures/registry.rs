@@ -131,7 +131,14 @@ pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, 
     for (index, t) in cfg.textures.iter().enumerate() {
         let prepared = exemplar_bytes(cfg, t).and_then(|bytes| prepare_texture(cfg, t, index, &bytes, &[], log));
         match prepared {
-            Ok(tex) => list.push(Arc::new(tex)),
+            Ok(tex) => {
+                // A stored upload that names a server file is kept, failed, with the way out.
+                if let Some(why) = t.upload_refusal() {
+                    log(format!("warning: uploaded texture '{}': {why}", t.id));
+                    let _ = tex.failure.set(why);
+                }
+                list.push(Arc::new(tex))
+            }
             Err(e) if t.uploaded => log(format!("warning: uploaded {e}; not served")),
             Err(e) => return Err(e),
         }

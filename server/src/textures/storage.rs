@@ -118,11 +118,8 @@ pub(crate) fn writable(dir: &std::path::Path) -> Result<(), std::io::Error> {
 /// process's server owns ([`super::lock`]) is read, never written: not even probed.
 pub(crate) fn data_dir_storable(cfg: &Config, log: &dyn Fn(String)) -> bool {
     let data_dir = cfg.data_dir();
-    if let Err(pid) = super::lock::may_write(&data_dir) {
-        log(format!(
-            "the data directory {} belongs to the textile server of pid {pid}: reading its analyses, storing none              (what is computed here is kept in memory)",
-            data_dir.display()
-        ));
+    if let Err(why) = super::lock::may_write(&data_dir) {
+        log(format!("{why}: reading its analyses, storing none (what is computed here is kept in memory)"));
         return false;
     }
     match writable(&data_dir) {
@@ -141,7 +138,14 @@ pub(crate) fn data_dir_storable(cfg: &Config, log: &dyn Fn(String)) -> bool {
 }
 
 /// Read the bytes of a file a texture setting names (relative to the configuration), as a
-/// preparation's [`Input::read`] asks.
+/// preparation's [`Input::read`] asks; an uploaded texture's settings read none.
 pub(crate) fn setting_file(cfg: &Config, t: &TextureConfig, name: &str) -> Result<Vec<u8>, textile_core::CoreError> {
+    // An upload names no file on the server (its record may predate that rule): nothing is read.
+    if t.uploaded {
+        return Err(textile_core::CoreError::Param {
+            name: "file",
+            message: "an uploaded texture reads no file on the server".into(),
+        });
+    }
     image_bytes(cfg, t, name).map_err(|e| textile_core::CoreError::Param { name: "file", message: e.to_string() })
 }

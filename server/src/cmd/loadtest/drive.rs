@@ -113,8 +113,8 @@ pub struct Outcome {
 pub struct Load {
     /// HTTP client (its pool holds the connections).
     pub client: reqwest::Client,
-    /// Base URL without a trailing slash.
-    pub root: String,
+    /// The server: every request goes to it ([`super::pattern::target`]).
+    pub root: reqwest::Url,
     /// Request paths, shared by the connections.
     pub paths: Arc<Mutex<Paths>>,
     /// Connections (open model: most requests in flight).
@@ -186,7 +186,7 @@ impl Load {
     /// `deadline`.
     async fn request(&self, path: &str, deadline: Instant) -> Answer {
         let r = tokio::time::timeout_at(deadline, async {
-            let resp = self.client.get(format!("{}{path}", self.root)).send().await?;
+            let resp = self.client.get(super::pattern::target(&self.root, path)).send().await?;
             let status = resp.status().as_u16();
             let retry = resp.headers().get("retry-after").and_then(|v| v.to_str().ok()?.parse::<u64>().ok());
             let body = resp.bytes().await?;

@@ -136,10 +136,10 @@ pub fn run(a: LoadtestArgs) -> CliResult {
     if a.pattern != "replay" && (a.once || a.speed.is_some() || !a.replay_status.is_empty()) {
         return Err("--once, --speed and --replay-status are for --pattern replay".into());
     }
-    let entries = match (&a.pattern[..], &a.file) {
+    let (entries, left_out) = match (&a.pattern[..], &a.file) {
         ("replay", Some(f)) => pattern::replay_lines(f, &a.replay_status)?,
         ("replay", None) => return Err("--pattern replay needs --file".into()),
-        _ => Vec::new(),
+        _ => Default::default(),
     };
     let model = model(&a, &entries)?;
     let once = a.once || a.speed.is_some();
@@ -162,13 +162,18 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         (Some(n), None) => (n, MAX_SECONDS),
         (n, Some(d)) => (n.unwrap_or(u64::MAX), d),
     };
-    let lines: Vec<String> = entries.into_iter().map(|e| e.path).collect();
+    // The paths alone (the times, if any, are in the model): no second copy of them.
+    let lines: Vec<Box<str>> = entries.into_iter().map(|e| e.path).collect();
     let rt = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
     rt.block_on(async move {
-        let client = reqwest::Client::builder().pool_max_idle_per_host(a.concurrency).build()?;
+        // Redirects are answers to count (3xx), never followed: a run stays on its server.
+        let client = reqwest::Client::builder()
+            .pool_max_idle_per_host(a.concurrency)
+            .redirect(reqwest::redirect::Policy::none())
+            .build()?;
         let root = a.url.trim_end_matches('/').to_string();
         let meta: serde_json::Value = client
-            .get(format!("{root}/textures/{}", a.texture))
+            .get(pattern::target(&base, &format!("/textures/{}", a.texture)))
             .send()
             .await
             .map_err(|e| format!("cannot reach {root}: {e}"))?
@@ -189,7 +194,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let make = |references: Option<Arc<verify::References>>| {
             Arc::new(Load {
                 client: client.clone(),
-                root: root.clone(),
+                root: base.clone(),
                 paths: paths.clone(),
                 concurrency: a.concurrency,
                 model: model.clone(),
@@ -263,6 +268,9 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             // A row per second of the run as asked (its measured end is a hair later).
             "timeline": report::timeline(all, duration.min(elapsed), open),
         });
+        if a.pattern == "replay" {
+            report["replay_left_out"] = left_out.json();
+        }
         if open {
             report["rate"] = match &model {
                 Model::Open { from, to } => json!({ "from": from, "to": to }),
@@ -277,7 +285,7 @@ pub fn run(a: LoadtestArgs) -> CliResult {
         let unchecked = std::mem::take(&mut *load.unchecked.lock().unwrap_or_else(|e| e.into_inner()));
         let mut late_mismatched = 0u64;
         if verifying {
-            verify::fetch(&client, &root, unchecked.keys().cloned(), &mut references).await?;
+            verify::fetch(&client, &base, unchecked.keys().cloned(), &mut references).await?;
             let mut m = load.mismatches.lock().unwrap_or_else(|e| e.into_inner());
             for (path, digests) in &unchecked {
                 let Some(want) = references.get(path) else { continue };
@@ -349,6 +357,9 @@ pub fn run(a: LoadtestArgs) -> CliResult {
             let _ = writeln!(w, "  200 only: {}", report::line(&report["latency_ms_200"]));
         }
         let _ = writeln!(w, "status: {}", statuses.iter().map(|(k, v)| format!("{k}×{v}")).collect::<Vec<_>>().join("  "));
+        if let Some(line) = left_out.line() {
+            let _ = writeln!(w, "{line}");
+        }
         let timed_out = statuses.get("timed_out").copied().unwrap_or(0);
         if open && (timed_out > 0 || out.unsent > 0) {
             let unanswered = timed_out + out.unsent;

@@ -3,7 +3,9 @@
 //! zooms), `hot` (one tile) and `replay` (the paths of a file, cycled).
 
 use std::path::Path;
+
 use std::sync::Arc;
+use textile_core::error::clip;
 
 /// An endless (or, for `replay`, cycled) sequence of request paths.
 pub type Paths = Box<dyn Iterator<Item = String> + Send>;
@@ -36,7 +38,7 @@ pub fn pattern(
     native: u32,
     minzoom: u32,
     query: &str,
-    (lines, once): (Vec<String>, bool),
+    (lines, once): (Vec<Box<str>>, bool),
     seed: u64,
 ) -> Paths {
     let q = if query.is_empty() { String::new() } else { format!("?{query}") };
@@ -72,8 +74,8 @@ pub fn pattern(
                 })
             }))
         }
-        "replay" if once => Box::new(lines.into_iter()),
-        "replay" => Box::new(lines.into_iter().cycle()),
+        "replay" if once => Box::new(lines.into_iter().map(String::from)),
+        "replay" => Box::new(lines.into_iter().cycle().map(String::from)),
         _ => {
             // pan: drag a 1920×1080 viewport right and slightly down, 64 px per frame; request
             // each tile the first time it becomes visible (a browser caches the rest).
@@ -90,13 +92,33 @@ pub fn pattern(
     }
 }
 
-/// The path (and query) of a URL or `/path`; `None` for anything else.
+/// The path (and query) of an `http` or `https` URL, or of a `/path`; `None` for anything
+/// else (another scheme, a relative reference, white space).
 pub fn path_of(s: &str) -> Option<String> {
     match reqwest::Url::parse(s) {
-        Ok(u) => Some(format!("{}{}", u.path(), u.query().map(|q| format!("?{q}")).unwrap_or_default())),
+        Ok(u) if matches!(u.scheme(), "http" | "https") => {
+            Some(format!("{}{}", u.path(), u.query().map(|q| format!("?{q}")).unwrap_or_default()))
+        }
+        Ok(_) => None,
         Err(_) if s.starts_with('/') && !s.contains(char::is_whitespace) => Some(s.to_string()),
         Err(_) => None,
     }
+}
+
+/// The URL of request path `path` (with its query) on the server at `root`: always that
+/// server, whatever the path holds (`//host/…`, `@host`, a scheme): the path and query are set
+/// on a copy of `root`, never parsed as a URL of their own.
+pub fn target(root: &reqwest::Url, path: &str) -> reqwest::Url {
+    let mut u = root.clone();
+    let (p, q) = match path.split_once('?') {
+        Some((p, q)) => (p, Some(q)),
+        None => (path, None),
+    };
+    let base = root.path().trim_end_matches('/');
+    u.set_path(&format!("{base}{p}"));
+    u.set_query(q);
+    u.set_fragment(None);
+    u
 }
 
 /// One line of a replay file: the path (and query) to request, and when the log saw it
@@ -104,10 +126,74 @@ pub fn path_of(s: &str) -> Option<String> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Entry {
     /// Path and query.
-    pub path: String,
+    pub path: Box<str>,
     /// The log's timestamp.
     pub at: Option<f64>,
 }
+
+/// Why lines of a replay file were left out, counted, with the first malformed ones named.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LeftOut {
+    /// Access-log lines of a method other than GET or HEAD.
+    pub method: u64,
+    /// Access-log lines whose status `--replay-status` does not list.
+    pub status: u64,
+    /// Lines that are no request (neither a URL, a `/path`, nor an access-log line).
+    pub malformed: u64,
+    /// Access-log lines whose time is before 1970 or after 2100.
+    pub time: u64,
+    /// The first few malformed lines: `FILE:LINE: why`.
+    pub examples: Vec<String>,
+}
+
+impl LeftOut {
+    /// How many malformed lines are named.
+    const EXAMPLES: usize = 3;
+
+    /// Lines left out in all.
+    pub fn total(&self) -> u64 {
+        self.method + self.status + self.malformed + self.time
+    }
+
+    /// As the JSON report gives it.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "method": self.method, "status_filter": self.status, "malformed": self.malformed,
+            "time_out_of_range": self.time, "malformed_lines": self.examples,
+        })
+    }
+
+    /// One line of the text report, if any line was left out.
+    pub fn line(&self) -> Option<String> {
+        if self.total() == 0 {
+            return None;
+        }
+        let mut parts = Vec::new();
+        for (n, why) in [
+            (self.method, "not GET or HEAD"),
+            (self.status, "status not asked for"),
+            (self.malformed, "malformed"),
+            (self.time, "time out of range"),
+        ] {
+            if n > 0 {
+                parts.push(format!("{n} {why}"));
+            }
+        }
+        let examples =
+            if self.examples.is_empty() { String::new() } else { format!(" ({})", self.examples.join("; ")) };
+        Some(format!("replay: {} lines left out: {}{examples}", self.total(), parts.join(", ")))
+    }
+
+    fn malformed(&mut self, at: String) {
+        self.malformed += 1;
+        if self.examples.len() < Self::EXAMPLES {
+            self.examples.push(at);
+        }
+    }
+}
+
+/// Seconds since the epoch of 2100-01-01: later access-log times are out of range.
+const LATEST: f64 = 4_102_444_800.0;
 
 /// Month numbers of access-log dates.
 const MONTHS: [&str; 12] = ["Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec"];
@@ -166,44 +252,78 @@ fn json_log(l: &str) -> Result<(String, String, u16, f64), String> {
     Ok((text("method").unwrap_or_else(|| "GET".into()), path, status, ts / 1000.0))
 }
 
-/// The entries of a replay file: one URL, `/path`, access-log line (nginx or Apache combined or
-/// common) or line of textile's JSON access log per line; blank lines and `#` comments skipped.
-/// Access-log lines other than GET or HEAD, or whose status is not in `statuses` (when given),
-/// are left out. A log whose every line has a time is played in the order of those times (a
-/// log is written as answers end, so its lines are not quite in arrival order).
-pub fn replay_lines(f: &Path, statuses: &[u16]) -> Result<Vec<Entry>, String> {
-    let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}", f.display()))?;
+/// The entries of a replay file, read line by line (never the whole file at once): one URL,
+/// `/path`, access-log line (nginx or Apache combined or common) or line of textile's JSON access
+/// log per line; blank lines and `#` comments skipped. Access-log lines other than GET or HEAD,
+/// whose status is not in `statuses` (when given), or whose time is out of range are left out,
+/// and so are malformed lines: each counted by reason ([`LeftOut`]). A log whose every line has
+/// a time is played in the order of those times (a log is written as answers end, so its lines
+/// are not quite in arrival order).
+pub fn replay_lines(f: &Path, statuses: &[u16]) -> Result<(Vec<Entry>, LeftOut), String> {
+    use std::io::BufRead;
+    let file = std::fs::File::open(f).map_err(|e| format!("{}: {e}", f.display()))?;
     let mut v = Vec::new();
-    for (n, l) in text.lines().enumerate().map(|(n, l)| (n + 1, l.trim())) {
+    let mut left = LeftOut::default();
+    let mut line = String::new();
+    let mut reader = std::io::BufReader::new(file);
+    for n in 1.. {
+        line.clear();
+        match reader.read_line(&mut line) {
+            Ok(0) => break,
+            Ok(_) => {}
+            Err(e) => return Err(format!("{}:{n}: {e}", f.display())),
+        }
+        let l = line.trim();
         if l.is_empty() || l.starts_with('#') {
             continue;
         }
         let logged = if l.starts_with('{') {
-            Some(json_log(l).map_err(|e| format!("{}:{n}: {e}", f.display()))?)
+            match json_log(l) {
+                Ok(x) => Some(x),
+                Err(e) => {
+                    left.malformed(format!("{}:{n}: {e}", f.display()));
+                    continue;
+                }
+            }
         } else {
             access_log(l).map(|(m, p, s, t)| (m.to_owned(), p.to_owned(), s, t))
         };
         if let Some((method, path, status, at)) = logged {
             if !path.starts_with('/') {
-                return Err(format!("{}:{n}: the request path '{path}' does not start with '/'", f.display()));
-            }
-            if matches!(method.as_str(), "GET" | "HEAD") && (statuses.is_empty() || statuses.contains(&status)) {
-                v.push(Entry { path, at: Some(at) });
+                left.malformed(format!(
+                    "{}:{n}: the request path '{}' does not start with '/'",
+                    f.display(),
+                    clip(&path)
+                ));
+            } else if !matches!(method.as_str(), "GET" | "HEAD") {
+                left.method += 1;
+            } else if !statuses.is_empty() && !statuses.contains(&status) {
+                left.status += 1;
+            } else if !(0.0..LATEST).contains(&at) {
+                left.time += 1;
+            } else {
+                v.push(Entry { path: path.into(), at: Some(at) });
             }
             continue;
         }
-        let path = path_of(l).ok_or_else(|| {
-            format!("{}:{n}: '{l}' is neither a URL, a /path, nor a combined or common access-log line", f.display())
-        })?;
-        v.push(Entry { path, at: None });
+        match path_of(l) {
+            Some(path) => v.push(Entry { path: path.into(), at: None }),
+            None => left.malformed(format!(
+                "{}:{n}: '{}' is neither an http(s) URL, a /path, nor a combined or common access-log line",
+                f.display(),
+                clip(l)
+            )),
+        }
     }
     if v.is_empty() {
-        return Err(format!("{}: no requests to replay", f.display()));
+        let why = left.line().map(|l| format!(" ({l})")).unwrap_or_default();
+        return Err(format!("{}: no requests to replay{why}", f.display()));
     }
     if v.iter().all(|e| e.at.is_some()) {
         v.sort_by(|a, b| a.at.partial_cmp(&b.at).unwrap_or(std::cmp::Ordering::Equal));
     }
-    Ok(v)
+    v.shrink_to_fit();
+    Ok((v, left))
 }
 
 #[cfg(test)]
@@ -240,11 +360,28 @@ mod tests {
             ),
         )
         .unwrap();
-        let e = replay_lines(&f, &[200]).unwrap();
-        let got: Vec<(&str, f64)> = e.iter().map(|e| (e.path.as_str(), e.at.unwrap())).collect();
+        let (e, left) = replay_lines(&f, &[200]).unwrap();
+        let got: Vec<(&str, f64)> = e.iter().map(|e| (&*e.path, e.at.unwrap())).collect();
         assert_eq!(got, [("/a", 1000.0), ("/b?x=1", 1000.25)]);
+        assert_eq!((left.method, left.status, left.total()), (1, 1, 2));
         std::fs::write(&f, "{\"ts\":1}\n").unwrap();
         assert!(replay_lines(&f, &[]).unwrap_err().contains(":1: a JSON access-log line without \"path\""));
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn requests_stay_on_the_server_whatever_the_line() {
+        let root = reqwest::Url::parse("http://127.0.0.1:8080").unwrap();
+        for line in ["x:@127.0.0.9:9/p", "mailto:@127.0.0.9/p", "ftp://127.0.0.9/p", "tiles/a/0/0/0.png"] {
+            assert_eq!(path_of(line), None, "{line}");
+        }
+        for path in ["//127.0.0.9:9/p", "/@127.0.0.9:9/p", "/p?q=//127.0.0.9", "/a/../../b"] {
+            let u = target(&root, path);
+            assert_eq!((u.host_str(), u.port()), (Some("127.0.0.1"), Some(8080)), "{path}: {u}");
+        }
+        assert_eq!(
+            target(&root, "/tiles/a/7/0/0.png?seed=2").as_str(),
+            "http://127.0.0.1:8080/tiles/a/7/0/0.png?seed=2"
+        );
     }
 }

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
-use super::pattern::path_of;
+use super::pattern::{path_of, target};
 
 /// Reference digests by request path.
 pub type References = HashMap<String, String>;
@@ -42,7 +42,7 @@ pub fn read(f: &Path) -> Result<References, String> {
 /// answers can be references.
 pub async fn fetch(
     client: &reqwest::Client,
-    root: &str,
+    root: &reqwest::Url,
     paths: impl Iterator<Item = String>,
     refs: &mut References,
 ) -> Result<(), String> {
@@ -50,7 +50,7 @@ pub async fn fetch(
         if refs.contains_key(&p) {
             continue;
         }
-        let r = client.get(format!("{root}{p}")).send().await.map_err(|e| format!("reference of {p}: {e}"))?;
+        let r = client.get(target(root, &p)).send().await.map_err(|e| format!("reference of {p}: {e}"))?;
         if r.status() != 200 {
             return Err(format!("reference of {p}: HTTP {}", r.status()));
         }
