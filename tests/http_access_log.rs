@@ -167,3 +167,22 @@ fn sighup_reopens_the_log_after_it_was_moved() {
     assert!(!read(&log).contains("n=1") && !read(&moved).contains("n=2"));
     assert_eq!(get("/health"), 200, "the server lives on after SIGHUP");
 }
+
+#[test]
+fn lines_a_full_disk_refuses_count_as_dropped() {
+    // /dev/full: every write fails with ENOSPC, as on a full disk.
+    let s = Server::builder().args(&["--access-log", "/dev/full"]).start();
+    let rt = tokio::runtime::Runtime::new().unwrap();
+    let metric = |name: &str| -> f64 {
+        let text = rt.block_on(async { s.get("/metrics").await.text().await.unwrap() });
+        let line = text.lines().find(|l| l.starts_with(name)).unwrap_or_else(|| panic!("no {name} in /metrics"));
+        line.rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    for i in 0..50 {
+        assert_eq!(rt.block_on(async { s.get(&format!("/health?i={i}")).await.status().as_u16() }), 200);
+    }
+    // Every request so far (the 50, and the /metrics reads) is dropped once its write fails.
+    assert!(wait_for(10, || metric("textile_access_log_dropped_total") >= 50.0), "dropped lines are counted");
+    assert_eq!(metric("textile_access_log_lines_total"), 0.0, "nothing was written");
+    assert!(s.log_text().contains("No space left on device"), "{}", s.log_text());
+}

@@ -1,12 +1,13 @@
 //! The access log's writer: one line per answered request ([`Entry`]), as a JSON object or in
 //! Combined Log Format, handed over a bounded channel to a thread of its own that appends them
 //! to a file (or stdout). A request never waits for it: when the channel is full the line is
-//! dropped and counted (`textile_access_log_dropped_total`). [`AccessLog::reopen`] (SIGHUP)
+//! dropped and counted (`textile_access_log_dropped_total`), and so is every line a failed
+//! write or flush held (a full disk); `textile_access_log_lines_total` counts lines written. [`AccessLog::reopen`] (SIGHUP)
 //! makes the writer close and reopen its file, so logrotate can move it away. How the HTTP layer
 //! fills an [`Entry`] is `http::access`'s.
 
 use std::fs::OpenOptions;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, Write};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError, SyncSender, TrySendError};
@@ -192,7 +193,8 @@ const FLUSH_EVERY: Duration = Duration::from_millis(200);
 
 impl AccessLog {
     /// Open `path` (`-`: stdout) for appending and start the writer; `buffer` lines wait for it
-    /// at most. `written` and `dropped` count lines.
+    /// at most. `written` counts lines written (and flushed), `dropped` those lost: the channel
+    /// was full, or their write or flush failed.
     pub fn open(
         path: &str,
         format: Format,
@@ -205,10 +207,10 @@ impl AccessLog {
         let (tx, rx) = mpsc::sync_channel(buffer.max(1));
         let reopen = Arc::new(AtomicBool::new(false));
         let writer = {
-            let reopen = reopen.clone();
+            let (reopen, dropped) = (reopen.clone(), dropped.clone());
             std::thread::Builder::new()
                 .name("textile-access-log".into())
-                .spawn(move || write_lines(rx, out, target, &reopen, &written))?
+                .spawn(move || write_lines(rx, out, target, &reopen, (&written, &dropped)))?
         };
         Ok(AccessLog { format, tx, reopen, dropped, writer: Mutex::new(Some(writer)) })
     }
@@ -250,16 +252,46 @@ impl AccessLog {
     }
 }
 
-/// The writer thread: append lines, flush when the channel runs dry (or every
-/// [`FLUSH_EVERY`]), reopen the file when asked.
+/// Bytes of lines gathered before they are written together.
+const BATCH: usize = 64 << 10;
+
+/// Lines gathered and not yet written: written together, then counted as written — or, when
+/// the write or its flush fails, every one of them counted as dropped.
+struct Batch {
+    bytes: Vec<u8>,
+    lines: u64,
+}
+
+impl Batch {
+    fn push(&mut self, line: &str) {
+        self.bytes.extend_from_slice(line.as_bytes());
+        self.lines += 1;
+    }
+
+    /// Write and flush the gathered lines; count them.
+    fn write(&mut self, out: &mut dyn Write, written: &IntCounter, dropped: &IntCounter) -> io::Result<()> {
+        let done = if self.lines == 0 { Ok(()) } else { out.write_all(&self.bytes).and_then(|()| out.flush()) };
+        match &done {
+            Ok(()) => written.inc_by(self.lines),
+            Err(_) => dropped.inc_by(self.lines),
+        }
+        self.bytes.clear();
+        self.lines = 0;
+        done
+    }
+}
+
+/// The writer thread: gather lines, write them when the channel runs dry (or every
+/// [`FLUSH_EVERY`], or [`BATCH`] bytes), reopen the file when asked. A line counts as written
+/// once its write and flush succeeded; lines a failed write or flush held count as dropped.
 fn write_lines(
     rx: Receiver<Message>,
-    out: Box<dyn Write + Send>,
+    mut out: Box<dyn Write + Send>,
     target: Target,
     reopen: &AtomicBool,
-    written: &IntCounter,
+    (written, dropped): (&IntCounter, &IntCounter),
 ) {
-    let mut out = BufWriter::with_capacity(64 << 10, out);
+    let mut batch = Batch { bytes: Vec::with_capacity(BATCH), lines: 0 };
     let mut last_error: Option<String> = None;
     let mut complain = |e: io::Error| {
         let e = e.to_string();
@@ -277,24 +309,28 @@ fn write_lines(
         let mut next = msg;
         while let Some(m) = next.take() {
             match m {
-                Message::Line(l) => match out.write_all(l.as_bytes()) {
-                    Ok(()) => written.inc(),
-                    Err(e) => complain(e),
-                },
+                Message::Line(l) => {
+                    batch.push(&l);
+                    if batch.bytes.len() >= BATCH {
+                        if let Err(e) = batch.write(&mut out, written, dropped) {
+                            complain(e);
+                        }
+                    }
+                }
                 Message::Close => {
-                    let _ = out.flush();
+                    let _ = batch.write(&mut out, written, dropped);
                     return;
                 }
             }
             next = rx.try_recv().ok();
         }
-        if let Err(e) = out.flush() {
+        if let Err(e) = batch.write(&mut out, written, dropped) {
             complain(e);
         }
         if reopen.swap(false, Ordering::Relaxed) {
             match target.open() {
                 Ok(f) => {
-                    out = BufWriter::with_capacity(64 << 10, f);
+                    out = f;
                     tracing::info!("access log reopened");
                 }
                 Err(e) => complain(e),
