@@ -51,10 +51,13 @@ fn analyze_detects_a_lattice_and_info_prints_it() {
     let out = dir.path().join("brick.tex");
     let (code, stdout, err) = run(&["analyze", &exemplar("brick.png"), "-o", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
-    assert!(stdout.contains("lattice: stripes every (18."), "brick's courses are found: {stdout}");
+    assert!(stdout.contains("lattice: stripes every [dy, dx] [0.00, 18."), "brick's courses are found: {stdout}");
     let (code, info, err) = run(&["info", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
-    assert!(info.contains("lattice:           stripes every (18.") && info.contains("detected"), "{info}");
+    assert!(
+        info.contains("lattice:           stripes every [dy, dx] [0.00, 18.") && info.contains("detected"),
+        "{info}"
+    );
     assert!(info.contains("structure:         lattice, 1-D: basis [dy, dx] [0.0, 18."), "{info}");
     // Turned off, and given as waves.
     let (code, stdout, err) =
@@ -64,7 +67,7 @@ fn analyze_detects_a_lattice_and_info_prints_it() {
     let (code, stdout, err) =
         run(&["analyze", &exemplar("brick.png"), "--lattice", "18.5@0", "-o", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
-    assert!(stdout.contains("stripes every (18.50, 0.00) texels, given"), "{stdout}");
+    assert!(stdout.contains("stripes every [dy, dx] [0.00, 18.50] texels, given"), "{stdout}");
     // Gravel has none; a bad spelling is a clear error that writes nothing.
     let (_, stdout, _) = run(&["analyze", &exemplar("gravel.png"), "-o", out.to_str().unwrap()]);
     assert!(stdout.contains("structure: none (stochastic)") && stdout.contains("lattice: none"), "{stdout}");

@@ -537,22 +537,22 @@ async fn uploads_report_their_structure_and_take_a_lattice_field() {
     let bond = until_ready(&s, headers.get("location").unwrap().to_str().unwrap()).await;
     let lattice = &bond["exemplar"]["lattice"];
     assert_eq!((lattice["kind"].as_str(), lattice["origin"].as_str()), (Some("grid"), Some("given")), "{lattice}");
-    // Its reduced basis is the given one, up to sign and order (as [x, y]).
+    // Its reduced basis is the given one, up to sign and order ([dy, dx], as given).
     let mut basis: Vec<[i64; 2]> = lattice["basis"]
         .as_array()
         .unwrap()
         .iter()
         .map(|v| {
-            let (x, y) = (v[0].as_f64().unwrap().round() as i64, v[1].as_f64().unwrap().round() as i64);
-            if y < 0 || (y == 0 && x < 0) {
-                [-x, -y]
+            let (dy, dx) = (v[0].as_f64().unwrap().round() as i64, v[1].as_f64().unwrap().round() as i64);
+            if dy < 0 || (dy == 0 && dx < 0) {
+                [-dy, -dx]
             } else {
-                [x, y]
+                [dy, dx]
             }
         })
         .collect();
     basis.sort();
-    assert_eq!(basis, [[-18, 16], [18, 16]], "{lattice}");
+    assert_eq!(basis, [[16, -18], [16, 18]], "{lattice}");
 }
 
 /// Issue 71, item 4: flatness is judged on the image as it was sent. A 1-px checkerboard
@@ -713,4 +713,41 @@ async fn truncated_or_lying_jpeg_and_webp_uploads_are_refused() {
     assert_eq!(status, 202, "{got}");
     let (status, _, got) = upload(&s, "?id=whole-webp", "image/webp", webp, Some(TOKEN)).await;
     assert_eq!(status, 202, "{got}");
+}
+
+#[tokio::test]
+async fn small_things_said_truly() {
+    let data = tempfile::tempdir().unwrap();
+    let s = admin_server(data.path(), &[]);
+    // The bearer scheme in any case.
+    for scheme in ["bearer", "BEARER", "Bearer"] {
+        let r = s
+            .client
+            .delete(s.url("/admin/textures/nosuch"))
+            .header("authorization", format!("{scheme} {TOKEN}"))
+            .send()
+            .await
+            .unwrap();
+        assert_eq!(r.status(), 404, "{scheme}: past the token check");
+    }
+    // Lattice values as given, and no 300-digit echo.
+    for (lattice, says) in [
+        ("-20@0", "period -20 is outside"),
+        ("1e9@1", "period 1.000e9 is outside"),
+        ("%5B%5B1e300,1e300%5D%5D", "basis vector [1.000e300, 1.000e300] is longer"),
+    ] {
+        let (status, _, body) =
+            upload(&s, &format!("?id=l&lattice={lattice}"), "image/png", brick(), Some(TOKEN)).await;
+        assert_eq!(status, 400, "{lattice}: {body}");
+        let message = body["message"].as_str().unwrap();
+        assert!(message.contains(says) && message.len() < 300, "{lattice}: {message}");
+    }
+    // The tileset's unknown-parameter answer names its anchoring parameters among the allowed.
+    let (status, body) = s.get_bytes("/3dtiles/gravel/tileset.json?bogus=1").await;
+    assert_eq!(status, 400);
+    let v: serde_json::Value = serde_json::from_slice(&body).unwrap();
+    let message = v["message"].as_str().unwrap();
+    for key in ["lon", "lat", "height"] {
+        assert!(message.contains(key), "{message}");
+    }
 }

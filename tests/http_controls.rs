@@ -75,7 +75,8 @@ async fn a_lattice_is_configured_served_and_checked() {
     let meta = s.json("/textures/corkboard").await;
     let lattice = &meta["exemplar"]["lattice"];
     assert_eq!((lattice["kind"].as_str(), lattice["origin"].as_str()), (Some("grid"), Some("given")), "{meta}");
-    assert_eq!(lattice["basis"], serde_json::json!([[0.0, 32.0], [64.0, 0.0]]), "{meta}");
+    // [dy, dx], as the configuration and `structure` give vectors.
+    assert_eq!(lattice["basis"], serde_json::json!([[32.0, 0.0], [0.0, 64.0]]), "{meta}");
     assert_eq!(meta["exemplar"]["toroidal"], true);
     assert_eq!(s.json("/textures/gravel").await["exemplar"]["lattice"], serde_json::Value::Null);
     // Tiles under the lattice are one window, and what `textile render --lattice` makes of the

@@ -33,9 +33,14 @@ pub fn dir(cfg: &Config) -> PathBuf {
 /// are hashed and the hashes compared in constant time, so the comparison's duration says
 /// nothing about the token.
 pub fn authorized(token: &str, authorization: Option<&[u8]>) -> bool {
-    let Some(given) = authorization.and_then(|a| a.strip_prefix(b"Bearer ")) else {
+    // `Bearer TOKEN`, the scheme in any case (RFC 9110: auth-schemes are case-insensitive).
+    let Some(given) = authorization.and_then(|a| {
+        let (scheme, rest) = a.split_at_checked(7)?;
+        (scheme.eq_ignore_ascii_case(b"bearer ")).then_some(rest)
+    }) else {
         return false;
     };
+    let given = given.trim_ascii_start();
     !token.is_empty() && blake3::hash(given) == blake3::hash(token.as_bytes())
 }
 
@@ -451,8 +456,10 @@ mod tests {
     #[test]
     fn the_token_must_match_exactly() {
         let t = "0123456789abcdef";
-        assert!(authorized(t, Some(b"Bearer 0123456789abcdef")));
-        for wrong in [&b"Bearer 0123456789abcdeg"[..], b"bearer 0123456789abcdef", b"0123456789abcdef", b"Bearer "] {
+        for right in [&b"Bearer 0123456789abcdef"[..], b"bearer 0123456789abcdef", b"BEARER  0123456789abcdef"] {
+            assert!(authorized(t, Some(right)), "{}", String::from_utf8_lossy(right));
+        }
+        for wrong in [&b"Bearer 0123456789abcdeg"[..], b"Bearer0123456789abcdef", b"0123456789abcdef", b"Bearer "] {
             assert!(!authorized(t, Some(wrong)));
         }
         assert!(!authorized(t, None));

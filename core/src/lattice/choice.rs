@@ -43,9 +43,28 @@ impl LatticeChoice {
         Ok(match self {
             LatticeChoice::Auto | LatticeChoice::None => None,
             LatticeChoice::Cells(nx, ny) => Some(Lattice::cells(*nx, *ny, w, h)?),
-            LatticeChoice::Waves(w) => Some(Lattice::given(w.iter().map(|&(p, a)| Wave::new(p, a)).collect(), side)?),
+            LatticeChoice::Waves(w) => {
+                // The periods as given, before a wave rounds them to its fixed point.
+                if let Some((p, _)) = w.iter().find(|(p, _)| !(2.0..=side as f64).contains(p)) {
+                    return Err(CoreError::Param {
+                        name: "lattice",
+                        message: format!("period {} is outside 2..={side} texels", number(*p)),
+                    });
+                }
+                Some(Lattice::given(w.iter().map(|&(p, a)| Wave::new(p, a)).collect(), side)?)
+            }
             LatticeChoice::Vectors(v) => Some(Lattice::given(waves_of(v, side)?, side)?),
         })
+    }
+}
+
+/// A number as an error message shows it: as given up to three decimals, in scientific
+/// notation from a million on (a hostile `1e300` does not come back as 301 digits).
+fn number(x: f64) -> String {
+    if x.abs() >= 1e6 {
+        format!("{x:.3e}")
+    } else {
+        format!("{}", (x * 1000.0).round() / 1000.0)
     }
 }
 
@@ -55,7 +74,7 @@ impl LatticeChoice {
 /// [`MIN_ANGLE`] apart) are refused, named.
 pub fn waves_of(vectors: &[[f64; 2]], side: u32) -> Result<Vec<Wave>> {
     let bad = |message: String| Err(CoreError::Param { name: "lattice", message });
-    let show = |v: &[f64; 2]| format!("[{}, {}]", v[0], v[1]);
+    let show = |v: &[f64; 2]| format!("[{}, {}]", number(v[0]), number(v[1]));
     if vectors.is_empty() || vectors.len() > 2 {
         return bad(format!("{} basis vectors: give one [dy, dx] (stripes) or two (a grid)", vectors.len()));
     }

@@ -190,13 +190,14 @@ impl Lattice {
 
     /// The lattice as `GET /textures/{id}` reports it (`exemplar.lattice`): `kind`
     /// (`stripes` or `grid`), `waves` (period in texels, angle of the normal in degrees),
-    /// `basis` (translation vectors in texels), `confidence` (0–1), `origin`.
+    /// `basis` (translation vectors in texels, each `[dy, dx]` as `structure.basis` and the
+    /// `lattice` setting give them), `confidence` (0–1), `origin`.
     pub fn summary(&self) -> serde_json::Value {
         let r = milli;
         serde_json::json!({
             "kind": if self.is_stripes() { "stripes" } else { "grid" },
             "waves": self.waves.iter().map(|w| serde_json::json!({"period": r(w.period()), "angle": r(w.angle_deg())})).collect::<Vec<_>>(),
-            "basis": self.basis().iter().map(|v| [r(v[0]), r(v[1])]).collect::<Vec<_>>(),
+            "basis": self.basis().iter().map(|v| [r(v[1]), r(v[0])]).collect::<Vec<_>>(),
             "confidence": self.confidence as f64 / 1000.0,
             "origin": self.origin,
         })
@@ -330,16 +331,21 @@ impl LevelLattice {
 }
 
 impl std::fmt::Display for Lattice {
-    /// `grid of (20.50, 0.00) × (10.25, 14.00) texels, detected, confidence 0.62`.
+    /// `grid of [dy, dx] [0.00, 20.50] × [14.00, 10.25] texels, detected, confidence 0.62`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let z = |x: f64| if x.abs() < 0.005 { 0.0 } else { x }; // no "-0.00"
-        let vecs: Vec<String> = self.basis().iter().map(|v| format!("({:.2}, {:.2})", z(v[0]), z(v[1]))).collect();
+        let vecs: Vec<String> = self.basis().iter().map(|v| format!("[{:.2}, {:.2}]", z(v[1]), z(v[0]))).collect();
         let kind = if self.is_stripes() { "stripes every" } else { "grid of" };
         let origin = match self.origin {
             Origin::Detected => "detected",
             Origin::Given => "given",
         };
-        write!(f, "{kind} {} texels, {origin}, confidence {:.2}", vecs.join(" × "), self.confidence as f64 / 1000.0)
+        write!(
+            f,
+            "{kind} [dy, dx] {} texels, {origin}, confidence {:.2}",
+            vecs.join(" × "),
+            self.confidence as f64 / 1000.0
+        )
     }
 }
 

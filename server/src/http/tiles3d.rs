@@ -99,7 +99,12 @@ pub async fn tileset_json(
     };
     // Everything else is the tiles' query: validated here, carried into the content URIs.
     let pairs = without_anchoring(raw.as_deref());
-    let (p, relief) = params_with_relief(&tex, ParamReader::request(pairs.clone())?)?;
+    let mut reader = ParamReader::request(pairs.clone())?;
+    // Taken above: named among the allowed keys when an unknown one is refused.
+    for key in ANCHORING {
+        reader.take(key);
+    }
+    let (p, relief) = params_with_relief(&tex, reader)?;
     // Sorted: one URI (and cache entry) per set of parameters, however they were ordered.
     let query = query_string(&pairs.into_iter().collect::<std::collections::BTreeMap<_, _>>());
     let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset{}|{query}|{transform:?}", crate::assets::LAYOUT)));
