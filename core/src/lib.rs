@@ -6,20 +6,25 @@
 //!
 //! The pipeline, one module per stage:
 //!
-//! 1. [`exemplar`] — decode and prepare the input (power-of-two square, toroidal flag);
-//! 2. [`analysis`] — Gaussian stack ([`stack`], also the low-pass of material maps), PCA
-//!    neighbourhoods, k-coherence candidates, computed once and stored in a file;
-//! 3. [`modes`] — the engines, one folder each behind one [`Mode`] trait:
+//! 1. [`exemplar`] — decode and prepare the input at its own size and shape (scaled only past
+//!    [`exemplar::MAX_SIDE`]), its toroidal flag, randomness mask and material maps ([`maps`],
+//!    [`mask`]);
+//! 2. [`lattice`] — its structure, found from the pixels or given: an exact repeat (a tile
+//!    repeated), a near-regular lattice (1-D or 2-D, real-valued periods), or none;
+//! 3. [`analysis`] — Gaussian stack ([`stack`], also the low-pass of material maps), PCA
+//!    neighbourhoods, k-coherence candidates, computed once and stored in a file; with what
+//!    each mode prepares per texture, it goes through one path, [`prepare`];
+//! 4. [`modes`] — the engines, one folder each behind one [`Mode`] trait:
 //!    [`modes::synth`] (Lefebvre & Hoppe's parallel controllable synthesis, the main engine),
-//!    [`modes::mosaic`] (Xu, Guo & Shum's chaos mosaic, the cheap one) and
-//!    [`modes::umbrella`] (just-in-time umbrella patches, for textures of elements); their parameters
-//!    are declared once as [`modes::params::ParamSpec`]s and read by one
-//!    [`modes::params::ParamReader`];
-//! 4. [`cache`] — the pyramidal cache that lets neighbouring windows share work;
-//! 5. [`image`] — the RGB windows the modes produce;
-//! 6. [`samples`] — per-sample queries (Wei & Levoy 2003): scattered texels and filtered
+//!    [`modes::mosaic`] (Xu, Guo & Shum's chaos mosaic, the cheap one),
+//!    [`modes::umbrella`] (just-in-time umbrella patches, for textures of elements) and
+//!    [`modes::tiling`] (the exemplar repeated, the reference); their parameters are declared
+//!    once as [`modes::params::ParamSpec`]s and read by one [`modes::params::ParamReader`];
+//! 5. [`cache`] — the pyramidal cache that lets neighbouring windows share work;
+//! 6. [`image`] — the RGB windows the modes produce;
+//! 7. [`samples`] — per-sample queries (Wei & Levoy 2003): scattered texels and filtered
 //!    footprints in any order, equal to the tiles' pixels, through the same cache;
-//! 7. [`tileable`] — one seamless, finite tileable image by Wei & Levoy's 2000 algorithm,
+//! 8. [`tileable`] — one seamless, finite tileable image by Wei & Levoy's 2000 algorithm,
 //!    its searches through the [`tsvq`] index.
 //!
 //! ```
