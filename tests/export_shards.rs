@@ -144,6 +144,16 @@ fn shards_merge_into_the_single_process_archive_and_resume_after_sigkill() {
     assert_eq!(merged(&mixed, &d.join("resumed.pmtiles")), want_pm, "resumed after SIGKILL");
     // Run once more with the same arguments: nothing to do.
     assert!(run_ok(&args).contains("already complete"));
+    // A damaged part in the way is named, with what to do (not "run it again" in a loop).
+    let whole = std::fs::read(&part).unwrap();
+    let mut damaged = whole.clone();
+    damaged[30] ^= 0x02;
+    std::fs::write(&part, &damaged).unwrap();
+    let a: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, err) = textile(&a);
+    assert_ne!(code, 0);
+    assert!(err.contains("header is damaged") && err.contains("remove it and run shard 1/3 again"), "{err}");
+    std::fs::write(&part, &whole).unwrap();
 
     // Bad merges name the problem.
     let (code, text) = merge(&[three[0].clone(), three[2].clone()], &d.join("gap.pmtiles"));

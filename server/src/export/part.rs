@@ -147,7 +147,10 @@ fn complete(path: &Path, header: &Header) -> Result<bool, String> {
                 header.rerun()
             ))
         }
-        Err(PartError::Other(e)) => return Err(e),
+        // Running the shard again would meet the same file: it must go first.
+        Err(PartError::Other(e)) => {
+            return Err(format!("{e} (the file is in the way of this shard: remove it and {})", header.rerun()))
+        }
     };
     if &existing == header {
         return Ok(true);
