@@ -74,6 +74,15 @@ fn merge(parts: &[PathBuf], out: &Path) -> (i32, String) {
     (code, stdout + &err)
 }
 
+/// Names in `dir` of partial parts, checkpoints and temporary files (hidden names).
+fn stray_files(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("partial") || n.starts_with('.'))
+        .collect()
+}
+
 fn merged(parts: &[PathBuf], out: &Path) -> Vec<u8> {
     let (code, text) = merge(parts, out);
     assert_eq!(code, 0, "{text}");
@@ -101,11 +110,7 @@ fn shards_merge_into_the_single_process_archive_and_resume_after_sigkill() {
     assert_eq!(merged(&eight, &d.join("m8.pmtiles")), want_pm, "8 shards");
     assert_eq!(merged(&eight, &d.join("m8.mbtiles")), want_mb, "8 shards, MBTiles");
     // Nothing but the parts and archives is left: no partial files, no checkpoints.
-    let stray: Vec<String> = std::fs::read_dir(d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.contains("partial") || n.starts_with('.'))
-        .collect();
+    let stray = stray_files(d);
     assert!(stray.is_empty(), "{stray:?}");
 
     // Shard 1 of 3 again, killed with SIGKILL at three moments, then run to the end.
@@ -300,11 +305,7 @@ fn merge_proves_every_record_and_keeps_its_output_safe() {
     let (code, text) = merge(&three, &directory);
     assert_ne!(code, 0);
     assert!(text.contains("is a directory"), "{text}");
-    let stray: Vec<String> = std::fs::read_dir(d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with('.') || n.contains("partial"))
-        .collect();
+    let stray = stray_files(d);
     assert!(stray.is_empty(), "no temporary file is left: {stray:?}");
 }
 

@@ -193,14 +193,16 @@ impl Writer {
             }
             return Ok(None);
         }
-        let head = header.bytes();
-        let first_line = {
-            let mut s = String::new();
-            let _ = BufReader::new(&f).take(MAGIC.len() as u64 + 1).read_line(&mut s);
-            s
+        let (head, crc) = (header.bytes(), header.line().1);
+        // What the partial file holds: this version's header (maybe this one's), version 1's
+        // (not resumable), or nothing readable.
+        let (old, partial_header) = match open_reader(&partial) {
+            Ok((h, _)) => (false, Some(h)),
+            Err(PartError::Version1) => (true, None),
+            Err(PartError::Other(_)) => (false, None),
         };
         let cp = read_checkpoint(path);
-        if first_line.trim_end() == MAGIC_V1 || cp.is_some_and(|c| c.version != VERSION) {
+        if old || cp.is_some_and(|c| c.version != VERSION) {
             return Err(format!(
                 "{}: a partial part of an older textile (version 1), which cannot be resumed: remove it and {}, then {}",
                 partial.display(),
@@ -210,11 +212,11 @@ impl Writer {
         }
         let len = f.metadata().map_err(io(&partial))?.len();
         let resume = cp.filter(|c| {
-            c.header == header.line().1
+            c.header == crc
                 && c.tiles <= header.range.1 - header.range.0
                 && c.bytes >= head.len() as u64
                 && len >= c.bytes
-                && read_header(&partial).is_ok_and(|h| &h == header)
+                && partial_header.as_ref() == Some(header)
         });
         let done = match resume {
             Some(c) => {
@@ -225,7 +227,7 @@ impl Writer {
                 // A checkpoint of anything else must not apply to what is written now.
                 let _ = std::fs::remove_file(checkpoint_path(path));
                 f.set_len(0).and_then(|()| f.rewind()).and_then(|()| f.write_all(&head)).map_err(io(&partial))?;
-                Checkpoint { version: VERSION, header: header.line().1, tiles: 0, bytes: head.len() as u64 }
+                Checkpoint { version: VERSION, header: crc, tiles: 0, bytes: head.len() as u64 }
             }
         };
         let mut file = BufWriter::with_capacity(1 << 20, f);
