@@ -58,7 +58,7 @@ fn analyze_detects_a_lattice_and_info_prints_it() {
         info.contains("lattice:           stripes every [dy, dx] [0.00, 18.") && info.contains("detected"),
         "{info}"
     );
-    assert!(info.contains("structure:         lattice, 1-D: basis [dy, dx] [0.0, 18."), "{info}");
+    assert!(info.contains("structure:         lattice, 1-D: basis [dy, dx] [0, 18."), "{info}");
     // Turned off, and given as waves.
     let (code, stdout, err) =
         run(&["analyze", &exemplar("brick.png"), "--lattice", "none", "-o", out.to_str().unwrap()]);

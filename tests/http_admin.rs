@@ -512,7 +512,7 @@ async fn uploads_report_their_structure_and_take_a_lattice_field() {
     let meta = until_ready(&s, &location).await;
     let st = &meta["structure"];
     assert_eq!(st["class"], "exact", "{st}");
-    assert_eq!(st["basis"], serde_json::json!([[0, 64], [64, 0]]), "{st}");
+    assert_eq!(st["basis"], serde_json::json!([[0.0, 64.0], [64.0, 0.0]]), "{st}");
     assert_eq!((st["tile"]["width"].as_i64(), st["tile"]["height"].as_i64()), (Some(64), Some(64)), "{st}");
     assert_eq!(st["scores"]["repeat"], 1.0, "{st}");
     assert_eq!(st["inner"]["class"], "none", "{st}");

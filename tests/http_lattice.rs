@@ -69,12 +69,19 @@ async fn near_regular_textures_keep_their_detected_lattice_and_umbrella_declines
     assert_eq!((st["class"].as_str(), st["dimensions"].as_u64()), (Some("lattice"), Some(1)), "{st}");
     let b = &st["basis"][0];
     assert!(b[0].as_f64() == Some(0.0) && b[1].as_f64().is_some_and(|dx| (17.0..19.0).contains(&dx)), "{st}");
-    let ridge = &st["scores"]["ridges"][0];
-    assert!(ridge["value"].as_f64() >= st["scores"]["thresholds"]["ridge_value"].as_f64(), "{st}");
+    // The decision's scores: the ridge kept clears both thresholds (its margin at least 1), in
+    // units of the autocorrelation's noise and as a contrast.
+    let (ridge, rule) = (&st["scores"]["ridge"], &st["scores"]["thresholds"]);
+    assert!(
+        ridge["z"].as_f64() >= rule["z"].as_f64() && ridge["contrast"].as_f64() >= rule["contrast"].as_f64(),
+        "{st}"
+    );
+    assert!(ridge["margin"].as_f64().is_some_and(|m| m >= 1.0), "{st}");
+    assert!(st["confidence"].as_f64().is_some_and(|c| c >= 0.5), "{st}");
     // The rectified corkboard is its 64 × 32 cell repeated: exact, the copies its basis.
     let st = &s.json("/textures/corkboard").await["structure"];
     assert_eq!(st["class"], "exact", "{st}");
-    assert_eq!(st["basis"], serde_json::json!([[32, 0], [0, 64]]), "{st}");
+    assert_eq!(st["basis"], serde_json::json!([[32.0, 0.0], [0.0, 64.0]]), "{st}");
     assert_eq!((st["tile"]["width"].as_i64(), st["tile"]["height"].as_i64()), (Some(64), Some(32)), "{st}");
 
     // Stochastic textures have none, and every mode serves them.

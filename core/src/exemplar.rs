@@ -89,9 +89,9 @@ pub struct Exemplar {
     /// The exact repeat of an exemplar that is a tile repeated (found with the lattice,
     /// [`Exemplar::with_lattice_choice`]): a texel's copies are never its second candidate.
     pub repeat: Option<Repeat>,
-    /// What structure detection found ([`crate::lattice::Detection::summary`]), for reports;
+    /// What structure detection found ([`crate::lattice::Structure`]), for reports;
     /// `None` when it did not run (`lattice = "none"`).
-    pub structure: Option<serde_json::Value>,
+    pub structure: Option<crate::lattice::Structure>,
     /// Its co-registered material maps ([`Exemplar::with_map`]); not part of
     /// [`Exemplar::hash_content`]: each map's tiles are keyed by the map's own hash.
     pub maps: Vec<MaterialMap>,
@@ -346,7 +346,7 @@ impl Exemplar {
         if *choice == LatticeChoice::Auto {
             self.lattice = found.lattice.clone();
         }
-        self.structure = Some(found.summary());
+        self.structure = Some(crate::lattice::Structure::of(&found));
         self.repeat = found.repeat;
         Ok(self)
     }

@@ -184,7 +184,7 @@ fn boards_at_fractional_spacings_are_one_dimensional() {
     let fill = Fill::new();
     for t in [19.3, 28.4] {
         let (d, basis) = found(&boards(&fill, t));
-        assert_eq!(d.class(), Class::Lattice, "boards every {t}: {:?}", d.ridges);
+        assert_eq!(d.class(), Class::Lattice, "boards every {t}: {:?}", (d.ridge, d.cell));
         assert!(same_lattice(&basis, &[[t, 0.0]], 0.5), "boards every {t}: found {basis:?}");
     }
 }
@@ -196,7 +196,7 @@ fn a_running_bond_is_two_dimensional_with_its_stagger() {
     for degrees in [0.0, 7.0] {
         let (d, basis) = found(&running_bond(&fill, l, h, degrees));
         let want = [turned([l, 0.0], degrees), turned([l / 2.0, h], degrees)];
-        assert_eq!(d.class(), Class::Lattice, "bond at {degrees}°: {:?}", d.ridges);
+        assert_eq!(d.class(), Class::Lattice, "bond at {degrees}°: {:?}", (d.ridge, d.cell));
         assert!(same_lattice(&basis, &want, 0.5), "bond at {degrees}°: found {basis:?}, want {want:?}");
     }
 }
@@ -205,10 +205,14 @@ fn a_running_bond_is_two_dimensional_with_its_stagger() {
 fn a_stack_bond_and_a_diagonal_tread_are_two_dimensional() {
     let fill = Fill::new();
     let (d, basis) = found(&stack_bond(&fill, 21.7, 33.1));
-    assert!(same_lattice(&basis, &[[21.7, 0.0], [0.0, 33.1]], 0.5), "stack bond: found {basis:?} ({:?})", d.ridges);
+    assert!(
+        same_lattice(&basis, &[[21.7, 0.0], [0.0, 33.1]], 0.5),
+        "stack bond: found {basis:?} ({:?})",
+        (d.ridge, d.cell)
+    );
     let p = 17.5;
     let (d, basis) = found(&tread(&fill, p));
-    assert!(same_lattice(&basis, &[[p, p], [p, -p]], 0.5), "tread: found {basis:?} ({:?})", d.ridges);
+    assert!(same_lattice(&basis, &[[p, p], [p, -p]], 0.5), "tread: found {basis:?} ({:?})", (d.ridge, d.cell));
 }
 
 #[test]
@@ -247,6 +251,6 @@ fn stochastic_exemplars_have_no_structure() {
     ] {
         let ex = load(name);
         let d = detect(&ex.pixels, ex.width, ex.height);
-        assert_eq!(d.class(), Class::None, "{name}: {:?} {:?} {:?}", d.repeat, d.lattice, d.ridges);
+        assert_eq!(d.class(), Class::None, "{name}: {:?} {:?} {:?}", d.repeat, d.lattice, (d.ridge, d.cell));
     }
 }

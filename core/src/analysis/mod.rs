@@ -30,7 +30,7 @@ use crate::stack::{build_stack, to_u8};
 
 /// Version of the analysis (its content and file layout; part of the analysis id, so a change
 /// recomputes stored analyses). Each mode's output has its own version (`Mode::VERSION`).
-pub const ALGORITHM_VERSION: u32 = 3;
+pub const ALGORITHM_VERSION: u32 = 4;
 /// First pyramid level that is corrected. LH05 leaves levels 0–2 uncorrected; we also leave
 /// level 3, whose 5×5 neighbourhood at stride `h_3 = m/8` spans over half the exemplar: there,
 /// correction grows coherent runs that can only repeat the few positions the exemplar offers
@@ -190,9 +190,9 @@ pub struct AnalysisHeader {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub repeat: Option<Repeat>,
     /// What structure detection found (class, basis, scores; see
-    /// [`crate::lattice::Detection::summary`]), for `textile info`.
+    /// [`crate::lattice::Structure`]), for `textile info`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub structure: Option<serde_json::Value>,
+    pub structure: Option<crate::lattice::Structure>,
 }
 
 /// A complete exemplar analysis.

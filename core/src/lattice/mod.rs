@@ -10,13 +10,20 @@
 //! Cells then vary while the grid holds. Lattices are found from the exemplar alone
 //! ([`detect`]) or given (`lattice = [nx, ny]` cells, or explicit periods and angles).
 
+mod acf;
+mod cell;
 mod choice;
 mod detect;
 mod exact;
+mod ridge;
+mod structure;
 
+pub use cell::Cell;
 pub use choice::{LatticeChoice, SYNTAX};
-pub use detect::{describe, detect, Class, Detection, Ridge, RIDGE_MIN_CONTRAST, RIDGE_MIN_VALUE};
+pub use detect::{cell_margin, detect, ridge_margin, Class, Detection, MIN_CONTRAST, MIN_Z};
 pub use exact::{Repeat, COPY_MIN, HALF_MAX};
+pub use ridge::Ridge;
+pub use structure::{Candidate, Scores, Structure, Thresholds, TileSize};
 
 use serde::{Deserialize, Serialize};
 

@@ -36,7 +36,7 @@ pub fn run(a: AnalyzeArgs) -> CliResult {
         }
     }
     if let Some(s) = &ex.structure {
-        println!("structure: {} ({:.0} ms)", textile_core::lattice::describe(s), 1000.0 * lattice_secs);
+        println!("structure: {} ({:.0} ms)", s, 1000.0 * lattice_secs);
     }
     match &ex.lattice {
         Some(l) => println!("lattice: {l}"),

@@ -59,7 +59,7 @@ pub fn run(a: InfoArgs) -> CliResult {
         println!("{:<18} {from}", format!("{} source:", step.what()));
     }
     match &h.structure {
-        Some(s) => println!("structure:         {}", textile_core::lattice::describe(s)),
+        Some(s) => println!("structure:         {}", s),
         None => println!("structure:         not detected (lattice = none)"),
     }
     match &h.lattice {
