@@ -38,14 +38,9 @@ pub(super) struct Autocorrelation {
 }
 
 impl Autocorrelation {
-    /// The autocorrelation of the `m × m` image `luma`.
-    pub(super) fn new(luma: &[f64], m: usize) -> Autocorrelation {
-        Self::of_channels(&[luma], m)
-    }
-
-    /// The autocorrelation of `m × m` channels together: their power spectra summed, then
-    /// normalised as one.
-    pub(super) fn of_channels(channels: &[&[f64]], m: usize) -> Autocorrelation {
+    /// The autocorrelations of the `m × m` images `images`, in order (they share the window's
+    /// own autocorrelation, which unbiases them).
+    pub(super) fn of_all<const K: usize>(images: [&[f64]; K], m: usize) -> [Autocorrelation; K] {
         let n = (2 * m).next_power_of_two();
         let hann: Vec<f64> =
             (0..m)
@@ -72,19 +67,17 @@ impl Autocorrelation {
             fft2(&mut buf, n, true);
             buf.into_iter().map(|c| c.re).collect::<Vec<f64>>()
         };
-        let mut signal = vec![0.0; n * n];
-        for luma in channels {
-            let mean = luma.iter().sum::<f64>() / luma.len().max(1) as f64;
-            let one = power(&|x, y| (luma[y * m + x] - mean) * window(x, y));
-            signal.iter_mut().zip(one).for_each(|(s, o)| *s += o);
-        }
         let weight = power(&window);
-        let mut a: Vec<f64> = signal.iter().zip(&weight).map(|(s, w)| s / w.max(1e-9)).collect();
-        let zero = a[0].max(1e-12);
-        a.iter_mut().for_each(|v| *v /= zero);
-        let mut acf = Autocorrelation { m, n, a, sigma: 1.0, r0: 1.0 };
-        (acf.sigma, acf.r0) = acf.bartlett();
-        acf
+        images.map(|luma| {
+            let mean = luma.iter().sum::<f64>() / luma.len().max(1) as f64;
+            let signal = power(&|x, y| (luma[y * m + x] - mean) * window(x, y));
+            let mut a: Vec<f64> = signal.iter().zip(&weight).map(|(s, w)| s / w.max(1e-9)).collect();
+            let zero = a[0].max(1e-12);
+            a.iter_mut().for_each(|v| *v /= zero);
+            let mut acf = Autocorrelation { m, n, a, sigma: 1.0, r0: 1.0 };
+            (acf.sigma, acf.r0) = acf.bartlett();
+            acf
+        })
     }
 
     /// `A` at the integer lag `(x, y)`.
@@ -164,35 +157,41 @@ impl Autocorrelation {
     }
 }
 
-/// The luma minus its Gaussian blur of σ = side/8 (three box passes each way, mirrored edges).
+/// The luma minus its Gaussian blur of σ = side/8 (three box passes each way, mirrored edges,
+/// running sums).
 pub(super) fn highpass(luma: &[f64], m: usize) -> Vec<f64> {
     let sigma = m as f64 / 8.0;
     let w = ((4.0 * sigma * sigma + 1.0).sqrt().round() as usize) | 1;
     let r = (w / 2) as i64;
+    let mm = m as i64;
     let mirror = |i: i64| -> usize {
-        let mm = m as i64;
-        let j = if i < 0 {
-            -i - 1
-        } else if i >= mm {
-            2 * mm - i - 1
-        } else {
-            i
-        };
-        j.clamp(0, mm - 1) as usize
+        let mut j = i;
+        // Mirrored until inside (a box wider than the image reflects more than once).
+        while j < 0 || j >= mm {
+            j = if j < 0 { -j - 1 } else { 2 * mm - j - 1 };
+        }
+        j as usize
+    };
+    // One box pass along a line read through `get`, written through `put`.
+    let pass = |line: &mut dyn FnMut(usize) -> f64, out: &mut [f64]| {
+        let mut sum: f64 = (-r..=r).map(|d| line(mirror(d))).sum();
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = sum / w as f64;
+            let i = i as i64;
+            sum += line(mirror(i + r + 1)) - line(mirror(i - r));
+        }
     };
     let mut b = luma.to_vec();
-    let mut rows = vec![0.0; m * m];
+    let mut out = vec![0.0; m];
     for _ in 0..3 {
         for y in 0..m {
-            for x in 0..m {
-                let s: f64 = (-r..=r).map(|d| b[y * m + mirror(x as i64 + d)]).sum();
-                rows[y * m + x] = s / w as f64;
-            }
+            pass(&mut |x| b[y * m + x], &mut out);
+            b[y * m..(y + 1) * m].copy_from_slice(&out);
         }
-        for y in 0..m {
-            for x in 0..m {
-                let s: f64 = (-r..=r).map(|d| rows[mirror(y as i64 + d) * m + x]).sum();
-                b[y * m + x] = s / w as f64;
+        for x in 0..m {
+            pass(&mut |y| b[y * m + x], &mut out);
+            for (y, v) in out.iter().enumerate() {
+                b[y * m + x] = *v;
             }
         }
     }

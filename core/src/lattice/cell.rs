@@ -14,6 +14,8 @@
 //! - a cell twice too big has the true lattice's points among its cosets, and fails;
 //! - a cell too small has its own points at the true lattice's half-way points, and fails.
 
+use rayon::prelude::*;
+
 use super::acf::{parabola_peak, Autocorrelation};
 use super::ridge::MIN_PERIOD;
 use super::MIN_ANGLE;
@@ -43,7 +45,8 @@ impl Autocorrelation {
         0.45 * self.m as f64
     }
 
-    /// Every cell the peaks propose, scored.
+    /// Every cell the peaks propose, roughly scored (each point read where the basis puts it,
+    /// not at the peak near it): [`Autocorrelation::cell_at`] scores the best of them.
     pub(super) fn cells(&self) -> Vec<Cell> {
         let reach = self.reach() as i64;
         let mut peaks: Vec<(f64, i64, i64)> = Vec::new();
@@ -75,7 +78,6 @@ impl Autocorrelation {
             }
         }
         let mut seen: Vec<([f64; 2], [f64; 2])> = Vec::new();
-        let mut out = Vec::new();
         for i in 0..proposed.len() {
             for j in i + 1..proposed.len() {
                 let (p, q) = (proposed[i], proposed[j]);
@@ -88,12 +90,9 @@ impl Autocorrelation {
                     continue;
                 }
                 seen.push((t1, t2));
-                if let Some(c) = self.cell_at(t1, t2) {
-                    out.push(c);
-                }
             }
         }
-        out
+        seen.par_iter().filter_map(|&(t1, t2)| self.score(t1, t2, false)).collect()
     }
 
     /// The lattice points of `t1, t2` in the upper half plane within reach whose cosets can be
@@ -130,6 +129,12 @@ impl Autocorrelation {
     /// `None` with fewer than two such points, or a basis vector longer than a quarter of the
     /// side (a repeat seen fewer than four times).
     pub(super) fn cell_at(&self, t1: [f64; 2], t2: [f64; 2]) -> Option<Cell> {
+        self.score(t1, t2, true)
+    }
+
+    /// [`Autocorrelation::cell_at`], reading each point at the highest `A` near it (`near`) or
+    /// where the basis puts it.
+    fn score(&self, t1: [f64; 2], t2: [f64; 2], near: bool) -> Option<Cell> {
         let longest = t1[0].hypot(t1[1]).max(t2[0].hypot(t2[1]));
         if longest > 0.25 * self.m as f64 + 0.5 {
             return None;
@@ -140,7 +145,13 @@ impl Autocorrelation {
         if points.len() < 2 {
             return None;
         }
-        let read = |p: [f64; 2]| self.near(p, (0.04 * p[0].hypot(p[1])).max(1.0));
+        let read = |p: [f64; 2]| {
+            if near {
+                self.near(p, (0.04 * p[0].hypot(p[1])).max(1.0))
+            } else {
+                self.at(p[0], p[1])
+            }
+        };
         let on: Vec<f64> = points.iter().map(|p| read(*p)).collect();
         let contrast = cosets(t1, t2)
             .iter()

@@ -24,6 +24,8 @@
 //! Deterministic on every machine: scalar (no SIMD) FFTs in `f64` and results rounded to the
 //! fixed point of [`Wave`].
 
+use rayon::prelude::*;
+
 use super::acf::{halve, highpass, Autocorrelation};
 use super::cell::Cell;
 use super::exact::{self, Repeat};
@@ -39,6 +41,9 @@ pub const MIN_CONTRAST: f64 = 0.075;
 /// Longest period of a lattice inside a tile repeated, as a share of the tile's period along
 /// it: twice the period must stay clear of the copy, which matches itself exactly.
 const INSIDE_SHARE: f64 = 0.45;
+
+/// Cells scored in full, of the best roughly scored.
+const RESCORED: usize = 24;
 
 /// Share of the best cell's margin a smaller cell needs to be taken instead.
 const SMALLEST_SHARE: f64 = 0.5;
@@ -115,10 +120,9 @@ fn detect_square(pixels: &[[u8; 3]], side: u32) -> Detection {
         m /= 2;
         scale *= 2.0;
     }
-    let raw = Autocorrelation::new(&luma, m);
+    let [raw, a] = Autocorrelation::of_all([&luma, &highpass(&luma, m)], m);
     let lags = exact::Lags { m: raw.m, n: raw.n, a: &raw.a };
     let repeat = exact::find(pixels, side as usize, &lags, scale as usize);
-    let a = Autocorrelation::new(&highpass(&luma, m), m);
     // A tiling's own period is no lattice: inside one tile, a wave must repeat more than twice.
     let inside = |period: f64, angle: f64| {
         repeat.as_ref().is_none_or(|rep| {
@@ -160,7 +164,7 @@ fn detect_square(pixels: &[[u8; 3]], side: u32) -> Detection {
 }
 
 /// The best ridge and cell of one view, each made its fundamental and refined if it passes.
-fn best_of(a: &Autocorrelation, inside: &dyn Fn(f64, f64) -> bool) -> (Option<Ridge>, Option<Cell>) {
+fn best_of(a: &Autocorrelation, inside: &(dyn Fn(f64, f64) -> bool + Sync)) -> (Option<Ridge>, Option<Cell>) {
     let ridge = a
         .ridges()
         .into_iter()
@@ -175,7 +179,10 @@ fn best_of(a: &Autocorrelation, inside: &dyn Fn(f64, f64) -> bool) -> (Option<Ri
             }
         });
     let cell_inside = |c: &Cell| waves_of_cell(c, 1.0).iter().all(|w| inside(w.period(), w.angle_deg()));
-    let cells: Vec<Cell> = a.cells().into_iter().filter(cell_inside).collect();
+    let mut rough = a.cells();
+    rough.sort_by(|x, y| cell_margin(y).total_cmp(&cell_margin(x)));
+    rough.truncate(RESCORED);
+    let cells: Vec<Cell> = rough.par_iter().filter_map(|c| a.cell_at(c.t1, c.t2)).filter(cell_inside).collect();
     let best = cells.iter().map(cell_margin).fold(f64::MIN, f64::max);
     // Of the cells nearly as good as the best, the smallest: an odd multiple of a cell (three
     // tread lugs across) passes the coset test too.

@@ -7,6 +7,8 @@
 //! `k = 1`, a double one at the half-way points. Its *score* `z` is that contrast in noise
 //! units: a line mean over `L` lags of which about `L / (2·r0)` are independent, three of them.
 
+use rayon::prelude::*;
+
 use super::acf::{parabola_peak, Autocorrelation};
 
 /// Shortest period detected, in texels: finer repeats are texture, not lattice.
@@ -74,19 +76,26 @@ impl Autocorrelation {
     /// [`MIN_PERIOD`] to [`Autocorrelation::longest_period`], scored.
     pub(super) fn ridges(&self) -> Vec<Ridge> {
         let steps = (self.longest_period() / 0.5).floor() as usize + 1;
-        let mut out = Vec::new();
-        for deg in 0..180 {
-            let angle = deg as f64;
-            let profile: Vec<f64> = (0..=steps).map(|i| self.ridge(angle, i as f64 * 0.5)).collect();
-            for i in 1..steps {
-                let t = i as f64 * 0.5;
-                if t < MIN_PERIOD || profile[i] < profile[i - 1] || profile[i] < profile[i + 1] {
-                    continue;
-                }
-                out.push(self.ridge_at(angle, t));
-            }
-        }
-        out
+        let per_angle: Vec<Vec<Ridge>> = (0..180)
+            .into_par_iter()
+            .map(|deg| {
+                let angle = deg as f64;
+                let profile: Vec<f64> = (0..=steps).map(|i| self.ridge(angle, i as f64 * 0.5)).collect();
+                // Peaks of the profile above its value half a period before: only those can
+                // have a comb (scored on long lines, the costly part).
+                (1..steps)
+                    .filter(|&i| {
+                        let t = i as f64 * 0.5;
+                        t >= MIN_PERIOD
+                            && profile[i] >= profile[i - 1]
+                            && profile[i] >= profile[i + 1]
+                            && profile[i] > self.ridge(angle, t / 2.0)
+                    })
+                    .map(|i| self.ridge_at(angle, i as f64 * 0.5))
+                    .collect()
+            })
+            .collect();
+        per_angle.into_iter().flatten().collect()
     }
 
     /// `r`, or the shortest of its sub-multiples `t/k` that `passes` and has nearly its
