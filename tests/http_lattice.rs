@@ -182,3 +182,62 @@ async fn lattice_none_is_the_earlier_bytes_and_near_regular_tiles_are_determinis
         assert!(&two.get_bytes(p).await == want, "{p} differs between processes and worker counts");
     }
 }
+
+/// Structure found on materials the detector was not fitted to (issue 80): two real game
+/// textures of the lattices set, embedded for tests (`config/exemplars/test/LICENSE.md`), are
+/// reported by `GET /textures/{id}` with the class, basis and confidence a person sees — the
+/// rusty metal plates a 64 × 64 grid, the red brick wall a running bond (2-D: courses 42.7
+/// apart, each shifted by about half a brick) — with the scores that decided them.
+#[tokio::test]
+async fn real_materials_report_the_lattice_a_person_sees() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("textile.toml");
+    let test_exemplar = |name: &str| format!("{}/../config/exemplars/test/{name}.png", env!("CARGO_MANIFEST_DIR"));
+    let text: String = ["metal_tiles", "brick_red"]
+        .iter()
+        .map(|id| format!("[[textures]]\nid = \"{id}\"\nexemplar = \"{}\"\n\n", test_exemplar(id)))
+        .collect();
+    std::fs::write(&cfg, text).unwrap();
+    let s = Server::builder().args(&["--config", cfg.to_str().unwrap()]).start();
+    let basis = |st: &serde_json::Value| -> Vec<[f64; 2]> {
+        st["basis"].as_array().unwrap().iter().map(|v| [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()]).collect()
+    };
+    // The distance between the lattice's rows along `[dy, dx]` direction `along`: the cell's
+    // area over the length of the lattice vector that runs along them.
+    let row_spacing = |b: &[[f64; 2]], along: [f64; 2]| {
+        let area = (b[0][0] * b[1][1] - b[0][1] * b[1][0]).abs();
+        let candidates = [b[0], b[1], [b[0][0] + b[1][0], b[0][1] + b[1][1]], [b[0][0] - b[1][0], b[0][1] - b[1][1]]];
+        let run = candidates
+            .iter()
+            .filter(|v| (v[0] * along[1] - v[1] * along[0]).abs() < 0.1 * v[0].hypot(v[1]))
+            .map(|v| v[0].hypot(v[1]))
+            .fold(f64::INFINITY, f64::min);
+        area / run
+    };
+
+    let metal = s.json("/textures/metal_tiles").await;
+    let st = &metal["structure"];
+    assert_eq!((st["class"].as_str(), st["dimensions"].as_u64()), (Some("lattice"), Some(2)), "{st}");
+    let mut lengths: Vec<f64> = basis(st).iter().map(|v| v[0].hypot(v[1])).collect();
+    lengths.sort_by(f64::total_cmp);
+    assert!(lengths.iter().all(|l| (l - 64.0).abs() < 0.64), "plates 64 × 64: {st}");
+    assert!(basis(st).iter().all(|v| v[0].abs().min(v[1].abs()) < 1.0), "axis-aligned: {st}");
+    assert!(st["confidence"].as_f64().is_some_and(|c| c > 0.5), "{st}");
+    assert!(st["scores"]["cell"]["margin"].as_f64().is_some_and(|m| m >= 1.0), "{st}");
+    assert_eq!(metal["exemplar"]["lattice"]["kind"], "grid", "the modes keep it: {metal}");
+
+    let brick = s.json("/textures/brick_red").await;
+    let st = &brick["structure"];
+    assert_eq!((st["class"].as_str(), st["dimensions"].as_u64()), (Some("lattice"), Some(2)), "a bond is 2-D: {st}");
+    let b = basis(st);
+    let courses = row_spacing(&b, [0.0, 1.0]);
+    assert!((courses - 42.7).abs() <= 0.04 * 42.7, "courses 42.7 apart (within 4 %), found {courses:.2}: {st}");
+    // The stagger: a basis vector goes up one course and about half a brick (≈ 42) along.
+    assert!(
+        b.iter().any(|v| (v[0].abs() - courses).abs() < 2.0 && (v[1].abs() - 42.5).abs() < 5.0),
+        "a half-brick stagger: {st}"
+    );
+    assert!(st["confidence"].as_f64().is_some_and(|c| c >= 0.5), "{st}");
+    let ridge = &st["scores"]["ridge"];
+    assert!(ridge["margin"].as_f64().is_some_and(|m| m >= 1.0), "its courses alone pass too: {st}");
+}

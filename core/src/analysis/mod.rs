@@ -318,6 +318,12 @@ impl Analysis {
         }
     }
 
+    /// The lattice its candidate sets keep (the prepared exemplar's when it was analysed):
+    /// synthesis holds it; other readers go through [`crate::modes::Source::lattice`].
+    pub fn lattice(&self) -> Option<&Lattice> {
+        self.header.lattice.as_ref()
+    }
+
     /// Exemplar width.
     pub fn width(&self) -> u32 {
         self.header.width

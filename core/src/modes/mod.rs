@@ -127,6 +127,16 @@ impl<'a> Source<'a> {
         self.exemplar.dims()
     }
 
+    /// The lattice the modes keep: the analysis's when there is one (its candidate sets were
+    /// built for it, [`Analysis::lattice`]), else the prepared exemplar's. Every mode reads it
+    /// here.
+    pub fn lattice(&self) -> Option<&'a crate::lattice::Lattice> {
+        match self.analysis {
+            Some(an) => an.lattice(),
+            None => self.exemplar.lattice.as_ref(),
+        }
+    }
+
     /// The exemplar's longer side (what parameters bounded by the exemplar's size compare with).
     pub fn longer_side(&self) -> u32 {
         self.exemplar.width.max(self.exemplar.height)

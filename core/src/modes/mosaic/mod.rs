@@ -70,7 +70,7 @@ pub fn render_texels(src: &Source, cache: &Pyramid, p: &MosaicParams, zoom_out: 
     let ex = src.exemplar;
     p.validate(ex.width, ex.height)?;
     check_window(rect, MAX_PIXELS)?;
-    let layout = Layout::new((ex.width as i64, ex.height as i64), p, ex.lattice.as_ref());
+    let layout = Layout::new((ex.width as i64, ex.height as i64), p, src.lattice());
     if zoom_out == 0 {
         return Ok(native(ex, src.texels(), &layout, rect));
     }

@@ -337,9 +337,7 @@ impl<'a> Ctx<'a> {
             jitter_head: head(key(TAG_JITTER, self.seed), l as i64),
             lattice: self
                 .an
-                .header
-                .lattice
-                .as_ref()
+                .lattice()
                 .map_or(LevelLattice::FREE, |lat| lat.level(h, self.dims.0.max(self.dims.1) as u32)),
         }
     }

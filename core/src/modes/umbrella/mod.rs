@@ -87,7 +87,7 @@ impl Mode for Umbrella {
     /// A near-regular exemplar: umbrellas scatter elements freely, which breaks the lattice
     /// into a collage, so the mode says so rather than rendering one.
     fn declines(src: &Source) -> Option<String> {
-        src.exemplar.lattice.as_ref().map(|l| {
+        src.lattice().map(|l| {
             format!("it is near-regular ({l}), and umbrella patches scatter elements off any lattice; synth and mosaic keep it")
         })
     }
