@@ -133,21 +133,6 @@ fn detect_square(pixels: &[[u8; 3]], side: u32) -> Detection {
     let (ridge, cell) = best_of(&a, &inside);
     if std::env::var_os("TEXTILE_LATTICE_DEBUG").is_some() {
         eprintln!("  sigma {:.4} r0 {}", a.sigma, a.r0);
-        if let Ok(probe) = std::env::var("TEXTILE_LATTICE_PROBE") {
-            for q in probe.split(';') {
-                let v: Vec<f64> = q.split(',').filter_map(|x| x.parse().ok()).collect();
-                if let [angle, t] = v[..] {
-                    let r = a.ridge_at(angle, t);
-                    eprintln!(
-                        "  probe {angle}/{t}: v {:.3} c {:.3} z {:.1} m {:.2}",
-                        r.value,
-                        r.contrast,
-                        r.z,
-                        ridge_margin(&r)
-                    );
-                }
-            }
-        }
     }
     let scaled_ridge = ridge.map(|r| Ridge { period: r.period * scale, ..r });
     let scaled_cell =
