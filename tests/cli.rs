@@ -380,3 +380,67 @@ async fn settings_are_declared_once_and_shown_everywhere() {
         assert!(field("id")["description"].as_str().is_some_and(|d| d.contains("required")), "{path}");
     }
 }
+
+/// One recipe, one result (issue 81): `textile analyze IMG` and `textile render --exemplar IMG`
+/// make the exemplar as serving IMG as a configured texture with the same settings does — the
+/// same analysis id, and a tile of the same bytes — for a plain exemplar, a non-square one, and
+/// one with a lattice (brick's courses, detected) and a randomness mask.
+#[tokio::test]
+async fn analyze_and_render_make_the_exemplar_serve_makes() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    // A non-square crop of gravel, and a mask keeping the left half of brick.
+    let gravel = image::open(exemplar("gravel.png")).unwrap().to_rgb8();
+    image::imageops::crop_imm(&gravel, 0, 16, 128, 96).to_image().save(p("wide.png")).unwrap();
+    image::GrayImage::from_fn(128, 128, |x, _| image::Luma([if x < 64 { 0 } else { 255 }])).save(p("mask.png")).unwrap();
+    let cases: [(&str, String, Option<String>); 3] = [
+        ("plain", exemplar("grass.png"), None),
+        ("wide", p("wide.png"), None),
+        ("masked", exemplar("brick.png"), Some(p("mask.png"))),
+    ];
+    let config: String = cases
+        .iter()
+        .map(|(id, image, mask)| {
+            let mask = mask.as_ref().map(|m| format!("randomness_mask = \"{m}\"\n")).unwrap_or_default();
+            format!("[[textures]]\nid = \"{id}\"\nexemplar = \"{image}\"\n{mask}\n")
+        })
+        .collect();
+    std::fs::write(p("textile.toml"), config).unwrap();
+    let s = Server::builder().args(&["--config", &p("textile.toml")]).start();
+    for (id, image, mask) in &cases {
+        let with_mask = |mut args: Vec<String>| {
+            if let Some(m) = mask {
+                args.extend(["--randomness-mask".to_string(), m.clone()]);
+            }
+            args
+        };
+        let out = p(&format!("{id}.tex"));
+        let args = with_mask(vec!["analyze".into(), image.clone(), "-o".into(), out]);
+        let (code, stdout, err) = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert_eq!(code, 0, "{id}: {err}");
+        let analysed = stdout.rsplit("(id ").next().and_then(|t| t.split(')').next()).unwrap_or_default().to_string();
+        let meta = s.json(&format!("/textures/{id}")).await;
+        assert_eq!(meta["analysis"]["id"].as_str(), Some(analysed.as_str()), "{id}: the served analysis: {meta}");
+        assert_eq!(meta["exemplar"]["randomness_mask"], mask.is_some(), "{id}");
+
+        let tile = p(&format!("{id}.png"));
+        let args = with_mask(vec![
+            "render".into(),
+            "--exemplar".into(),
+            image.clone(),
+            "--z".into(),
+            "7".into(),
+            "--x".into(),
+            "1".into(),
+            "--y".into(),
+            "-1".into(),
+            "-o".into(),
+            tile.clone(),
+        ]);
+        let (code, _, err) = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        assert_eq!(code, 0, "{id}: {err}");
+        let (status, served) = s.get_bytes(&format!("/tiles/{id}/7/1/-1.png")).await;
+        assert_eq!(status, 200, "{id}");
+        assert!(std::fs::read(&tile).unwrap() == served, "{id}: textile render --exemplar draws the served tile");
+    }
+}

@@ -2,21 +2,18 @@
 //! prepares beside it (`FILE.<extension>`).
 
 use textile_core::prepare::{Input, Origin};
-use textile_core::{Analysis, Cancel, ExemplarOptions};
+use textile_core::{Analysis, Cancel};
 
 use super::args::{AnalyzeArgs, CliResult};
-use super::{read_exemplar, toroidal_flag, Bar};
+use super::Bar;
 use std::sync::Mutex;
 
 /// `textile analyze EXEMPLAR -o FILE`.
 pub fn run(a: AnalyzeArgs) -> CliResult {
-    let toroidal = if a.lattice.needs_toroidal() { Some(true) } else { toroidal_flag(&a.toroidal) };
-    let ex = read_exemplar(&a.exemplar, &ExemplarOptions { max_input_side: a.max_side, toroidal })?;
-    ex.check_not_flat().map_err(|e| format!("{}: {e}", a.exemplar.display()))?;
     let t = std::time::Instant::now();
-    let ex = ex.with_lattice_choice(&a.lattice)?;
-    let lattice_secs = t.elapsed().as_secs_f64();
-    let an = Analysis::try_build_with(&ex, a.index, &Bar(Mutex::new(None), "analysing"), &Cancel::new())?;
+    let ex = a.recipe.make(&a.exemplar)?;
+    let prepared_secs = t.elapsed().as_secs_f64();
+    let an = Analysis::try_build_with(&ex, a.recipe.index, &Bar(Mutex::new(None), "analysing"), &Cancel::new())?;
     an.save(&a.output)?;
     // What each mode prepares, beside it (`FILE.<extension>`), for `textile info` and for a
     // server whose data directory holds them all.
@@ -36,7 +33,7 @@ pub fn run(a: AnalyzeArgs) -> CliResult {
         }
     }
     if let Some(s) = &ex.structure {
-        println!("structure: {} ({:.0} ms)", s, 1000.0 * lattice_secs);
+        println!("structure: {} (exemplar prepared in {:.0} ms)", s, 1000.0 * prepared_secs);
     }
     match &ex.lattice {
         Some(l) => println!("lattice: {l}"),

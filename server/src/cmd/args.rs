@@ -6,10 +6,11 @@ use std::path::PathBuf;
 use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
 use textile_core::analysis::IndexChoice;
+use textile_core::exemplar::Toroidal;
 use textile_core::lattice::LatticeChoice;
 
 pub use super::flags::SettingFlags;
-use crate::config::Overrides;
+use crate::config::{settings, Overrides};
 
 /// Any error ending a command, as text for the user.
 pub type CliResult = Result<(), Box<dyn std::error::Error>>;
@@ -96,21 +97,32 @@ pub struct AnalyzeArgs {
     /// Output analysis file.
     #[arg(short, long, value_name = "FILE")]
     pub output: PathBuf,
-    /// Toroidal (wrap-around) exemplar: auto, true or false.
-    #[arg(long, default_value = "auto", value_parser = ["auto", "true", "false"])]
-    pub toroidal: String,
-    /// Candidate search: exact (k-d tree, every texel), coherent (approximate, on a grid at the
-    /// coarse levels; several times faster on large exemplars) or auto (coherent from 256² up).
-    #[arg(long, default_value = "auto", value_parser = index_choice)]
+    /// How the exemplar is made and analysed.
+    #[command(flatten)]
+    pub recipe: ExemplarArgs,
+}
+
+/// The settings of a texture's exemplar as flags (`textile analyze`, `textile render
+/// --exemplar`), each with the help its texture setting declares (`config::settings`): the
+/// same image and settings make the same exemplar and analysis as a configured texture.
+#[derive(Debug, Args)]
+pub struct ExemplarArgs {
+    #[arg(long, default_value = "auto", value_parser = toroidal_choice, requires = "exemplar", help = settings::TOROIDAL.help)]
+    pub toroidal: Toroidal,
+    #[arg(long, default_value = "auto", value_parser = index_choice, requires = "exemplar", help = settings::INDEX.help)]
     pub index: IndexChoice,
-    /// Largest accepted exemplar side.
-    #[arg(long, default_value_t = 1024)]
-    pub max_side: u32,
-    /// The lattice of a near-regular exemplar: auto (detected), none, NX,NY cells of a
-    /// rectified exemplar (counts dividing its width and height; implies toroidal), or
-    /// PERIOD@ANGLE[,PERIOD@ANGLE] waves (texels, degrees of the normal).
-    #[arg(long, value_name = "LATTICE", default_value = "auto", value_parser = lattice_choice)]
+    #[arg(long, value_name = "LATTICE", default_value = "auto", value_parser = lattice_choice, requires = "exemplar", help = settings::LATTICE.help)]
     pub lattice: LatticeChoice,
+    /// The image is a high-resolution source, halved into the exemplar (as `exemplar_hires`).
+    #[arg(long, requires = "exemplar")]
+    pub hires: bool,
+    /// The exemplar's randomness mask (as `randomness_mask`): an image of its size, white where
+    /// synthesis may move content, black where it keeps it.
+    #[arg(long, value_name = "IMAGE", requires = "exemplar")]
+    pub randomness_mask: Option<PathBuf>,
+    /// Largest accepted exemplar side (as `max_exemplar_side`).
+    #[arg(long, default_value_t = 1024, requires = "exemplar")]
+    pub max_side: u32,
 }
 
 /// `textile tileable`.
@@ -153,14 +165,9 @@ pub struct RenderArgs {
     /// An exemplar image, analysed on the fly.
     #[arg(long, value_name = "IMAGE")]
     pub exemplar: Option<PathBuf>,
-    /// Candidate search of the on-the-fly analysis (with --exemplar): auto, exact or coherent.
-    #[arg(long, default_value = "auto", value_parser = index_choice, requires = "exemplar")]
-    pub index: IndexChoice,
-    /// The lattice of a near-regular exemplar (with --exemplar): auto (detected), none, NX,NY
-    /// cells of a rectified exemplar (counts dividing its width and height; implies toroidal), or
-    /// PERIOD@ANGLE[,PERIOD@ANGLE] waves (texels, degrees of the normal); the output keeps it.
-    #[arg(long, value_name = "LATTICE", default_value = "auto", value_parser = lattice_choice, requires = "exemplar")]
-    pub lattice: LatticeChoice,
+    /// How the exemplar given with --exemplar is made and analysed.
+    #[command(flatten)]
+    pub recipe: ExemplarArgs,
     /// Zoom (default: the texture's native zoom).
     #[arg(long)]
     pub z: Option<u32>,
@@ -385,6 +392,11 @@ pub struct LoadtestArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--toroidal`: see [`Toroidal`].
+fn toroidal_choice(s: &str) -> Result<Toroidal, String> {
+    s.parse()
 }
 
 /// `--lattice`: see [`LatticeChoice`]'s command-line spelling.

@@ -10,10 +10,10 @@ use textile_core::files::write_atomic;
 use textile_core::maps::MapChoice;
 use textile_core::modes::params::{Scope, COMMON};
 use textile_core::samples::{self, camera::GroundCamera, Footprint};
-use textile_core::{Analysis, Cancel, ExemplarOptions, ModeParams, ParamReader, Pyramid};
+use textile_core::{Analysis, Cancel, ModeParams, ParamReader, Pyramid};
 
 use super::args::{CliResult, RenderArgs};
-use super::{configured_texture, output_format, param_pairs, read_exemplar};
+use super::{configured_texture, output_format, param_pairs};
 use crate::config::TextureConfig;
 use crate::encode::{encode, Effort, Format};
 use crate::model::Model;
@@ -80,10 +80,8 @@ pub fn run(a: RenderArgs) -> CliResult {
     }
     let output = a.output.clone().ok_or("--output is required")?;
     let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
-        let toroidal = a.lattice.needs_toroidal().then_some(true);
-        let mut ex = read_exemplar(path, &ExemplarOptions { toroidal, ..ExemplarOptions::default() })?;
-        ex = ex.with_lattice_choice(&a.lattice)?;
-        let an = Analysis::try_build_with(&ex, a.index, &textile_core::NoProgress, &Cancel::new())?;
+        let ex = a.recipe.make(path)?;
+        let an = Analysis::try_build_with(&ex, a.recipe.index, &textile_core::NoProgress, &Cancel::new())?;
         Arc::new(Texture::new(TextureConfig::new("exemplar", &path.display().to_string()), 0, ex, an)?)
     } else {
         configured_texture(&a.config, a.texture.as_deref().unwrap_or_default())?

@@ -11,31 +11,7 @@ use textile_core::lattice::LatticeChoice;
 use textile_core::maps::NormalConvention;
 use textile_core::MODE_NAMES;
 
-/// Tri-state toroidal setting of a texture.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Toroidal {
-    /// Detect from the wrap-around seam.
-    Auto,
-    /// The exemplar wraps seamlessly.
-    True,
-    /// The exemplar does not wrap.
-    False,
-    /// The exemplar does not wrap: replace it by a seamless texture of the same size
-    /// synthesized from it (Wei & Levoy 2000, as `textile tileable`), which wraps.
-    Synthesize,
-}
-
-impl Toroidal {
-    /// As the core's option.
-    pub fn as_option(self) -> Option<bool> {
-        match self {
-            Toroidal::Auto => None,
-            Toroidal::True => Some(true),
-            Toroidal::False | Toroidal::Synthesize => Some(false),
-        }
-    }
-}
+pub use textile_core::exemplar::Toroidal;
 
 /// One served texture.
 ///
@@ -97,6 +73,18 @@ pub struct TextureConfig {
 }
 
 impl TextureConfig {
+    /// How its exemplar is made ([`textile_core::exemplar::Recipe`]), images up to
+    /// `max_input_side` pixels a side.
+    pub fn recipe(&self, max_input_side: u32) -> textile_core::exemplar::Recipe {
+        textile_core::exemplar::Recipe {
+            max_input_side,
+            toroidal: self.toroidal,
+            hires: self.exemplar_hires.is_some(),
+            lattice: self.lattice.clone(),
+            normal_convention: self.normal_convention(),
+        }
+    }
+
     /// The image file the texture is made from: `exemplar_hires` when given, else `exemplar`.
     pub fn image(&self) -> &str {
         self.exemplar_hires.as_deref().unwrap_or(&self.exemplar)
@@ -139,11 +127,9 @@ impl TextureConfig {
                     "\"synthesize\" remakes the exemplar, which randomness_mask could no longer follow".into(),
                 )
             }
-            _ if self.lattice.needs_toroidal() && !matches!(self.toroidal, Toroidal::Auto | Toroidal::True) => {
-                return bad(
-                    format!("{at}.toroidal"),
-                    "a lattice tiles the exemplar, which therefore wraps around: use auto or true".into(),
-                )
+            _ if self.toroidal.with_lattice(&self.lattice).is_err() => {
+                let message = self.toroidal.with_lattice(&self.lattice).err().unwrap_or_default();
+                return bad(format!("{at}.toroidal"), message.into());
             }
             (true, Some(_)) if self.toroidal == Toroidal::Synthesize => {
                 return bad(

@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use textile_core::{Exemplar, ExemplarOptions};
+use textile_core::exemplar::Images;
 
 use super::storage::{exemplar_bytes, image_bytes};
 use super::{LoadError, Texture};
@@ -62,63 +62,21 @@ pub fn prepare_texture(
     given: &[(String, Vec<u8>)],
     log: &dyn Fn(String),
 ) -> Result<Texture, LoadError> {
-    // A lattice tiles the exemplar, which therefore wraps around.
-    let toroidal = if t.lattice.needs_toroidal() { Some(true) } else { t.toroidal.as_option() };
-    let opts = ExemplarOptions { max_input_side: cfg.max_exemplar_side, toroidal };
-    let core = |source| LoadError::Core { id: t.id.clone(), source };
-    let mut ex = Exemplar::from_bytes(bytes, &opts).map_err(core)?;
-    ex.check_not_flat().map_err(core)?;
-    // The mask is prepared like the exemplar's image, so that they stay aligned.
-    let mask = match &t.randomness_mask {
-        Some(path) => Some(Exemplar::from_bytes(&image_bytes(cfg, t, path)?, &opts).map_err(core)?),
-        None => None,
-    };
-    if t.exemplar_hires.is_some() {
-        ex = Exemplar::from_hires(ex).map_err(core)?;
-        let (w, h) = (ex.width, ex.height);
-        log(format!("texture '{}': exemplar {w}x{h} reduced from its {}x{} exemplar_hires", t.id, 2 * w, 2 * h));
-    }
-    if t.toroidal == crate::config::Toroidal::Synthesize {
-        let started = std::time::Instant::now();
-        ex = textile_core::tileable::make_toroidal(&ex, 0).map_err(core)?;
-        log(format!(
-            "texture '{}': exemplar made toroidal by synthesis (toroidal = \"synthesize\") in {:.2}s",
-            t.id,
-            started.elapsed().as_secs_f64()
-        ));
-    }
-    ex = ex.with_lattice_choice(&t.lattice).map_err(core)?;
-    if let Some(mask) = &mask {
-        ex = ex.with_randomness_mask(mask).map_err(core)?;
-    }
-    // Each map is prepared like the exemplar's image, so that they stay co-registered.
+    let mask = t.randomness_mask.as_deref().map(|path| image_bytes(cfg, t, path)).transpose()?;
+    let mut maps: Vec<(&str, &str, Vec<u8>)> = Vec::new();
     for (name, image) in t.map_images() {
-        let read;
         let bytes = match given.iter().find(|(n, _)| n == name) {
-            Some((_, b)) => b,
-            None => {
-                read = image_bytes(cfg, t, image)?;
-                &read
-            }
+            Some((_, b)) => b.clone(),
+            None => image_bytes(cfg, t, image)?,
         };
-        let map = Exemplar::from_bytes(bytes, &opts).map_err(|e| LoadError::Core {
-            id: t.id.clone(),
-            source: textile_core::CoreError::Map { name: name.into(), message: format!("({image}): {e}") },
-        })?;
-        ex = ex.with_map(name, &map, t.normal_convention()).map_err(core)?;
+        maps.push((name, image, bytes));
     }
-    let prep = &ex.preparation;
-    if (prep.input_width, prep.input_height) != (prep.width, prep.height) {
-        log(format!(
-            "texture '{}': exemplar {}x{} scaled to {}x{} (exemplars are used up to {} texels a side)",
-            t.id,
-            prep.input_width,
-            prep.input_height,
-            prep.width,
-            prep.height,
-            textile_core::exemplar::MAX_SIDE
-        ));
-    }
+    let maps: Vec<(&str, &str, &[u8])> = maps.iter().map(|(n, i, b)| (*n, *i, b.as_slice())).collect();
+    let images = Images { exemplar: bytes, mask: mask.as_deref(), maps: &maps };
+    let ex = t
+        .recipe(cfg.max_exemplar_side)
+        .make(&images, &|note| log(format!("texture '{}': {note}", t.id)))
+        .map_err(|source| LoadError::Core { id: t.id.clone(), source })?;
     Texture::prepare(t.clone(), index, ex)
 }
 
