@@ -95,11 +95,44 @@ impl Rect {
     }
 }
 
-/// Synthesis levels of a `w × h` exemplar: `L = ⌈log2 max(w, h)⌉`, so that one pixel of level
-/// 0 covers the whole exemplar (for a power-of-two square of side `m`, `log2 m`).
+/// An exemplar's size, and what follows from it: its longer side (which periods, lattices and
+/// searches are measured against) and its levels (the native zoom). The one place these are
+/// computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Size {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+}
+
+impl Size {
+    /// A `width × height` exemplar's size.
+    pub fn new(width: u32, height: u32) -> Size {
+        Size { width, height }
+    }
+
+    /// A `(w, h)` size in `usize`, as exemplar dimensions are indexed.
+    pub fn of_dims((w, h): (usize, usize)) -> Size {
+        Size::new(w as u32, h as u32)
+    }
+
+    /// The longer side.
+    pub fn longer(self) -> u32 {
+        self.width.max(self.height)
+    }
+
+    /// Synthesis levels: `L = ⌈log2 max(w, h)⌉`, so that one pixel of level 0 covers the whole
+    /// exemplar (for a power-of-two square of side `m`, `log2 m`). It is also the native zoom.
+    pub fn levels(self) -> u32 {
+        let m = self.longer().max(1);
+        32 - (m - 1).leading_zeros()
+    }
+}
+
+/// Synthesis levels of a `w × h` exemplar ([`Size::levels`]).
 pub fn levels_for(w: u32, h: u32) -> u32 {
-    let m = w.max(h).max(1);
-    32 - (m - 1).leading_zeros()
+    Size::new(w, h).levels()
 }
 
 /// The largest centred square of a `w × h` image (itself when square) and its side: what the

@@ -39,7 +39,7 @@ impl CandidateRules {
             w,
             h,
             toroidal,
-            separation: (w.max(h) * 5).div_ceil(100),
+            separation: (crate::geom::Size::of_dims((w, h)).longer() as usize * 5).div_ceil(100),
             phase: LevelLattice::FREE,
             copies: None,
             leaves_per_texel: LEAVES_PER_TEXEL,
@@ -194,7 +194,11 @@ pub fn candidate_sets(
     let between = |done: usize| {
         let opened = leaves.load(Ordering::Relaxed);
         if opened > budget {
-            return Err(CoreError::AnalysisWork { side: w.max(h) as u32, leaves: opened, budget });
+            return Err(CoreError::AnalysisWork {
+                side: crate::geom::Size::of_dims((w, h)).longer(),
+                leaves: opened,
+                budget,
+            });
         }
         between(done)
     };

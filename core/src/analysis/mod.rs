@@ -242,7 +242,7 @@ impl Analysis {
         progress: &dyn Progress,
         cancel: &Cancel,
     ) -> Result<Analysis> {
-        let search = index.resolve(ex.width.max(ex.height));
+        let search = index.resolve(ex.size().longer());
         let dims = ex.dims();
         let levels = ex.levels();
         // Steps: the stack, then every corrected level's bands of candidate search.
@@ -260,8 +260,7 @@ impl Analysis {
                 Ok(())
             };
             let h = 1 << (levels - l);
-            let phase =
-                ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, ex.width.max(ex.height)));
+            let phase = ex.lattice.as_ref().map_or(LevelLattice::FREE, |lat| lat.level(h as i64, ex.size().longer()));
             let rules = CandidateRules::new(dims, ex.toroidal).with_phase(phase).without_copies(ex.repeat.as_ref());
             corrected.push(analyse_level(&stack8[l as usize], &rules, h as usize, search, &between)?);
         }
@@ -295,7 +294,7 @@ impl Analysis {
     /// The analysis id an exemplar would get with the search `index` chooses: compare with a
     /// stored analysis's `header.id` to know whether it is still current.
     pub fn id_for(ex: &Exemplar, index: IndexChoice) -> String {
-        analysis_id(ex, index.resolve(ex.width.max(ex.height)))
+        analysis_id(ex, index.resolve(ex.size().longer()))
     }
 
     /// The exemplar as the analysis holds it (pixels, size, flags, lattice; not the
@@ -337,6 +336,11 @@ impl Analysis {
     /// Exemplar size `(width, height)` for indexing.
     pub fn dims(&self) -> (usize, usize) {
         (self.header.width as usize, self.header.height as usize)
+    }
+
+    /// Its exemplar's size ([`crate::geom::Size`]: longer side, levels).
+    pub fn size(&self) -> crate::geom::Size {
+        crate::geom::Size::new(self.header.width, self.header.height)
     }
 
     /// Finest level index `L`.

@@ -159,7 +159,12 @@ impl Exemplar {
 
     /// Synthesis levels of this exemplar ([`levels_for`]).
     pub fn levels(&self) -> u32 {
-        levels_for(self.width, self.height)
+        self.size().levels()
+    }
+
+    /// Its size ([`crate::geom::Size`]: longer side, levels).
+    pub fn size(&self) -> crate::geom::Size {
+        crate::geom::Size::new(self.width, self.height)
     }
 
     /// Its size as `(width, height)` in `usize`, for indexing.
@@ -392,7 +397,7 @@ fn halve(pixels: &[[u8; 3]], (w, h): (u32, u32)) -> (Vec<[u8; 3]>, Vec<[u8; 3]>)
 /// scaled so that the longer side is [`MAX_SIDE`], keeping the shape (the shorter side
 /// rounded, at least [`MIN_INPUT_SIDE`]).
 pub fn prepared_size(w: u32, h: u32) -> (u32, u32) {
-    let long = w.max(h);
+    let long = crate::geom::Size::new(w, h).longer();
     if long <= MAX_SIDE {
         return (w, h);
     }

@@ -39,7 +39,7 @@ impl LatticeChoice {
     /// vectors, checked); `None` for `auto`, whose lattice is detected from the pixels
     /// ([`super::detect`]), and for `none`.
     pub fn explicit(&self, w: u32, h: u32) -> Result<Option<Lattice>> {
-        let side = w.max(h);
+        let side = crate::geom::Size::new(w, h).longer();
         Ok(match self {
             LatticeChoice::Auto | LatticeChoice::None => None,
             LatticeChoice::Cells(nx, ny) => Some(Lattice::cells(*nx, *ny, w, h)?),

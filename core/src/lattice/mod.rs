@@ -114,7 +114,7 @@ impl Lattice {
         if ny > 1 {
             waves.push(Wave::new(h as f64 / ny as f64, 90.0));
         }
-        Lattice::given(waves, w.max(h))
+        Lattice::given(waves, crate::geom::Size::new(w, h).longer())
     }
 
     /// A lattice of the given waves (`(period, angle°)`): one or two, periods from 2 texels to

@@ -139,7 +139,7 @@ impl<'a> Source<'a> {
 
     /// The exemplar's longer side (what parameters bounded by the exemplar's size compare with).
     pub fn longer_side(&self) -> u32 {
-        self.exemplar.width.max(self.exemplar.height)
+        self.exemplar.size().longer()
     }
 
     /// `L = ⌈log2 max(w, h)⌉`: the native zoom and finest level.

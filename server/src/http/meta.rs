@@ -377,7 +377,7 @@ pub async fn tilejson(
         "center": [0.0, 0.0, t.native_zoom()],
         "tileSize": TILE_SIZE,
         "textile": {
-            "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.width.max(t.exemplar.height),
+            "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.size().longer(),
             "exemplar_width": t.exemplar.width, "exemplar_height": t.exemplar.height,
             "magnified_zooms": t.max_zoom() - t.native_zoom(),
         },

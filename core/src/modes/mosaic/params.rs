@@ -55,7 +55,7 @@ impl MosaicParams {
         if self.smoothing > MAX_SMOOTHING {
             return bad("smoothing", format!("{} is outside 0..={MAX_SMOOTHING}", self.smoothing));
         }
-        check_period(self.period, w.max(h))?;
+        check_period(self.period, crate::geom::Size::new(w, h).longer())?;
         // The mosaic's background is the tiled exemplar: a periodic mosaic repeats whole tiles.
         if let Some(n) = self.period {
             if n % w as i64 != 0 || n % h as i64 != 0 {

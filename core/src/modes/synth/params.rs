@@ -139,8 +139,8 @@ impl ParamValue for Randomness {
 impl SynthParams {
     /// Check the parameters for a `w × h` exemplar (list length, period, ranges).
     pub fn validate(&self, (w, h): (usize, usize)) -> Result<()> {
-        let levels = crate::geom::levels_for(w as u32, h as u32);
-        let side = w.max(h) as u32;
+        let size = crate::geom::Size::of_dims((w, h));
+        let (levels, side) = (size.levels(), size.longer());
         if let Randomness::PerLevel(v) = &self.randomness {
             if v.len() != levels as usize + 1 {
                 return Err(CoreError::Param {

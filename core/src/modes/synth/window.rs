@@ -338,7 +338,7 @@ impl<'a> Ctx<'a> {
             lattice: self
                 .an
                 .lattice()
-                .map_or(LevelLattice::FREE, |lat| lat.level(h, self.dims.0.max(self.dims.1) as u32)),
+                .map_or(LevelLattice::FREE, |lat| lat.level(h, self.an.size().longer())),
         }
     }
 
