@@ -392,7 +392,9 @@ async fn analyze_and_render_make_the_exemplar_serve_makes() {
     // A non-square crop of gravel, and a mask keeping the left half of brick.
     let gravel = image::open(exemplar("gravel.png")).unwrap().to_rgb8();
     image::imageops::crop_imm(&gravel, 0, 16, 128, 96).to_image().save(p("wide.png")).unwrap();
-    image::GrayImage::from_fn(128, 128, |x, _| image::Luma([if x < 64 { 0 } else { 255 }])).save(p("mask.png")).unwrap();
+    image::GrayImage::from_fn(128, 128, |x, _| image::Luma([if x < 64 { 0 } else { 255 }]))
+        .save(p("mask.png"))
+        .unwrap();
     let cases: [(&str, String, Option<String>); 3] = [
         ("plain", exemplar("grass.png"), None),
         ("wide", p("wide.png"), None),

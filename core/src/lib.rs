@@ -8,7 +8,9 @@
 //!
 //! 1. [`exemplar`] — decode and prepare the input at its own size and shape (scaled only past
 //!    [`exemplar::MAX_SIDE`]), its toroidal flag, randomness mask and material maps ([`maps`],
-//!    [`mask`]);
+//!    [`mask`]), in the order one [`recipe`] applies for every caller (a texture's settings:
+//!    largest side, wrap-around or a seamless replacement, high-resolution source, lattice,
+//!    mask, maps), its sizes read through [`geom::Size`];
 //! 2. [`lattice`] — its structure, found from the pixels or given: an exact repeat (a tile
 //!    repeated), a near-regular lattice (1-D or 2-D, real-valued periods), or none;
 //! 3. [`analysis`] — Gaussian stack ([`stack`], also the low-pass of material maps), PCA
@@ -61,6 +63,7 @@ pub mod memo;
 pub mod modes;
 pub mod prepare;
 pub mod progress;
+pub mod recipe;
 pub mod samples;
 pub mod stack;
 pub mod tileable;

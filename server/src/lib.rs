@@ -11,7 +11,6 @@
 //! [`pipeline::ImageJob`].
 
 pub mod access_log;
-pub mod assets;
 pub mod cache;
 pub mod cmd;
 pub mod config;
@@ -21,16 +20,15 @@ pub mod export;
 pub mod http;
 pub mod memory;
 pub mod metrics;
-pub mod model;
 pub mod output;
 pub mod pipeline;
 pub mod queue;
 pub mod request;
 pub mod robustness;
 pub mod sampling;
+pub mod scene;
 pub mod state;
 pub mod textures;
-pub mod tileset;
 pub mod uploads;
 
 /// Parse the command line and run the chosen command; the process exit code.

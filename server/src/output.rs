@@ -13,11 +13,11 @@ use std::sync::Arc;
 use axum::body::Bytes;
 use textile_core::Pyramid;
 
-use crate::assets::{glb, gltf_json, x3d, Relief, Slot};
 use crate::error::ApiError;
 use crate::metrics::GLTF_LABEL;
-use crate::model::{generator, material_images, Model};
 use crate::pipeline::{self, etag_for, ImageJob};
+use crate::scene::assets::{glb, gltf_json, x3d, Relief, Slot};
+use crate::scene::model::{generator, material_images, Model};
 use crate::state::AppState;
 
 /// Something textile serves or writes.

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand};
 use textile_core::analysis::IndexChoice;
-use textile_core::exemplar::Toroidal;
 use textile_core::lattice::LatticeChoice;
+use textile_core::recipe::Toroidal;
 
 pub use super::flags::SettingFlags;
 use crate::config::{settings, Overrides};

@@ -83,19 +83,19 @@ pub(crate) fn toroidal_flag(s: &str) -> Option<bool> {
 
 impl args::ExemplarArgs {
     /// The exemplar of the image at `path`, made by the one recipe
-    /// ([`textile_core::exemplar::Recipe`]) with these flags; what the recipe did is printed.
+    /// ([`textile_core::recipe::Recipe`]) with these flags; what the recipe did is printed.
     pub(crate) fn make(&self, path: &Path) -> Result<Exemplar, Box<dyn std::error::Error>> {
         let read = |p: &Path| std::fs::read(p).map_err(|e| format!("cannot read {}: {e}", p.display()));
         let bytes = read(path)?;
         let mask = self.randomness_mask.as_deref().map(read).transpose()?;
-        let recipe = textile_core::exemplar::Recipe {
+        let recipe = textile_core::recipe::Recipe {
             max_input_side: self.max_side,
             toroidal: self.toroidal,
             hires: self.hires,
             lattice: self.lattice.clone(),
             normal_convention: None,
         };
-        let images = textile_core::exemplar::Images { exemplar: &bytes, mask: mask.as_deref(), maps: &[] };
+        let images = textile_core::recipe::Images { exemplar: &bytes, mask: mask.as_deref(), maps: &[] };
         Ok(recipe
             .make(&images, &|note| eprintln!("{}: {note}", path.display()))
             .map_err(|e| format!("{}: {e}", path.display()))?)

@@ -16,10 +16,10 @@ use super::args::{CliResult, RenderArgs};
 use super::{configured_texture, output_format, param_pairs};
 use crate::config::TextureConfig;
 use crate::encode::{encode, Effort, Format};
-use crate::model::Model;
 use crate::output::Output;
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
+use crate::scene::model::Model;
 use crate::textures::Texture;
 
 /// `textile render --sheet`: a picture of what the mode prepared for the texture.

@@ -11,7 +11,7 @@ use textile_core::lattice::LatticeChoice;
 use textile_core::maps::NormalConvention;
 use textile_core::MODE_NAMES;
 
-pub use textile_core::exemplar::Toroidal;
+pub use textile_core::recipe::Toroidal;
 
 /// One served texture.
 ///
@@ -73,10 +73,10 @@ pub struct TextureConfig {
 }
 
 impl TextureConfig {
-    /// How its exemplar is made ([`textile_core::exemplar::Recipe`]), images up to
+    /// How its exemplar is made ([`textile_core::recipe::Recipe`]), images up to
     /// `max_input_side` pixels a side.
-    pub fn recipe(&self, max_input_side: u32) -> textile_core::exemplar::Recipe {
-        textile_core::exemplar::Recipe {
+    pub fn recipe(&self, max_input_side: u32) -> textile_core::recipe::Recipe {
+        textile_core::recipe::Recipe {
             max_input_side,
             toroidal: self.toroidal,
             hires: self.exemplar_hires.is_some(),

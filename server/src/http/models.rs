@@ -14,13 +14,13 @@ use base64::Engine;
 
 use textile_core::ParamReader;
 
-use crate::assets::Slot;
 use crate::error::ApiError;
 use crate::http::content::answer;
 use crate::http::extract::{base_url, path_error, texture, Peer};
-use crate::model::{Model, MAX_PATCH, SLOT};
 use crate::output::Output;
 use crate::request::{parse_tile, query_pairs};
+use crate::scene::assets::Slot;
+use crate::scene::model::{Model, MAX_PATCH, SLOT};
 use crate::state::AppState;
 
 pub(super) fn split_ext<'a>(s: &'a str, allowed: &[&str]) -> Result<(&'a str, &'a str), ApiError> {

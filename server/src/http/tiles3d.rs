@@ -1,7 +1,7 @@
 //! OGC 3D Tiles 1.1 endpoints: a texture's tileset (implicit quadtree over its zooms, same
 //! query parameters as tiles, optional Earth anchoring with `lon`, `lat`, `height`), its subtree
 //! files, and its content tiles (the glTF tiles of `/gltf`, addressed by implicit coordinates).
-//! The documents themselves are built by [`crate::tileset`].
+//! The documents themselves are built by [`crate::scene::tileset`].
 
 use std::sync::Arc;
 
@@ -16,13 +16,13 @@ use crate::http::content::answer;
 use crate::http::content::{if_none_match, image, not_modified};
 use crate::http::extract::{path_error, texture};
 use crate::http::models::split_ext;
-use crate::model::{generator, params_with_relief, Model};
 use crate::output::Output;
 use crate::pipeline::{cache_key, etag_for};
 use crate::request::{query_pairs, query_string, TileSpec};
+use crate::scene::model::{generator, params_with_relief, Model};
+use crate::scene::tileset::{enu_to_ecef, subtree, tileset, Content, Tree, SUBTREE_LEVELS};
 use crate::state::AppState;
 use crate::textures::Texture;
-use crate::tileset::{enu_to_ecef, subtree, tileset, Content, Tree, SUBTREE_LEVELS};
 use textile_core::ParamReader;
 
 /// The tileset's anchoring parameters. Content requests accept and ignore them: CesiumJS carries
@@ -107,7 +107,8 @@ pub async fn tileset_json(
     let (p, relief) = params_with_relief(&tex, reader)?;
     // Sorted: one URI (and cache entry) per set of parameters, however they were ordered.
     let query = query_string(&pairs.into_iter().collect::<std::collections::BTreeMap<_, _>>());
-    let etag = etag_for(&cache_key(&tex, &p, format_args!("tileset{}|{query}|{transform:?}", crate::assets::LAYOUT)));
+    let etag =
+        etag_for(&cache_key(&tex, &p, format_args!("tileset{}|{query}|{transform:?}", crate::scene::assets::LAYOUT)));
     let cc = &st.cache_control;
     if if_none_match(&headers, &etag) {
         return Ok(not_modified(&etag, cc));

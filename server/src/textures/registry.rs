@@ -5,7 +5,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use textile_core::exemplar::Images;
+use textile_core::recipe::Images;
 
 use super::storage::{exemplar_bytes, image_bytes};
 use super::{LoadError, Texture};

@@ -3,7 +3,7 @@
 //! anchors the tileset on the WGS 84 ellipsoid for Earth-based clients.
 //!
 //! **Frame.** 3D Tiles is Z-up; clients turn glTF content from Y-up to Z-up, so the glTF frame of
-//! [`crate::assets`] (X east, Y up, Z south, 1 unit = 1 native texel) becomes x east, y north,
+//! [`crate::scene::assets`] (X east, Y up, Z south, 1 unit = 1 native texel) becomes x east, y north,
 //! z up: texel `(tx, ty)` lies at `(tx, −ty, 0)`. That is an east-north-up frame, the local frame
 //! of [`enu_to_ecef`].
 //!
@@ -130,13 +130,13 @@ pub fn enu_to_ecef(lon: f64, lat: f64, height: f64) -> [f64; 16] {
 /// The tileset JSON. `query` is the request's query string (mode and its parameters, without
 /// the anchoring ones), carried into the content URIs; `transform` anchors the root; `relief`
 /// the height of a displaced mesh's highest point, which the bounding volumes contain (from its
-/// skirts' foot, [`crate::assets::SKIRT_DEPTH`] below the ground, to `relief` above).
+/// skirts' foot, [`crate::scene::assets::SKIRT_DEPTH`] below the ground, to `relief` above).
 pub fn tileset(tree: &Tree, query: &str, transform: Option<[f64; 16]>, relief: Option<f32>, generator: &str) -> Value {
     let h = tree.root_side() / 2.0;
     let sep = if query.is_empty() { "" } else { "?" };
     // The vertical extent: a flat quad lies in the ground (one texel thick around it).
     let (z0, z1) = match relief {
-        Some(r) => (-(crate::assets::SKIRT_DEPTH as f64), r as f64),
+        Some(r) => (-(crate::scene::assets::SKIRT_DEPTH as f64), r as f64),
         None => (-0.5, 0.5),
     };
     let (zc, zh) = ((z0 + z1) / 2.0, (z1 - z0) / 2.0);

@@ -12,11 +12,11 @@ use base64::Engine;
 use textile_core::maps::MapChoice;
 use textile_core::{ModeParams, ParamReader, TILE_SIZE};
 
-use crate::assets::{image_side, metallic_roughness, Quad, Slot, BORDER, LAYOUT};
 use crate::encode::Format;
 use crate::error::ApiError;
 use crate::pipeline::{cache_key, engine_version, ImageJob, Target};
 use crate::request::{params, query_string, TileSpec, WindowSpec, COORD_MAX};
+use crate::scene::assets::{image_side, metallic_roughness, Quad, Slot, BORDER, LAYOUT};
 use crate::textures::Texture;
 
 /// A request's parameters, sorted, as carried into tile URLs.

@@ -4,6 +4,9 @@
 //! `textile analyze` and `textile render --exemplar` all make their exemplars here, so the same
 //! image and settings give the same exemplar, analysis and pixels everywhere.
 //!
+//! It sits above [`crate::exemplar`] and [`crate::tileable`] (which makes the seamless
+//! replacement), and nothing in the core depends on it.
+//!
 //! Order: decode (refusing an image that is too large before decoding it) → refuse a flat one →
 //! halve a high-resolution source → synthesize a toroidal replacement if asked → detect or take
 //! the lattice → attach the randomness mask → attach each map. The mask and maps are decoded like
@@ -14,8 +17,8 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
-use super::{Exemplar, ExemplarOptions};
 use crate::error::{CoreError, Result};
+use crate::exemplar::{Exemplar, ExemplarOptions};
 use crate::lattice::LatticeChoice;
 use crate::maps::NormalConvention;
 
@@ -153,7 +156,7 @@ impl fmt::Display for Note {
             Note::Scaled { from: (a, b), to: (w, h) } => write!(
                 f,
                 "exemplar {a}x{b} scaled to {w}x{h} (exemplars are used up to {} texels a side)",
-                super::MAX_SIDE
+                crate::exemplar::MAX_SIDE
             ),
         }
     }

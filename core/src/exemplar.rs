@@ -5,10 +5,6 @@
 
 use serde::{Deserialize, Serialize};
 
-mod recipe;
-
-pub use recipe::{Images, Note, Recipe, Toroidal, TOROIDAL_VALUES};
-
 pub use crate::geom::{centred_square, levels_for};
 
 use crate::error::{CoreError, Result};
