@@ -40,6 +40,54 @@ impl Format {
     }
 }
 
+/// A line of the JSON access log (`access_log_format = "json"`), as the server writes it and as
+/// `textile loadtest --replay` reads it back: one type for both. Its fields are written in this
+/// (alphabetical) order; a reader needs only `ts` and `path` (`method` defaults to GET, `status`
+/// to 200).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct JsonRecord {
+    /// The client went away before the body ended (written only then).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub aborted: bool,
+    /// Body bytes sent.
+    #[serde(default)]
+    pub bytes: u64,
+    /// `hit`, `miss` or `-`.
+    #[serde(default)]
+    pub cache: String,
+    /// Client address.
+    #[serde(default)]
+    pub client: String,
+    /// Request method.
+    #[serde(default = "JsonRecord::get")]
+    pub method: String,
+    /// From arrival to the body's end, milliseconds (thousandths).
+    #[serde(default)]
+    pub ms: f64,
+    /// Path and query, as requested.
+    #[serde(default)]
+    pub path: Option<String>,
+    /// Status sent.
+    #[serde(default = "JsonRecord::ok")]
+    pub status: u16,
+    /// Arrival, UTC, to the millisecond.
+    #[serde(default)]
+    pub time: String,
+    /// Arrival, Unix milliseconds.
+    #[serde(default)]
+    pub ts: Option<i64>,
+}
+
+impl JsonRecord {
+    fn get() -> String {
+        "GET".into()
+    }
+
+    fn ok() -> u16 {
+        200
+    }
+}
+
 /// One answered request.
 #[derive(Debug, Clone)]
 pub struct Entry {
@@ -98,21 +146,19 @@ impl Entry {
         let (y, mo, d, h, mi, s, ms) = utc(self.ts_ms);
         match format {
             Format::Json => {
-                let mut v = serde_json::json!({
-                    "ts": self.ts_ms,
-                    "time": format!("{y:04}-{mo:02}-{d:02}T{h:02}:{mi:02}:{s:02}.{ms:03}Z"),
-                    "client": self.client,
-                    "method": self.method,
-                    "path": self.path,
-                    "status": self.status,
-                    "bytes": self.bytes,
-                    "ms": (self.ms * 1000.0).round() / 1000.0,
-                    "cache": self.cache,
-                });
-                if self.aborted {
-                    v["aborted"] = true.into();
-                }
-                format!("{v}\n")
+                let record = JsonRecord {
+                    aborted: self.aborted,
+                    bytes: self.bytes,
+                    cache: self.cache.to_string(),
+                    client: self.client.clone(),
+                    method: self.method.clone(),
+                    ms: (self.ms * 1000.0).round() / 1000.0,
+                    path: Some(self.path.clone()),
+                    status: self.status,
+                    time: format!("{y:04}-{mo:02}-{d:02}T{h:02}:{mi:02}:{s:02}.{ms:03}Z"),
+                    ts: Some(self.ts_ms as i64),
+                };
+                format!("{}\n", serde_json::to_string(&record).unwrap_or_default())
             }
             Format::Combined => {
                 let quoted = |v: &Option<String>| match v {
@@ -367,6 +413,19 @@ mod tests {
         assert_eq!(j["time"], "2000-10-10T20:55:36.042Z");
         assert_eq!(j["path"], "/tiles/gravel/7/1/1.png?seed=2");
         assert_eq!(j["ms"], 1.235);
+        // The line as written, whole (its keys in order), and read back as the same record.
+        let line = entry().line(Format::Json);
+        assert_eq!(
+            line,
+            "{\"bytes\":81605,\"cache\":\"hit\",\"client\":\"127.0.0.1\",\"method\":\"GET\",\"ms\":1.235,\
+             \"path\":\"/tiles/gravel/7/1/1.png?seed=2\",\"status\":200,\"time\":\"2000-10-10T20:55:36.042Z\",\
+             \"ts\":971211336042}\n"
+        );
+        let back: JsonRecord = serde_json::from_str(&line).unwrap();
+        assert_eq!(
+            (back.path.as_deref(), back.ts, back.status),
+            (Some("/tiles/gravel/7/1/1.png?seed=2"), Some(971_211_336_042), 200)
+        );
         let c = entry().line(Format::Combined);
         assert_eq!(
             c,

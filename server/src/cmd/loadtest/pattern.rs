@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use crate::access_log::JsonRecord;
 use std::sync::Arc;
 use textile_core::error::clip;
 
@@ -244,12 +245,10 @@ fn access_log(l: &str) -> Option<(&str, &str, u16, f64)> {
 /// A line of textile's own JSON access log (`access_log_format = "json"`) → (method, path,
 /// status, time): `ts` is the request's arrival in Unix milliseconds.
 fn json_log(l: &str) -> Result<(String, String, u16, f64), String> {
-    let v: serde_json::Value = serde_json::from_str(l).map_err(|e| format!("not a JSON access-log line: {e}"))?;
-    let text = |k: &str| v.get(k).and_then(|x| x.as_str()).map(str::to_owned);
-    let path = text("path").ok_or("a JSON access-log line without \"path\"")?;
-    let ts = v.get("ts").and_then(|x| x.as_f64()).ok_or("a JSON access-log line without \"ts\" (milliseconds)")?;
-    let status = v.get("status").and_then(|x| x.as_u64()).and_then(|s| u16::try_from(s).ok()).unwrap_or(200);
-    Ok((text("method").unwrap_or_else(|| "GET".into()), path, status, ts / 1000.0))
+    let r: JsonRecord = serde_json::from_str(l).map_err(|e| format!("not a JSON access-log line: {e}"))?;
+    let path = r.path.ok_or("a JSON access-log line without \"path\"")?;
+    let ts = r.ts.ok_or("a JSON access-log line without \"ts\" (milliseconds)")?;
+    Ok((r.method, path, r.status, ts as f64 / 1000.0))
 }
 
 /// The entries of a replay file, read line by line (never the whole file at once): one URL,
