@@ -321,7 +321,7 @@ fn tileable_writes_a_seamless_texture_deterministically_and_refuses_bad_input() 
 /// command that reads the configuration) with the table's help, and the flag sets that key.
 #[test]
 fn setting_flags_come_from_the_settings_table() {
-    use textile_server::config::settings::{describe, Kind, SERVICE};
+    use textile_server::config::settings::{describe, ValueKind, SERVICE};
     let (code, help, err) = run(&["serve", "--help"]);
     assert_eq!(code, 0, "{err}");
     let flagged: Vec<_> = SERVICE.iter().filter(|s| s.flag.is_some()).collect();
@@ -333,7 +333,7 @@ fn setting_flags_come_from_the_settings_table() {
         assert!(line.contains(s.help), "--{}: {line}", flag.long);
         // The flag sets its key, as --print-config shows.
         let value = match s.kind {
-            Kind::Int { min, max, .. } => (min + (max - min) / 3).max(1).min(max).to_string(),
+            ValueKind::Int { min, max, .. } => (min + (max - min) / 3).max(1).min(max).to_string(),
             _ if s.key == "bind" => "127.0.0.1:9".to_string(),
             _ => "/tmp/textile-flag-test".to_string(),
         };

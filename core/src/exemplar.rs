@@ -40,7 +40,7 @@ impl Default for ExemplarOptions {
 
 /// What was done to the input to prepare it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Preparation {
+pub struct Intake {
     /// Input width.
     pub input_width: u32,
     /// Input height.
@@ -74,7 +74,7 @@ pub struct Exemplar {
     /// Whether synthesis may wrap around the exemplar edges.
     pub toroidal: bool,
     /// What preparation did.
-    pub preparation: Preparation,
+    pub preparation: Intake,
     /// The image the exemplar was reduced from, twice as wide and high, when it was given ([`Exemplar::from_hires`]): magnified zooms sample their detail from it.
     pub hires: Option<Vec<[u8; 3]>>,
     /// The randomness mask over the exemplar (`R_E`), when the texture has one
@@ -134,7 +134,7 @@ impl Exemplar {
             height,
             pixels,
             toroidal,
-            preparation: Preparation {
+            preparation: Intake {
                 input_width: w,
                 input_height: h,
                 width,
@@ -233,7 +233,7 @@ impl Exemplar {
         let seam_ratio = seam_ratio(&pixels, width as usize, height as usize);
         let forced = hires.preparation.toroidal_forced;
         let toroidal = if forced { hires.toroidal } else { seam_ratio <= 1.5 };
-        let preparation = Preparation { width, height, seam_ratio, ..hires.preparation };
+        let preparation = Intake { width, height, seam_ratio, ..hires.preparation };
         Ok(Exemplar {
             width,
             height,

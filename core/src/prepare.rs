@@ -21,7 +21,7 @@ use crate::progress::Progress;
 /// A texture setting a preparation reads (in the texture's table of its mode): its key and what
 /// it does.
 #[derive(Debug, Clone, Copy)]
-pub struct Setting {
+pub struct PreparationSetting {
     /// Key.
     pub name: &'static str,
     /// What it does.
@@ -60,7 +60,7 @@ pub trait Preparation: Sized + Send + Sync + 'static {
     /// The extension of its file in the data directory (`<texture>.<EXTENSION>`).
     const EXTENSION: &'static str;
     /// The texture settings it reads.
-    const SETTINGS: &'static [Setting] = &[];
+    const SETTINGS: &'static [PreparationSetting] = &[];
 
     /// A state the texture's settings give outright (nothing computed or stored), if they do.
     fn given(_input: &Input) -> Result<Option<Self>> {

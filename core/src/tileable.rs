@@ -298,7 +298,7 @@ pub fn make_toroidal(ex: &Exemplar, seed: u64) -> Result<Exemplar> {
     let img = synthesize_sized(ex, levels, ex.dims(), &opts, &crate::analysis::NoProgress, &Cancel::new())?;
     let pixels: Vec<[u8; 3]> = img.pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
     let seam_ratio = crate::exemplar::seam_ratio(&pixels, ex.width as usize, ex.height as usize);
-    let preparation = crate::exemplar::Preparation {
+    let preparation = crate::exemplar::Intake {
         toroidal_forced: true,
         seam_ratio,
         toroidal_synthesized: true,

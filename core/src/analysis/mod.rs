@@ -22,7 +22,7 @@ use crate::analysis::features::{
 use crate::cache::{Pyramid, Stack};
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
-use crate::exemplar::{Exemplar, Preparation};
+use crate::exemplar::{Exemplar, Intake};
 use crate::image::box_stack;
 use crate::lattice::{Lattice, LevelLattice, Repeat};
 use crate::mask::RandomnessMask;
@@ -173,7 +173,7 @@ pub struct AnalysisHeader {
     /// Wrap-around synthesis.
     pub toroidal: bool,
     /// How the input image was prepared.
-    pub preparation: Preparation,
+    pub preparation: Intake,
     /// How the candidate sets were searched (files from before the choice existed: exact).
     #[serde(default)]
     pub index: SearchIndex,

@@ -7,10 +7,11 @@ use serde_json::{json, Map, Value};
 use super::{Analysis, IndexChoice, Progress};
 use crate::cancel::Cancel;
 use crate::error::{AnalysisFileProblem, Result};
-use crate::prepare::{Input, Preparation, Setting};
+use crate::prepare::{Input, Preparation, PreparationSetting};
 
 /// The setting choosing the candidate search.
-pub const INDEX: Setting = Setting { name: "index", help: "candidate search of the analysis: auto, exact or coherent" };
+pub const INDEX: PreparationSetting =
+    PreparationSetting { name: "index", help: "candidate search of the analysis: auto, exact or coherent" };
 
 /// The candidate search the input asks for (its default when it gives none or a bad one, which
 /// configuration checks refuse first).
@@ -21,7 +22,7 @@ fn search(input: &Input) -> IndexChoice {
 impl Preparation for Analysis {
     const WHAT: &'static str = "analysis";
     const EXTENSION: &'static str = "tex";
-    const SETTINGS: &'static [Setting] = &[INDEX];
+    const SETTINGS: &'static [PreparationSetting] = &[INDEX];
 
     fn id(input: &Input) -> String {
         Analysis::id_for(input.exemplar, search(input))

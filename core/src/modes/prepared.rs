@@ -17,7 +17,7 @@ use super::{Mode, Prepared};
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::exemplar::Exemplar;
-use crate::prepare::{load, load_or_compute, Input, Origin, Preparation, Setting, State};
+use crate::prepare::{load, load_or_compute, Input, Origin, Preparation, PreparationSetting, State};
 use crate::progress::Progress;
 
 /// What a mode prepares per texture: `()` for nothing, or any [`Preparation`].
@@ -89,7 +89,7 @@ pub trait Step: Send + Sync {
     /// See [`Preparation::EXTENSION`].
     fn extension(&self) -> &'static str;
     /// See [`Preparation::SETTINGS`].
-    fn settings(&self) -> &'static [Setting];
+    fn settings(&self) -> &'static [PreparationSetting];
     /// See [`Preparation::id`].
     fn id(&self, input: &Input) -> String;
     /// [`load_or_compute`] the state and keep it in `into` (unless it holds one already, which
@@ -122,7 +122,7 @@ where
     fn extension(&self) -> &'static str {
         <M::State as Preparation>::EXTENSION
     }
-    fn settings(&self) -> &'static [Setting] {
+    fn settings(&self) -> &'static [PreparationSetting] {
         <M::State as Preparation>::SETTINGS
     }
     fn id(&self, input: &Input) -> String {

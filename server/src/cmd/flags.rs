@@ -7,7 +7,7 @@
 use clap::{Arg, ArgMatches, Args, Command, FromArgMatches};
 use serde_json::{Map, Value as Json};
 
-use crate::config::settings::{describe, Kind, Setting, SERVICE};
+use crate::config::settings::{describe, Setting, ValueKind, SERVICE};
 
 /// The settings given as flags: those of every command (`EVERY = true`) or those of
 /// `textile serve` only, as `key → value`.
@@ -29,7 +29,7 @@ impl<const EVERY: bool> FromArgMatches for SettingFlags<EVERY> {
     fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
         for s in flagged(EVERY) {
             let value = match s.kind {
-                Kind::Int { .. } => m.get_one::<u64>(s.key).map(|v| Json::from(*v)),
+                ValueKind::Int { .. } => m.get_one::<u64>(s.key).map(|v| Json::from(*v)),
                 _ => m.get_one::<String>(s.key).map(|v| Json::from(v.as_str())),
             };
             if let Some(v) = value {
@@ -46,7 +46,7 @@ impl<const EVERY: bool> Args for SettingFlags<EVERY> {
             let Some(flag) = s.flag else { return cmd };
             let arg = Arg::new(s.key).long(flag.long).value_name(flag.value).help(describe(s));
             cmd.arg(match s.kind {
-                Kind::Int { .. } => arg.value_parser(clap::value_parser!(u64)),
+                ValueKind::Int { .. } => arg.value_parser(clap::value_parser!(u64)),
                 _ => arg,
             })
         })

@@ -7,12 +7,12 @@
 //! parameter specs, which drive upload field checks and the admin API's OpenAPI.
 
 use serde_json::{json, Map, Value as Json};
-use textile_core::modes::params::{Kind as FieldKind, ParamSpec, Scope};
+use textile_core::modes::params::{Kind, ParamSpec, Scope};
 use textile_core::MODE_NAMES;
 
 /// A service setting's type, range and default.
 #[derive(Debug, Clone, Copy)]
-pub enum Kind {
+pub enum ValueKind {
     /// A whole number in `min..=max`; `zero` says what 0 means, when it means something.
     Int {
         /// Least value.
@@ -47,7 +47,7 @@ pub struct Setting {
     /// Key in the configuration file.
     pub key: &'static str,
     /// Type, range, default.
-    pub kind: Kind,
+    pub kind: ValueKind,
     /// Whether `TEXTILE_<KEY>` sets it.
     pub env: bool,
     /// Its command-line flag, if it has one.
@@ -80,15 +80,15 @@ impl Setting {
 }
 
 const fn int(key: &'static str, min: u64, max: u64, default: u64, help: &'static str) -> Setting {
-    Setting { key, kind: Kind::Int { min, max, default, zero: None }, env: true, flag: None, help }
+    Setting { key, kind: ValueKind::Int { min, max, default, zero: None }, env: true, flag: None, help }
 }
 
 const fn int0(key: &'static str, max: u64, default: u64, zero: &'static str, help: &'static str) -> Setting {
-    Setting { key, kind: Kind::Int { min: 0, max, default, zero: Some(zero) }, env: true, flag: None, help }
+    Setting { key, kind: ValueKind::Int { min: 0, max, default, zero: Some(zero) }, env: true, flag: None, help }
 }
 
 const fn text(key: &'static str, default: &'static str, help: &'static str) -> Setting {
-    Setting { key, kind: Kind::Text { default }, env: true, flag: None, help }
+    Setting { key, kind: ValueKind::Text { default }, env: true, flag: None, help }
 }
 
 /// The service's settings, in the order `--print-config` shows them.
@@ -102,7 +102,7 @@ pub const SERVICE: &[Setting] = &[
     text("cache_control", "public, max-age=31536000, immutable", "Cache-Control of tiles"),
     Setting {
         key: "cors_origins",
-        kind: Kind::List { default: &["*"] },
+        kind: ValueKind::List { default: &["*"] },
         env: false,
         flag: None,
         help: "CORS origins (\"*\": any)",
@@ -114,7 +114,7 @@ pub const SERVICE: &[Setting] = &[
     int("max_exemplar_side", 16, 8192, 1024, "largest exemplar side accepted, in pixels"),
     Setting {
         key: "include_default_textures",
-        kind: Kind::Bool { default: false },
+        kind: ValueKind::Bool { default: false },
         env: false,
         flag: None,
         help: "keep the built-in textures beside a configuration file's own",
@@ -122,7 +122,7 @@ pub const SERVICE: &[Setting] = &[
     text("public_url", "", "the URL clients reach the service at, for absolute URLs (empty: from the request)"),
     Setting {
         key: "trusted_proxies",
-        kind: Kind::List { default: &[] },
+        kind: ValueKind::List { default: &[] },
         env: false,
         flag: None,
         help: "addresses of reverse proxies whose forwarded headers are believed",
@@ -166,10 +166,10 @@ pub fn defaults() -> Map<String, Json> {
         .iter()
         .map(|s| {
             let v = match s.kind {
-                Kind::Int { default, .. } => json!(default),
-                Kind::Text { default } => json!(default),
-                Kind::List { default } => json!(default),
-                Kind::Bool { default } => json!(default),
+                ValueKind::Int { default, .. } => json!(default),
+                ValueKind::Text { default } => json!(default),
+                ValueKind::List { default } => json!(default),
+                ValueKind::Bool { default } => json!(default),
             };
             (s.key.to_string(), v)
         })
@@ -180,7 +180,7 @@ pub fn defaults() -> Map<String, Json> {
 /// the first out of range as `(key, message)`.
 pub fn check_ranges(values: &Json) -> Result<(), (&'static str, String)> {
     for s in SERVICE {
-        let Kind::Int { min, max, zero, .. } = s.kind else { continue };
+        let ValueKind::Int { min, max, zero, .. } = s.kind else { continue };
         let Some(v) = values.get(s.key).and_then(Json::as_u64) else { continue };
         if !(min..=max).contains(&v) {
             let zero = zero.map(|z| format!(" (0 = {z})")).unwrap_or_default();
@@ -200,13 +200,13 @@ pub fn comment(s: &Setting) -> String {
 /// help, and [`comment`]).
 pub fn describe(s: &Setting) -> String {
     let range = match s.kind {
-        Kind::Int { min, max, default, zero } => {
+        ValueKind::Int { min, max, default, zero } => {
             let zero = zero.map(|z| format!(", 0 = {z}")).unwrap_or_default();
             format!("{min}..={max}{zero}; default {default}")
         }
-        Kind::Text { default } => format!("default {default:?}"),
-        Kind::List { default } => format!("default {default:?}"),
-        Kind::Bool { default } => format!("default {default}"),
+        ValueKind::Text { default } => format!("default {default:?}"),
+        ValueKind::List { default } => format!("default {default:?}"),
+        ValueKind::Bool { default } => format!("default {default}"),
     };
     let env = if s.env { format!("; env TEXTILE_{}", s.key.to_uppercase()) } else { String::new() };
     format!("{} ({range}{env})", s.help)
@@ -215,52 +215,52 @@ pub fn describe(s: &Setting) -> String {
 /// `id`: a texture's URL id.
 pub const ID: ParamSpec = ParamSpec {
     name: "id",
-    kind: FieldKind::Text { max_len: 64 },
+    kind: Kind::Text { max_len: 64 },
     scope: Scope::Texture,
     help: "texture id, 1-64 of a-z 0-9 _ - (required)",
 };
 /// `name`: a display name.
 pub const NAME: ParamSpec =
-    ParamSpec { name: "name", kind: FieldKind::Text { max_len: 200 }, scope: Scope::Texture, help: "display name" };
+    ParamSpec { name: "name", kind: Kind::Text { max_len: 200 }, scope: Scope::Texture, help: "display name" };
 /// `toroidal`: whether the exemplar wraps around.
 pub const TOROIDAL: ParamSpec = ParamSpec {
     name: "toroidal",
-    kind: FieldKind::Choice(&["auto", "true", "false", "synthesize"]),
+    kind: Kind::Choice(&["auto", "true", "false", "synthesize"]),
     scope: Scope::Texture,
     help: "whether the exemplar wraps around (auto: detected; synthesize: replaced by a seamless one made from it)",
 };
 /// `index`: the analysis's candidate search.
 pub const INDEX: ParamSpec = ParamSpec {
     name: "index",
-    kind: FieldKind::Choice(&["auto", "exact", "coherent"]),
+    kind: Kind::Choice(&["auto", "exact", "coherent"]),
     scope: Scope::Texture,
     help: "candidate search of the analysis (auto: coherent from 256² up)",
 };
 /// `default_mode`: the mode of requests that name none.
 pub const DEFAULT_MODE: ParamSpec = ParamSpec {
     name: "default_mode",
-    kind: FieldKind::Choice(MODE_NAMES),
+    kind: Kind::Choice(MODE_NAMES),
     scope: Scope::Texture,
     help: "mode of requests that name none",
 };
 /// `default_seed`: the seed of requests that name none.
 pub const DEFAULT_SEED: ParamSpec = ParamSpec {
     name: "default_seed",
-    kind: FieldKind::Integer { min: 0, max: u64::MAX },
+    kind: Kind::Integer { min: 0, max: u64::MAX },
     scope: Scope::Texture,
     help: "seed of requests that name none",
 };
 /// `lattice`: the lattice of a near-regular exemplar.
 pub const LATTICE: ParamSpec = ParamSpec {
     name: "lattice",
-    kind: FieldKind::Text { max_len: 100 },
+    kind: Kind::Text { max_len: 100 },
     scope: Scope::Texture,
     help: "lattice of a near-regular exemplar: auto (detected, the default), none (no detection), NX,NY cells of a rectified exemplar, or PERIOD@ANGLE[,PERIOD@ANGLE] waves",
 };
 /// `attribution`: shown in TileJSON.
 pub const ATTRIBUTION: ParamSpec = ParamSpec {
     name: "attribution",
-    kind: FieldKind::Text { max_len: 1000 },
+    kind: Kind::Text { max_len: 1000 },
     scope: Scope::Texture,
     help: "attribution shown in TileJSON",
 };

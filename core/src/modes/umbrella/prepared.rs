@@ -18,10 +18,10 @@ use crate::error::{AnalysisFileProblem, CoreError, Result};
 use crate::exemplar::Exemplar;
 use crate::geom::centred_square;
 use crate::maps::MaterialMap;
-use crate::prepare::{Input, Preparation, Setting};
+use crate::prepare::{Input, Preparation, PreparationSetting};
 
 /// The setting naming a hand-made set.
-pub const SET: Setting = Setting {
+pub const SET: PreparationSetting = PreparationSetting {
     name: "set",
     help: "a hand-made umbrella set instead of elements extracted from the exemplar: JSON naming element images \
            with alpha, relative to the set file (path relative to the configuration)",
@@ -116,7 +116,7 @@ pub fn extraction_id(ex: &Exemplar) -> String {
 impl Preparation for Extraction {
     const WHAT: &'static str = "umbrella extraction";
     const EXTENSION: &'static str = "umbrella";
-    const SETTINGS: &'static [Setting] = &[SET];
+    const SETTINGS: &'static [PreparationSetting] = &[SET];
 
     fn given(input: &Input) -> Result<Option<Extraction>> {
         let Some(set) = input.setting(SET.name) else { return Ok(None) };
