@@ -318,7 +318,7 @@ impl Analysis {
     }
 
     /// The lattice its candidate sets keep (the prepared exemplar's when it was analysed):
-    /// synthesis holds it; other readers go through [`crate::modes::Source::lattice`].
+    /// synthesis holds it; the other modes read it through their source's `lattice()`.
     pub fn lattice(&self) -> Option<&Lattice> {
         self.header.lattice.as_ref()
     }
