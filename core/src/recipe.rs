@@ -70,18 +70,6 @@ impl FromStr for Toroidal {
     }
 }
 
-impl fmt::Display for Toroidal {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let i = match self {
-            Toroidal::Auto => 0,
-            Toroidal::True => 1,
-            Toroidal::False => 2,
-            Toroidal::Synthesize => 3,
-        };
-        f.write_str(TOROIDAL_VALUES[i])
-    }
-}
-
 /// Everything a texture's settings say about how its exemplar is made.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recipe {

@@ -38,7 +38,7 @@ fn samples(spec: &ParamSpec, levels: u32) -> Vec<String> {
 /// texture settings alike).
 fn read(base: &ModeParams, src: &Source, pairs: &[(&str, String)]) -> textile_core::Result<ModeParams> {
     let mut r = ParamReader::texture(pairs.iter().map(|(k, v)| (k.to_string(), v.clone())))?;
-    let common = Common::read(&mut r, src.longer_side())?;
+    let common = Common::read(&mut r, src.exemplar.size().longer())?;
     let p = base.parse(&common, &mut r, src)?;
     assert!(r.is_empty(), "{pairs:?} left keys unread");
     Ok(p)

@@ -85,7 +85,8 @@ impl Autocorrelation {
                 if sin < MIN_ANGLE.to_radians().sin() {
                     continue;
                 }
-                let (t1, t2) = canonical(reduce(p, q));
+                let [t1, t2] = super::reduce(p, q);
+                let (t1, t2) = canonical((t1, t2));
                 if seen.contains(&(t1, t2)) {
                     continue;
                 }
@@ -248,26 +249,6 @@ fn half(t1: [f64; 2], t2: [f64; 2], i: f64, j: f64) -> [f64; 2] {
 
 fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[1] - a[1] * b[0]
-}
-
-/// The shortest pair of vectors spanning the lattice of `a` and `b` (Gauss's reduction),
-/// shortest first.
-fn reduce(mut a: [f64; 2], mut b: [f64; 2]) -> ([f64; 2], [f64; 2]) {
-    let dot = |u: [f64; 2], v: [f64; 2]| u[0] * v[0] + u[1] * v[1];
-    for _ in 0..32 {
-        if dot(a, a) > dot(b, b) {
-            std::mem::swap(&mut a, &mut b);
-        }
-        let mu = (dot(a, b) / dot(a, a)).round();
-        if mu == 0.0 {
-            break;
-        }
-        b = [b[0] - mu * a[0], b[1] - mu * a[1]];
-    }
-    if dot(a, a) > dot(b, b) {
-        std::mem::swap(&mut a, &mut b);
-    }
-    (a, b)
 }
 
 /// A reduced basis in one spelling: each vector in the upper half plane, so that the same

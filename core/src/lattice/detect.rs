@@ -141,7 +141,7 @@ fn detect_square(pixels: &[[u8; 3]], side: u32) -> Detection {
         Some(Lattice { waves, origin: Origin::Detected, confidence: confidence(margin) })
     };
     let lattice = match (&scaled_cell, &scaled_ridge) {
-        (Some(c), _) if cell_margin(c) >= 1.0 => found(waves_of_cell(c, 1.0), cell_margin(c)),
+        (Some(c), _) if cell_margin(c) >= 1.0 => found(waves_of_cell(c), cell_margin(c)),
         (_, Some(r)) if ridge_margin(r) >= 1.0 => found(vec![Wave::new(r.period, r.angle)], ridge_margin(r)),
         _ => None,
     };
@@ -163,7 +163,7 @@ fn best_of(a: &Autocorrelation, inside: &(dyn Fn(f64, f64) -> bool + Sync)) -> (
                 r
             }
         });
-    let cell_inside = |c: &Cell| waves_of_cell(c, 1.0).iter().all(|w| inside(w.period(), w.angle_deg()));
+    let cell_inside = |c: &Cell| waves_of_cell(c).iter().all(|w| inside(w.period(), w.angle_deg()));
     let mut rough = a.cells();
     rough.sort_by(|x, y| cell_margin(y).total_cmp(&cell_margin(x)));
     rough.truncate(RESCORED);
@@ -181,9 +181,9 @@ fn best_of(a: &Autocorrelation, inside: &(dyn Fn(f64, f64) -> bool + Sync)) -> (
     (ridge, cell)
 }
 
-/// A cell's two waves (its vectors times `scale`).
-fn waves_of_cell(c: &Cell, scale: f64) -> Vec<Wave> {
-    let [t1, t2] = [c.t1, c.t2].map(|t| [t[1] * scale, t[0] * scale]);
+/// A cell's two waves.
+fn waves_of_cell(c: &Cell) -> Vec<Wave> {
+    let [t1, t2] = [c.t1, c.t2].map(|t| [t[1], t[0]]);
     super::choice::waves_of(&[t1, t2], u32::MAX).unwrap_or_default()
 }
 

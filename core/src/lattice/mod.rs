@@ -233,7 +233,7 @@ pub const MIN_ANGLE: f64 = 20.0;
 pub const PHASE_TOLERANCE: f64 = 0.75;
 
 /// The shortest basis of the lattice spanned by `u, v` (Lagrange–Gauss reduction).
-fn reduce(mut u: [f64; 2], mut v: [f64; 2]) -> [[f64; 2]; 2] {
+pub(super) fn reduce(mut u: [f64; 2], mut v: [f64; 2]) -> [[f64; 2]; 2] {
     let dot = |a: [f64; 2], b: [f64; 2]| a[0] * b[0] + a[1] * b[1];
     for _ in 0..64 {
         if dot(u, u) > dot(v, v) {

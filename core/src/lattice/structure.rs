@@ -125,16 +125,6 @@ impl Structure {
             None => Structure { scores: Some(scores), ..lattice },
         }
     }
-
-    /// The lattice the modes keep, as a detection reports it, when the class is `lattice`; for
-    /// `exact`, the one inside its tile.
-    pub fn kept(&self) -> Option<&Structure> {
-        match self.class {
-            Class::Lattice => Some(self),
-            Class::Exact => self.inner.as_deref().filter(|s| s.class == Class::Lattice),
-            Class::None => None,
-        }
-    }
 }
 
 /// A lattice (or none) as a structure without scores.

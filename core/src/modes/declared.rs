@@ -202,7 +202,7 @@ pub trait Declared: Clone + std::fmt::Debug + PartialEq + Eq + std::hash::Hash +
 ///             spec ITERATIONS = "iterations", Kind::Integer { min: 0, max: 64 }, Request, "help" }
 ///         pub period: Option<i64> { default: None, canonical: ";period=", period }
 ///     }
-///     check(p, src) { p.validate(src.longer_side()) }
+///     check(p, src) { p.validate(src.exemplar.size().longer()) }
 /// }
 /// ```
 #[macro_export]

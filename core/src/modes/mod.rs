@@ -137,11 +137,6 @@ impl<'a> Source<'a> {
         }
     }
 
-    /// The exemplar's longer side (what parameters bounded by the exemplar's size compare with).
-    pub fn longer_side(&self) -> u32 {
-        self.exemplar.size().longer()
-    }
-
     /// `L = ⌈log2 max(w, h)⌉`: the native zoom and finest level.
     pub fn levels(&self) -> u32 {
         self.exemplar.levels()
@@ -626,7 +621,7 @@ impl Defaults {
                 MODE_NAMES.join(", ")
             ))
         })?;
-        let common = Common::read(&mut r, src.longer_side())?;
+        let common = Common::read(&mut r, src.exemplar.size().longer())?;
         let p = base.parse(&common, &mut r, src)?;
         r.finish(&mode, &all_specs())?;
         Ok(p)

@@ -225,7 +225,7 @@ pub const NAME: ParamSpec =
 /// `toroidal`: whether the exemplar wraps around.
 pub const TOROIDAL: ParamSpec = ParamSpec {
     name: "toroidal",
-    kind: Kind::Choice(&["auto", "true", "false", "synthesize"]),
+    kind: Kind::Choice(&textile_core::recipe::TOROIDAL_VALUES),
     scope: Scope::Texture,
     help: "whether the exemplar wraps around (auto: detected; synthesize: replaced by a seamless one made from it)",
 };

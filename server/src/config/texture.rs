@@ -117,6 +117,7 @@ impl TextureConfig {
         if !valid_id(&self.id) {
             return bad(format!("{at}.id"), format!("'{}' must be 1-64 of a-z 0-9 _ -", clip(&self.id)));
         }
+        let wraps = self.toroidal.with_lattice(&self.lattice);
         match (self.exemplar.is_empty(), &self.exemplar_hires) {
             (false, Some(_)) => {
                 return bad(format!("{at}.exemplar_hires"), "replaces exemplar: give one of the two".into())
@@ -127,10 +128,7 @@ impl TextureConfig {
                     "\"synthesize\" remakes the exemplar, which randomness_mask could no longer follow".into(),
                 )
             }
-            _ if self.toroidal.with_lattice(&self.lattice).is_err() => {
-                let message = self.toroidal.with_lattice(&self.lattice).err().unwrap_or_default();
-                return bad(format!("{at}.toroidal"), message.into());
-            }
+            _ if let Err(message) = wraps => return bad(format!("{at}.toroidal"), message.into()),
             (true, Some(_)) if self.toroidal == Toroidal::Synthesize => {
                 return bad(
                     format!("{at}.toroidal"),

@@ -208,7 +208,7 @@ fn parameters(t: &Texture) -> Value {
     let default_params = t.defaults.get(t.defaults.mode).map(|p| p.values(&src)).unwrap_or_default();
     out[SEED.name]["default"] = default_params.get("seed").cloned().unwrap_or(Value::Null);
     out[WORLD.name]["default"] = Value::Null;
-    out[WORLD.name]["min"] = json!(((src.longer_side() as i64 + TILE_SIZE - 1) / TILE_SIZE).max(1));
+    out[WORLD.name]["min"] = json!(((src.exemplar.size().longer() as i64 + TILE_SIZE - 1) / TILE_SIZE).max(1));
     for info in textile_core::modes::all() {
         let values = t.defaults.get(info.name).map(|p| p.values(&src)).unwrap_or_default();
         for spec in info.specs.iter().filter(|s| s.scope == Scope::Request) {

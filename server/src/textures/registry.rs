@@ -2,6 +2,7 @@
 //! every change; [`prepare_registry`] decodes every exemplar (modes that need only the exemplar
 //! serve from then on).
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -63,15 +64,16 @@ pub fn prepare_texture(
     log: &dyn Fn(String),
 ) -> Result<Texture, LoadError> {
     let mask = t.randomness_mask.as_deref().map(|path| image_bytes(cfg, t, path)).transpose()?;
-    let mut maps: Vec<(&str, &str, Vec<u8>)> = Vec::new();
+    // An upload's maps come with their bytes; the others are read from their files.
+    let mut maps: Vec<(&str, &str, Cow<[u8]>)> = Vec::new();
     for (name, image) in t.map_images() {
         let bytes = match given.iter().find(|(n, _)| n == name) {
-            Some((_, b)) => b.clone(),
-            None => image_bytes(cfg, t, image)?,
+            Some((_, b)) => Cow::Borrowed(b.as_slice()),
+            None => Cow::Owned(image_bytes(cfg, t, image)?),
         };
         maps.push((name, image, bytes));
     }
-    let maps: Vec<(&str, &str, &[u8])> = maps.iter().map(|(n, i, b)| (*n, *i, b.as_slice())).collect();
+    let maps: Vec<(&str, &str, &[u8])> = maps.iter().map(|(n, i, b)| (*n, *i, b.as_ref())).collect();
     let images = Images { exemplar: bytes, mask: mask.as_deref(), maps: &maps };
     let ex = t
         .recipe(cfg.max_exemplar_side)

@@ -28,7 +28,7 @@ crate::declare_params! {
         /// Accepted like every mode's; the tiling repeats at the exemplar's own size.
         pub period: Option<i64> { default: None, canonical: none, period }
     }
-    check(p, src) { check_period(p.period, src.longer_side()) }
+    check(p, src) { check_period(p.period, src.exemplar.size().longer()) }
 }
 
 impl Mode for Tiling {

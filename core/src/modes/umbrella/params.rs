@@ -66,5 +66,5 @@ crate::declare_params! {
         /// Period in texels (power of two ≥ the exemplar side): an arrangement on a torus.
         pub period: Option<i64> { default: None, canonical: ";period=", period }
     }
-    check(p, src) { check_period(p.period, src.longer_side()) }
+    check(p, src) { check_period(p.period, src.exemplar.size().longer()) }
 }
