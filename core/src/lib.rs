@@ -56,6 +56,7 @@ pub mod files;
 pub mod geom;
 pub mod hash;
 pub mod image;
+pub mod landscape;
 pub mod lattice;
 pub mod maps;
 pub mod mask;

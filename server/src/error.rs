@@ -60,6 +60,11 @@ impl ApiError {
     pub fn bad_request(code: &'static str, message: impl Into<String>) -> Self {
         Self::new(Kind::BadRequest, code, message)
     }
+    /// The same answer, its message starting with `prefix` (saying where it arose).
+    pub fn prefixed(mut self, prefix: &str) -> Self {
+        self.message = format!("{prefix}{}", self.message);
+        self
+    }
     /// No route for a path.
     pub fn not_found_route(path: &str) -> Self {
         Self::new(Kind::NotFound, "not_found", format!("no route for '{}'; see /openapi.json", clip(path)))

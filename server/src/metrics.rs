@@ -10,6 +10,9 @@ use textile_core::PyramidStats;
 
 /// Label under which glTF documents are counted in the per-mode metrics, besides the modes.
 pub const GLTF_LABEL: &str = "gltf";
+/// Label under which landscapes' images are counted in the per-mode metrics (their layers'
+/// syntheses happen inside them).
+pub const LANDSCAPE_LABEL: &str = "landscape";
 
 /// Every metric of the service.
 pub struct Metrics {

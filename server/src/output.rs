@@ -14,7 +14,8 @@ use axum::body::Bytes;
 use textile_core::Pyramid;
 
 use crate::error::ApiError;
-use crate::metrics::GLTF_LABEL;
+use crate::metrics::{GLTF_LABEL, LANDSCAPE_LABEL};
+use crate::pipeline::landscape::LandscapeJob;
 use crate::pipeline::{self, etag_for, ImageJob};
 use crate::scene::assets::{glb, gltf_json, x3d, Relief, Slot};
 use crate::scene::model::{generator, material_images, Model};
@@ -25,6 +26,8 @@ use crate::state::AppState;
 pub enum Output {
     /// An image: a tile or window of the colour, a material map or the coordinates.
     Image(ImageJob),
+    /// A landscape's image: its layers' images joined.
+    Landscape(LandscapeJob),
     /// A GLB: a tile's textured quad with its material and, with `relief`, its displaced mesh;
     /// or a patch's quads, one node per tile.
     Glb(Model),
@@ -58,6 +61,7 @@ impl Output {
     pub fn key(&self) -> String {
         match self {
             Output::Image(job) => job.key(),
+            Output::Landscape(job) => job.key(),
             Output::Glb(m) if m.tiles > 1 => m.key("patch", &m.tiles.to_string()),
             Output::Glb(m) => {
                 let relief = m.relief.map(|v| format!("|relief={v}")).unwrap_or_default();
@@ -84,6 +88,7 @@ impl Output {
     pub fn content_type(&self) -> &'static str {
         match self {
             Output::Image(job) => job.format().content_type(),
+            Output::Landscape(job) => job.format().content_type(),
             Output::Glb(_) => "model/gltf-binary",
             Output::Gltf { .. } => "model/gltf+json",
             Output::MaterialImage { .. } => "image/png",
@@ -94,13 +99,13 @@ impl Output {
     /// Whether its bytes are kept in the tile cache under its ETag (images and GLBs, which are
     /// work to make; documents are assembled afresh).
     fn kept(&self) -> bool {
-        matches!(self, Output::Image(_) | Output::Glb(_))
+        matches!(self, Output::Image(_) | Output::Landscape(_) | Output::Glb(_))
     }
 
     /// The images it is assembled from, in the order [`Output::assemble`] takes them.
     pub fn parts(&self) -> Vec<ImageJob> {
         match self {
-            Output::Image(_) | Output::Gltf { .. } | Output::X3d { .. } => Vec::new(),
+            Output::Image(_) | Output::Landscape(_) | Output::Gltf { .. } | Output::X3d { .. } => Vec::new(),
             Output::Glb(m) if m.tiles > 1 => m.tile_specs().map(|t| m.image_at(t)).collect(),
             Output::Glb(m) => {
                 let mut parts = vec![m.image()];
@@ -118,7 +123,7 @@ impl Output {
     pub fn assemble(&self, mut parts: Vec<Vec<u8>>) -> Result<Vec<u8>, ApiError> {
         let encode = |doc: &serde_json::Value| serde_json::to_vec(doc).map_err(|e| ApiError::internal(e.to_string()));
         match self {
-            Output::Image(_) => Err(ApiError::internal("an image is rendered, not assembled")),
+            Output::Image(_) | Output::Landscape(_) => Err(ApiError::internal("an image is rendered, not assembled")),
             Output::Glb(m) if m.tiles > 1 => {
                 let quads: Vec<_> = m.tile_specs().map(|t| m.quad(&t)).collect();
                 let images: Vec<(Vec<u8>, &str)> = parts.into_iter().map(|p| (p, "image/png")).collect();
@@ -167,8 +172,10 @@ impl Output {
 
     /// Its bytes made here and now (no tile cache, no pool): what `textile render` writes.
     pub fn bytes(&self, cache: &Pyramid) -> Result<Vec<u8>, ApiError> {
-        if let Output::Image(job) = self {
-            return Ok(job.bytes(cache)?.0);
+        match self {
+            Output::Image(job) => return Ok(job.bytes(cache)?.0),
+            Output::Landscape(job) => return job.bytes(cache, &textile_core::Cancel::default()),
+            _ => {}
         }
         let parts = self.parts().iter().map(|job| Ok(job.bytes(cache)?.0)).collect::<Result<Vec<_>, ApiError>>()?;
         self.assemble(parts)
@@ -188,9 +195,14 @@ impl Output {
 /// way (so shared with the image tiles that show them), assembled on the synthesis pool and
 /// kept in the tile cache where it is work to make. `etag` is the output's [`Output::etag`].
 pub async fn produce(st: &Arc<AppState>, etag: &str, out: Output) -> (Result<Bytes, ApiError>, bool) {
-    if let Output::Image(job) = out {
-        return pipeline::produce(st, etag, job).await;
-    }
+    let out = match out {
+        Output::Image(job) => return pipeline::produce(st, etag, job).await,
+        Output::Landscape(job) => {
+            let pyramid = st.pyramid.clone();
+            return pipeline::cached(st, etag, LANDSCAPE_LABEL, move |cancel| job.bytes(&pyramid, cancel)).await;
+        }
+        out => out,
+    };
     if out.kept() {
         if let Some(b) = st.cache.peek(etag) {
             return (Ok(b), true);

@@ -12,7 +12,7 @@ use textile_core::{ModeParams, ParamReader};
 
 use crate::encode::Format;
 use crate::error::ApiError;
-use crate::textures::Texture;
+use crate::textures::{Texture, Zooms};
 
 /// Smallest tile coordinate.
 pub const COORD_MIN: i64 = -(1 << 31);
@@ -143,12 +143,17 @@ pub fn split_format(s: &str) -> Result<(&str, Format), ApiError> {
 
 /// Parse `z`, `x` and `y[@2x].fmt` path segments for a texture.
 pub fn parse_tile(tex: &Texture, z: &str, x: &str, y_fmt: &str) -> Result<TileSpec, ApiError> {
+    parse_tile_in(tex.zooms(), z, x, y_fmt)
+}
+
+/// Parse `z`, `x` and `y[@2x].fmt` path segments within `zooms`.
+pub fn parse_tile_in(zooms: Zooms, z: &str, x: &str, y_fmt: &str) -> Result<TileSpec, ApiError> {
     let (y, format) = split_format(y_fmt)?;
     let (y, scale) = match y.strip_suffix("@2x") {
         Some(y) => (y, 2),
         None => (y, 1),
     };
-    let z = parse_int("z", z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32;
+    let z = parse_int("z", z, zooms.min as i64, zooms.max as i64)? as u32;
     let x = parse_int("x", x, COORD_MIN, COORD_MAX)?;
     let y = parse_int("y", y, COORD_MIN, COORD_MAX)?;
     Ok(TileSpec { z, x, y, scale, format })
@@ -173,13 +178,18 @@ pub struct WindowSpec {
 
 /// Take a window's geometry (`x`, `y`, `w`, `h`, optional `z`) from a query.
 pub fn parse_window(tex: &Texture, r: &mut ParamReader, format: Format) -> Result<WindowSpec, ApiError> {
+    parse_window_in(tex.zooms(), r, format)
+}
+
+/// Take a window's geometry (`x`, `y`, `w`, `h`, optional `z`) within `zooms` from a query.
+pub fn parse_window_in(zooms: Zooms, r: &mut ParamReader, format: Format) -> Result<WindowSpec, ApiError> {
     let mut need = |k: &str| {
         r.take(k).ok_or_else(|| ApiError::bad_request("missing_parameter", format!("parameter '{k}' is required")))
     };
     let (x, y, w, h) = (need("x")?, need("y")?, need("w")?, need("h")?);
     let z = match r.take("z") {
-        Some(z) => parse_int("z", &z, tex.min_zoom() as i64, tex.max_zoom() as i64)? as u32,
-        None => tex.native_zoom(),
+        Some(z) => parse_int("z", &z, zooms.min as i64, zooms.max as i64)? as u32,
+        None => zooms.native,
     };
     let x = parse_int("x", &x, -MAX_WINDOW_COORD, MAX_WINDOW_COORD)?;
     let y = parse_int("y", &y, -MAX_WINDOW_COORD, MAX_WINDOW_COORD)?;

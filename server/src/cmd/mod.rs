@@ -123,6 +123,7 @@ pub(crate) fn configured_texture(c: &ConfigArgs, id: &str) -> Result<Arc<Texture
     let cfg = crate::uploads::with_stored(&Config::load(c.config.as_deref(), &overrides)?, &|s| eprintln!("{s}"));
     let mut only = cfg.clone();
     only.textures.retain(|t| t.id == id);
+    only.landscapes.clear();
     if only.textures.is_empty() {
         let ids: Vec<_> = cfg.textures.iter().map(|t| t.id.as_str()).collect();
         return Err(format!("no texture '{id}'; configured: {}", ids.join(", ")).into());
@@ -130,6 +131,21 @@ pub(crate) fn configured_texture(c: &ConfigArgs, id: &str) -> Result<Arc<Texture
     let _ = exemplar_bytes(&only, &only.textures[0])?;
     let reg = load_registry(&only, &|s| eprintln!("{s}"))?;
     Ok(reg.list[0].clone())
+}
+
+/// The configured landscape `id` with the textures it is made of, analysed; `None` if `id` is
+/// no landscape.
+pub(crate) fn configured_landscape(
+    c: &ConfigArgs,
+    id: &str,
+) -> Result<Option<Arc<crate::textures::Landscape>>, Box<dyn std::error::Error>> {
+    let cfg = Config::load(c.config.as_deref(), &c.overrides(None))?;
+    let Some(l) = cfg.landscapes.iter().find(|l| l.id == id) else { return Ok(None) };
+    let mut only = cfg.clone();
+    only.textures.retain(|t| l.layers.iter().any(|y| y.texture == t.id));
+    only.landscapes.retain(|m| m.id == id);
+    let reg = load_registry(&only, &|s| eprintln!("{s}"))?;
+    Ok(reg.landscape(id).cloned())
 }
 
 /// The `--param KEY=VALUE` pairs and the flags, as query pairs.

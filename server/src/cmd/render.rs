@@ -13,14 +13,15 @@ use textile_core::samples::{self, camera::GroundCamera, Footprint};
 use textile_core::{Analysis, Cancel, ModeParams, ParamReader, Pyramid};
 
 use super::args::{CliResult, RenderArgs};
-use super::{configured_texture, output_format, param_pairs};
+use super::{configured_landscape, configured_texture, output_format, param_pairs};
 use crate::config::TextureConfig;
 use crate::encode::{encode, Effort, Format};
 use crate::output::Output;
+use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::scene::model::Model;
-use crate::textures::Texture;
+use crate::textures::{Landscape, Texture};
 
 /// `textile render --sheet`: a picture of what the mode prepared for the texture.
 fn sheet(tex: &Texture, params: &ModeParams, output: &Path) -> CliResult {
@@ -79,6 +80,11 @@ pub fn run(a: RenderArgs) -> CliResult {
         };
     }
     let output = a.output.clone().ok_or("--output is required")?;
+    if a.exemplar.is_none() {
+        if let Some(land) = configured_landscape(&a.config, a.texture.as_deref().unwrap_or_default())? {
+            return render_landscape(&a, land, &output);
+        }
+    }
     let tex: Arc<Texture> = if let Some(path) = &a.exemplar {
         let ex = a.recipe.make(path)?;
         let an = Analysis::try_build_with(&ex, a.recipe.index, &textile_core::NoProgress, &Cancel::new())?;
@@ -162,6 +168,42 @@ pub fn run(a: RenderArgs) -> CliResult {
     let (bytes, r) = ImageJob { tex, params, target, map }.bytes(&Pyramid::off())?;
     write_atomic(&output, &bytes)?;
     println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
+    Ok(())
+}
+
+/// `textile render --texture LANDSCAPE`: a tile or window of a landscape, the bytes the server
+/// serves for it.
+fn render_landscape(a: &RenderArgs, land: Arc<Landscape>, output: &Path) -> CliResult {
+    if a.sheet || a.camera.is_some() || a.mode.is_some() || !a.params.is_empty() || a.controls.is_some() {
+        return Err("a landscape renders tiles and windows with --seed, --world and --map only (its layers' \
+                    parameters are in its configuration)"
+            .into());
+    }
+    let format = output_format(output)?;
+    let z = a.z.unwrap_or(land.native_zoom);
+    if !(land.min_zoom..=land.max_zoom).contains(&z) {
+        return Err(format!("--z {z} is outside {}..={}", land.min_zoom, land.max_zoom).into());
+    }
+    let target = match &a.window {
+        Some(win) => {
+            let v: Vec<i64> = win
+                .split(',')
+                .map(|s| s.trim().parse::<i64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| "--window must be X,Y,W,H integers")?;
+            let [x, y, w, h] = v[..] else { return Err("--window must be X,Y,W,H".into()) };
+            Target::Window(WindowSpec { z, x, y, w, h, format })
+        }
+        None => Target::Tile(TileSpec { z, x: a.x.unwrap_or(0), y: a.y.unwrap_or(0), scale: 1, format }),
+    };
+    let mut pairs = param_pairs(&[], &None, a.seed, a.world)?;
+    pairs.push(("map".into(), a.map.clone()));
+    let mut r = ParamReader::request(pairs)?;
+    let map = LandscapeMap::read(&land, &mut r, format)?;
+    let job = LandscapeJob::new(land, target, map, r)?;
+    let bytes = Output::Landscape(job).bytes(&Pyramid::new(64 << 20))?;
+    write_atomic(output, &bytes)?;
+    println!("wrote {} (landscape, {} bytes)", output.display(), bytes.len());
     Ok(())
 }
 

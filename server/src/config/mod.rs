@@ -8,9 +8,11 @@ use figment::providers::{Env, Format, Serialized, Toml};
 use figment::Figment;
 use serde::{Deserialize, Serialize};
 
+mod landscape;
 pub mod settings;
 mod texture;
 
+pub use landscape::{parse_colour, BlendConfig, LandscapeConfig, LayerConfig, SplatConfig, SCALE_RANGE};
 pub use texture::{valid_id, TextureConfig, Toroidal, NORMAL_CONVENTION};
 
 /// The built-in layers: every setting's declared default, then `config/textile.toml`.
@@ -115,6 +117,9 @@ pub struct Config {
     pub access_log_buffer: usize,
     /// Served textures.
     pub textures: Vec<TextureConfig>,
+    /// Served landscapes: configured textures composed into one ground.
+    #[serde(default)]
+    pub landscapes: Vec<LandscapeConfig>,
     /// Directory relative exemplar paths are resolved against (set by the loader).
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -171,9 +176,22 @@ impl Config {
                 t.name = t.id.clone();
             }
         }
+        for l in &mut cfg.landscapes {
+            if l.name.is_empty() {
+                l.name = l.id.clone();
+            }
+        }
+        let builtin: Config =
+            built_in().extract().map_err(|e| ConfigError(format!("the built-in configuration: {e}")))?;
+        // The built-in landscapes stay where the textures they are made of do.
+        if cfg.landscapes == builtin.landscapes {
+            let ids: Vec<&str> = cfg.textures.iter().map(|t| t.id.as_str()).collect();
+            let builtin_ids: Vec<&str> = builtin.textures.iter().map(|t| t.id.as_str()).collect();
+            if !(cfg.include_default_textures || ids == builtin_ids) {
+                cfg.landscapes.clear();
+            }
+        }
         if cfg.include_default_textures {
-            let builtin: Config =
-                built_in().extract().map_err(|e| ConfigError(format!("the built-in configuration: {e}")))?;
             let mine: Vec<String> = cfg.textures.iter().map(|t| t.id.clone()).collect();
             let mut all: Vec<TextureConfig> = builtin.textures.into_iter().filter(|t| !mine.contains(&t.id)).collect();
             all.append(&mut cfg.textures);
@@ -227,6 +245,24 @@ impl Config {
             if !seen.insert(&t.id) {
                 return bad(&format!("textures[{i}].id"), format!("'{}' is used twice", t.id));
             }
+        }
+        let ids: Vec<&str> = self.textures.iter().map(|t| t.id.as_str()).collect();
+        let landscape_ids: Vec<&str> = self.landscapes.iter().map(|l| l.id.as_str()).collect();
+        for (i, l) in self.landscapes.iter().enumerate() {
+            let at = format!("landscapes[{i}]");
+            if !seen.insert(&l.id) {
+                return bad(
+                    &format!("{at}.id"),
+                    format!("'{}' is used twice (texture and landscape ids are one space)", l.id),
+                );
+            }
+            if let Some(j) = l.layers.iter().position(|y| landscape_ids.contains(&y.texture.as_str())) {
+                return bad(
+                    &format!("{at}.layers[{j}].texture"),
+                    format!("landscape '{}': '{}' is a landscape; a layer is a texture", l.id, l.layers[j].texture),
+                );
+            }
+            l.validate(&at, &ids).map_err(|(key, msg)| ConfigError(format!("key '{key}': {msg}")))?;
         }
         Ok(())
     }
@@ -288,6 +324,7 @@ mod tests {
         assert_eq!(cfg.textures[4].map_images().count(), 3, "the flagstones material");
         assert_eq!(cfg.bind, "127.0.0.1:8080");
         assert_eq!(cfg.textures[3].lattice, textile_core::lattice::LatticeChoice::Cells(2, 4));
+        assert_eq!(cfg.landscapes.len(), 1, "the meadow, of the built-in textures");
     }
 
     #[test]

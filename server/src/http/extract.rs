@@ -18,6 +18,18 @@ use crate::textures::{Registry, Texture};
 
 /// The texture with `id`, or a 404 naming the available ones.
 pub fn texture(reg: &Registry, id: &str) -> Result<Arc<Texture>, ApiError> {
+    if reg.landscape(id).is_some() {
+        return Err(ApiError::new(
+            crate::error::Kind::NotFound,
+            "landscape_not_served_here",
+            format!(
+                "'{}' is a landscape: it is served as tiles, windows, TileJSON and its description \
+                 (/textures/{}); this endpoint serves textures",
+                textile_core::error::clip(id),
+                textile_core::error::clip(id)
+            ),
+        ));
+    }
     reg.get(id).cloned().ok_or_else(|| {
         let known: Vec<String> = reg.list.iter().map(|t| t.config.id.clone()).collect();
         ApiError::unknown_texture(id, &known)

@@ -1,4 +1,5 @@
-//! Image endpoints: tiles (`/tiles/{id}/{z}/{x}/{y}.{fmt}`) and windows (`/windows/{id}.{fmt}`).
+//! Image endpoints: tiles (`/tiles/{id}/{z}/{x}/{y}.{fmt}`) and windows (`/windows/{id}.{fmt}`),
+//! of textures and of landscapes.
 //! Each validates its request into an [`ImageJob`] and answers it as an [`Output`] (`If-None-Match`
 //! without rendering, else the bytes through the pipeline). The mode parameters accepted
 //! in the query are documented from the modes' specs (see `http::openapi`).
@@ -14,8 +15,11 @@ use crate::error::ApiError;
 use crate::http::content::answer;
 use crate::http::extract::{path_error, texture};
 use crate::output::Output;
+use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
 use crate::pipeline::{ImageJob, Target};
-use crate::request::{map_choice, params, parse_tile, parse_window, query_reader, split_format};
+use crate::request::{
+    map_choice, params, parse_tile, parse_tile_in, parse_window, parse_window_in, query_reader, split_format,
+};
 use crate::state::AppState;
 
 /// A tile of the infinite texture.
@@ -38,6 +42,13 @@ pub async fn tile(
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path((id, z, x, y)) = path.map_err(path_error)?;
+    if let Some(land) = reg.landscape(&id) {
+        let spec = parse_tile_in(land.zooms(), &z, &x, &y)?;
+        let mut r = query_reader(q.as_deref())?;
+        let map = LandscapeMap::read(land, &mut r, spec.format)?;
+        let job = LandscapeJob::new(land.clone(), Target::Tile(spec), map, r)?;
+        return answer(&st, &headers, Output::Landscape(job)).await;
+    }
     let tex = texture(&reg, &id)?;
     let spec = parse_tile(&tex, &z, &x, &y)?;
     let mut r = query_reader(q.as_deref())?;
@@ -65,6 +76,13 @@ pub async fn window(
     let reg = st.ready()?;
     let Path(file) = path.map_err(path_error)?;
     let (id, fmt) = split_format(&file)?;
+    if let Some(land) = reg.landscape(id) {
+        let mut r = query_reader(q.as_deref())?;
+        let spec = parse_window_in(land.zooms(), &mut r, fmt)?;
+        let map = LandscapeMap::read(land, &mut r, fmt)?;
+        let job = LandscapeJob::new(land.clone(), Target::Window(spec), map, r)?;
+        return answer(&st, &headers, Output::Landscape(job)).await;
+    }
     let tex = texture(&reg, id)?;
     let mut r = query_reader(q.as_deref())?;
     let spec = parse_window(&tex, &mut r, fmt)?;

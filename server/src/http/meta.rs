@@ -84,7 +84,20 @@ pub async fn catalog(State(st): State<Arc<AppState>>, headers: HeaderMap, peer: 
             })
         })
         .collect();
-    Ok(Json(json!({ "textures": textures, "uploads": !st.config.admin_token.is_empty() })))
+    let landscapes: Vec<Value> = reg
+        .landscapes
+        .iter()
+        .map(|l| {
+            let id = &l.config.id;
+            json!({
+                "id": id, "name": l.config.name, "kind": "landscape", "status": l.status().0.as_str(),
+                "layers": l.layers.iter().map(|y| y.tex.config.id.clone()).collect::<Vec<_>>(),
+                "tilejson": format!("{base}/tiles/{id}/tilejson.json"),
+                "description": format!("{base}/textures/{id}"),
+            })
+        })
+        .collect();
+    Ok(Json(json!({ "textures": textures, "landscapes": landscapes, "uploads": !st.config.admin_token.is_empty() })))
 }
 
 /// What each mode prepared for a texture, by mode: its description, with `what` it is and the
@@ -118,6 +131,9 @@ pub async fn texture_meta(
 ) -> Result<Json<Value>, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
+    if let Some(l) = reg.landscape(&id) {
+        return Ok(Json(crate::textures::landscape::describe(l)));
+    }
     let t = texture(&reg, &id)?;
     let (ex, prep) = (&t.exemplar, &t.exemplar.preparation);
     let analysis = match (t.analysis(), t.file_hash()) {
@@ -255,6 +271,17 @@ pub async fn exemplar(
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
+    if reg.landscape(&id).is_some() {
+        return Err(ApiError::new(
+            crate::error::Kind::NotFound,
+            "no_exemplar",
+            format!(
+                "'{}' is a landscape: it has no exemplar (its layers' textures do: see /textures/{})",
+                clip(&id),
+                clip(&id)
+            ),
+        ));
+    }
     let t = texture(&reg, &id)?;
     let mut r = t.exemplar_png.clone().into_response();
     r.headers_mut().insert(header::CONTENT_TYPE, HeaderValue::from_static("image/png"));
@@ -327,7 +354,6 @@ pub async fn tilejson(
 ) -> Result<Json<Value>, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let t = texture(&reg, &id)?;
     let q = query_pairs(raw.as_deref());
     // A caller's `v` (e.g. busting its own cache of this document) is carried into the tiles'
     // version after the server's, which still changes with the analysis and engine.
@@ -338,6 +364,47 @@ pub async fn tilejson(
             format!("parameter 'v': at most {MAX_CALLER_V} characters"),
         ));
     }
+    let base = base_url(&st, &headers, peer);
+    if let Some(l) = reg.landscape(&id) {
+        // Checked as its tiles' queries are (a layer not ready answers 503 as they do).
+        let mut r = textile_core::ParamReader::request(q.clone())?;
+        crate::pipeline::landscape::LandscapeMap::read(l, &mut r, Format::Png)?;
+        let target = crate::pipeline::Target::Tile(crate::request::TileSpec {
+            z: l.native_zoom,
+            x: 0,
+            y: 0,
+            scale: 1,
+            format: Format::Png,
+        });
+        crate::pipeline::landscape::LandscapeJob::new(
+            l.clone(),
+            target,
+            crate::pipeline::landscape::LandscapeMap::Albedo,
+            r,
+        )?;
+        let layers: Vec<String> = l
+            .layers
+            .iter()
+            .map(|y| format!("{}|{}", y.tex.file_hash().unwrap_or("analysing"), y.tex.defaults.canonical()))
+            .collect();
+        let version = blake3::hash(format!("{}|{}|{}", engine_version(), l.hash, layers.join("|")).as_bytes());
+        // A world-wrapping client needs the splat to repeat; a painted one shown once cannot.
+        let world = l.splat.check_period(TILE_SIZE << l.native_zoom).is_ok();
+        let doc = Document {
+            id: &id,
+            name: &l.config.name,
+            attribution: &l.config.attribution,
+            version: &version.to_hex()[..12],
+            zooms: l.zooms(),
+            world,
+        };
+        let textile = json!({
+            "landscape": id, "native_zoom": l.native_zoom,
+            "layers": l.layers.iter().map(|y| y.tex.config.id.clone()).collect::<Vec<_>>(),
+        });
+        return Ok(Json(doc.tilejson(&base, q, caller_v, textile)));
+    }
+    let t = texture(&reg, &id)?;
     params(&t, textile_core::ParamReader::request(q.clone())?)?;
     // Everything that decides a tile's bytes besides its own request: engine, analysis, and the
     // texture's configured defaults of every mode with the modes' versions (a changed default
@@ -346,42 +413,69 @@ pub async fn tilejson(
     let file_hash = t.file_hash().unwrap_or("analysing");
     let version =
         &blake3::hash(format!("{}|{file_hash}|{}", engine_version(), t.defaults.canonical()).as_bytes()).to_hex()[..12];
-    let mut qs = form_urlencoded::Serializer::new(String::new());
-    match &caller_v {
-        Some(cv) => qs.append_pair("v", &format!("{version}-{cv}")),
-        None => qs.append_pair("v", version),
+    let doc = Document {
+        id: &id,
+        name: &t.config.name,
+        attribution: &t.config.attribution,
+        version,
+        zooms: t.zooms(),
+        world: true,
     };
-    let mut q = q;
-    // TileJSON's bounds are the wrapped Web-Mercator world, which world-wrapping clients
-    // (MapLibre, OpenLayers) draw again past ±180°: unless the query names a period, the tiles
-    // repeat exactly once around it (`world` = 2^native tiles), so the date line is no seam.
-    if !q.iter().any(|(k, _)| k == "world") {
-        q.push(("world".to_string(), (1u64 << t.native_zoom()).to_string()));
+    let textile = json!({
+        "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.size().longer(),
+        "exemplar_width": t.exemplar.width, "exemplar_height": t.exemplar.height,
+        "magnified_zooms": t.max_zoom() - t.native_zoom(),
+    });
+    Ok(Json(doc.tilejson(&base, q, caller_v, textile)))
+}
+
+/// What a TileJSON document says of a texture or a landscape.
+struct Document<'a> {
+    id: &'a str,
+    name: &'a str,
+    attribution: &'a str,
+    /// The server's version of its tiles.
+    version: &'a str,
+    zooms: crate::textures::Zooms,
+    /// Whether its tiles may repeat around the Web-Mercator world.
+    world: bool,
+}
+
+impl Document<'_> {
+    /// TileJSON 3.0.0, the query carried into `tiles`, with `textile`'s own facts.
+    fn tilejson(&self, base: &str, mut q: Vec<(String, String)>, caller_v: Option<String>, textile: Value) -> Value {
+        let mut qs = form_urlencoded::Serializer::new(String::new());
+        match &caller_v {
+            Some(cv) => qs.append_pair("v", &format!("{}-{cv}", self.version)),
+            None => qs.append_pair("v", self.version),
+        };
+        // TileJSON's bounds are the wrapped Web-Mercator world, which world-wrapping clients
+        // (MapLibre, OpenLayers) draw again past ±180°: unless the query names a period, the
+        // tiles repeat exactly once around it (`world` = 2^native tiles), so the date line is
+        // no seam.
+        if self.world && !q.iter().any(|(k, _)| k == "world") {
+            q.push(("world".to_string(), (1u64 << self.zooms.native).to_string()));
+        }
+        q.sort();
+        for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
+            qs.append_pair(k, v);
+        }
+        json!({
+            "tilejson": "3.0.0",
+            "name": self.name,
+            "description": format!("Infinite example-based texture '{}' synthesized by textile", self.id),
+            "version": "1.0.0",
+            "attribution": self.attribution,
+            "scheme": "xyz",
+            "tiles": [format!("{base}/tiles/{}/{{z}}/{{x}}/{{y}}.png?{}", self.id, qs.finish())],
+            "minzoom": self.zooms.min,
+            "maxzoom": self.zooms.max,
+            "bounds": [-180.0, -85.051_128_779_806_59, 180.0, 85.051_128_779_806_59],
+            "center": [0.0, 0.0, self.zooms.native],
+            "tileSize": TILE_SIZE,
+            "textile": textile,
+        })
     }
-    q.sort();
-    for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
-        qs.append_pair(k, v);
-    }
-    let base = base_url(&st, &headers, peer);
-    Ok(Json(json!({
-        "tilejson": "3.0.0",
-        "name": t.config.name,
-        "description": format!("Infinite example-based texture '{}' synthesized by textile", t.config.id),
-        "version": "1.0.0",
-        "attribution": t.config.attribution,
-        "scheme": "xyz",
-        "tiles": [format!("{base}/tiles/{}/{{z}}/{{x}}/{{y}}.png?{}", t.config.id, qs.finish())],
-        "minzoom": t.min_zoom(),
-        "maxzoom": t.max_zoom(),
-        "bounds": [-180.0, -85.051_128_779_806_59, 180.0, 85.051_128_779_806_59],
-        "center": [0.0, 0.0, t.native_zoom()],
-        "tileSize": TILE_SIZE,
-        "textile": {
-            "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.size().longer(),
-            "exemplar_width": t.exemplar.width, "exemplar_height": t.exemplar.height,
-            "magnified_zooms": t.max_zoom() - t.native_zoom(),
-        },
-    })))
 }
 
 /// Prometheus metrics in the text exposition format.

@@ -7,6 +7,7 @@
 //! low-priority pool they run on), and [`lock`] (one server per data directory).
 
 pub mod analysing;
+pub mod landscape;
 pub mod lock;
 pub mod preparation;
 pub mod registry;
@@ -20,6 +21,7 @@ use textile_core::modes::Prepared;
 use textile_core::{Analysis, Cancel, Defaults, Exemplar, Source};
 
 use crate::config::TextureConfig;
+pub use landscape::Landscape;
 pub use preparation::{analyse_registry, analyse_texture, load_registry};
 pub use registry::{prepare_registry, prepare_texture, Registry};
 pub use storage::{embedded, exemplar_bytes, stored_extensions};
@@ -27,6 +29,17 @@ pub use storage::{embedded, exemplar_bytes, stored_extensions};
 /// Zoom steps served beyond native, magnified (design note §1.8); `@2x` tiles at the highest
 /// zoom are rendered one step further, within [`textile_core::modes::magnify::MAX_ZOOM_IN`].
 pub const MAGNIFY_STEPS: u32 = 3;
+
+/// The zooms a texture or landscape serves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Zooms {
+    /// Smallest.
+    pub min: u32,
+    /// Largest.
+    pub max: u32,
+    /// Native (one pixel per texel).
+    pub native: u32,
+}
 
 /// A texture ready to serve.
 pub struct Texture {
@@ -189,6 +202,10 @@ impl Texture {
     pub fn native_zoom(&self) -> u32 {
         self.exemplar.levels()
     }
+    /// The zooms it serves.
+    pub fn zooms(&self) -> Zooms {
+        Zooms { min: self.min_zoom(), max: self.max_zoom(), native: self.native_zoom() }
+    }
     /// Smallest zoom served.
     pub fn min_zoom(&self) -> u32 {
         0
@@ -249,6 +266,16 @@ pub enum LoadError {
         /// Texture id.
         id: String,
         /// What happened.
+        message: String,
+    },
+    /// A landscape cannot be made from its configuration.
+    #[error("landscape '{id}': key '{field}': {message}")]
+    Landscape {
+        /// Landscape id.
+        id: String,
+        /// The key at fault.
+        field: String,
+        /// What is wrong.
         message: String,
     },
     /// The exemplar or its analysis is unusable.

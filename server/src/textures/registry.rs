@@ -9,6 +9,7 @@ use std::sync::Arc;
 use textile_core::recipe::Images;
 
 use super::storage::{exemplar_bytes, image_bytes};
+use super::Landscape;
 use super::{LoadError, Texture};
 use crate::config::{Config, TextureConfig};
 
@@ -19,25 +20,39 @@ pub struct Registry {
     /// Textures in catalogue order.
     pub list: Vec<Arc<Texture>>,
     by_id: HashMap<String, Arc<Texture>>,
+    /// Landscapes in configuration order.
+    pub landscapes: Vec<Arc<Landscape>>,
 }
 
 impl Registry {
     /// A registry of these textures (ids unique).
     pub fn new(list: Vec<Arc<Texture>>) -> Self {
         let by_id = list.iter().map(|t| (t.config.id.clone(), t.clone())).collect();
-        Registry { list, by_id }
+        Registry { list, by_id, landscapes: Vec::new() }
+    }
+
+    /// This registry serving these landscapes too.
+    pub fn with_landscapes(mut self, landscapes: Vec<Arc<Landscape>>) -> Self {
+        self.landscapes = landscapes;
+        self
+    }
+
+    /// The landscape with this id.
+    pub fn landscape(&self, id: &str) -> Option<&Arc<Landscape>> {
+        self.landscapes.iter().find(|l| l.config.id == id)
     }
 
     /// This registry with `tex` added at the end.
     pub fn with(&self, tex: Arc<Texture>) -> Self {
         let mut list: Vec<_> = self.list.iter().filter(|t| t.config.id != tex.config.id).cloned().collect();
         list.push(tex);
-        Registry::new(list)
+        Registry::new(list).with_landscapes(self.landscapes.clone())
     }
 
     /// This registry without the texture `id`.
     pub fn without(&self, id: &str) -> Self {
         Registry::new(self.list.iter().filter(|t| t.config.id != id).cloned().collect())
+            .with_landscapes(self.landscapes.clone())
     }
 
     /// Uploaded textures in it.
@@ -103,5 +118,7 @@ pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, 
             Err(e) => return Err(e),
         }
     }
-    Ok(Registry::new(list))
+    let reg = Registry::new(list);
+    let landscapes = super::landscape::build_all(cfg, &reg)?;
+    Ok(reg.with_landscapes(landscapes))
 }

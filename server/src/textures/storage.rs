@@ -56,23 +56,32 @@ pub fn exemplar_bytes(cfg: &Config, t: &TextureConfig) -> Result<Vec<u8>, LoadEr
 
 /// Read the bytes of an image a texture config names (`embedded:NAME` or a path).
 pub(crate) fn image_bytes(cfg: &Config, t: &TextureConfig, image: &str) -> Result<Vec<u8>, LoadError> {
+    file_bytes(cfg, &t.id, image, MAX_EXEMPLAR_FILE)
+}
+
+/// Read the bytes of a file the configuration names for `id` (`embedded:NAME`, or a regular
+/// file relative to the configuration of at most `max` bytes).
+pub fn file_bytes(cfg: &Config, id: &str, image: &str, max: u64) -> Result<Vec<u8>, LoadError> {
     if let Some(name) = image.strip_prefix("embedded:") {
         return embedded(name)
             .map(|b| b.to_vec())
-            .ok_or_else(|| LoadError::NoEmbedded { id: t.id.clone(), name: name.into() });
+            .ok_or_else(|| LoadError::NoEmbedded { id: id.to_string(), name: name.into() });
     }
     let path = cfg.base_dir.join(image);
     // Regular files only (a FIFO or device would block the read or never end), of a bounded size.
-    let meta =
-        std::fs::metadata(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path: path.clone(), source })?;
-    let bad = |message: String| LoadError::NotAnImageFile { id: t.id.clone(), path: path.clone(), message };
+    let meta = std::fs::metadata(&path).map_err(|source| LoadError::Read {
+        id: id.to_string(),
+        path: path.clone(),
+        source,
+    })?;
+    let bad = |message: String| LoadError::NotAnImageFile { id: id.to_string(), path: path.clone(), message };
     if !meta.is_file() {
         return Err(bad("is not a regular file".into()));
     }
-    if meta.len() > MAX_EXEMPLAR_FILE {
-        return Err(bad(format!("is {} bytes; exemplar files are at most {MAX_EXEMPLAR_FILE}", meta.len())));
+    if meta.len() > max {
+        return Err(bad(format!("is {} bytes; at most {max} are read", meta.len())));
     }
-    std::fs::read(&path).map_err(|source| LoadError::Read { id: t.id.clone(), path, source })
+    std::fs::read(&path).map_err(|source| LoadError::Read { id: id.to_string(), path, source })
 }
 
 /// Largest exemplar file read (bytes): far beyond any accepted exemplar side, compressed.

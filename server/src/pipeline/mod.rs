@@ -3,7 +3,10 @@
 //! and ETag say everything that determines its bytes, whose [`ImageJob::bytes`] renders it
 //! (tiles and windows mapped onto a mode's view at the right zoom-out; `@2x` tiles one zoom-out
 //! less at twice the size, or each texel as 2×2 pixels at native zoom) and encodes it, and whose
-//! [`produce`] runs that through the tile cache (single flight) on the synthesis pool.
+//! [`produce`] runs that through the tile cache (single flight) on the synthesis pool. A
+//! landscape's image is a [`landscape::LandscapeJob`]: its layers' jobs, joined.
+
+pub mod landscape;
 
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -126,22 +129,9 @@ impl ImageJob {
         etag_for(&self.key())
     }
 
-    /// The view rendered, and whether it is upscaled 2× (`@2x` at native zoom, pixel-doubled
-    /// as it always was; `@2x` tiles at other zooms are rendered one zoom finer).
+    /// The view rendered, and whether it is upscaled 2× (see [`view_of`]).
     fn view(&self) -> (View, bool) {
-        let native = self.tex.native_zoom() as i64;
-        match self.target {
-            Target::Window(w) => (View::at(native - w.z as i64, Rect::new(w.x, w.y, w.w, w.h)), false),
-            Target::Tile(t) => {
-                let k = native - t.z as i64;
-                let (s, big) = (TILE_SIZE, 2 * TILE_SIZE);
-                match (t.scale, k) {
-                    (1, _) => (View::at(k, Rect::new(s * t.x, s * t.y, s, s)), false),
-                    (_, 0) => (View::native(Rect::new(s * t.x, s * t.y, s, s)), true),
-                    _ => (View::at(k - 1, Rect::new(big * t.x, big * t.y, big, big)), false),
-                }
-            }
-        }
+        view_of(self.target, self.tex.native_zoom())
     }
 
     /// Whether this is a big window (over [`PIECE`]² pixels): rendered in pieces, and admitted
@@ -239,6 +229,25 @@ impl ImageJob {
         let bytes = crate::encode::png_uv(&uv).map_err(|e| ApiError::internal(format!("encoding: {e}")))?;
         let image = RgbWindow { width: uv.width, height: uv.height, pixels: Vec::new() };
         Ok((bytes, Rendered { image, synthesized: 0 }))
+    }
+}
+
+/// The view a target shows of a texture whose native zoom is `native`, and whether it is
+/// upscaled 2× (`@2x` at native zoom, pixel-doubled as it always was; `@2x` tiles at other
+/// zooms are rendered one zoom finer).
+pub fn view_of(target: Target, native: u32) -> (View, bool) {
+    let native = native as i64;
+    match target {
+        Target::Window(w) => (View::at(native - w.z as i64, Rect::new(w.x, w.y, w.w, w.h)), false),
+        Target::Tile(t) => {
+            let k = native - t.z as i64;
+            let (s, big) = (TILE_SIZE, 2 * TILE_SIZE);
+            match (t.scale, k) {
+                (1, _) => (View::at(k, Rect::new(s * t.x, s * t.y, s, s)), false),
+                (_, 0) => (View::native(Rect::new(s * t.x, s * t.y, s, s)), true),
+                _ => (View::at(k - 1, Rect::new(big * t.x, big * t.y, big, big)), false),
+            }
+        }
     }
 }
 
