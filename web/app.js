@@ -6,10 +6,15 @@
 
 // p: the parameters the user changed, by name, as the query string carries them.
 // a: the map shown (albedo, a material map, or 'lit': colour shaded by the normal map); l: the
-// light's direction in degrees for 'lit'.
-const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false, a: 'albedo', l: 135 };
+// light's direction in degrees for 'lit'; o: the splat overlay of a landscape shown.
+const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false, a: 'albedo', l: 135, o: false };
 let catalog = null, meta = null, map = null, layer = null, grid = null, latticeLayer = null, debounce = null;
+let splatLayer = null;
 const $ = (id) => document.getElementById(id);
+
+// A landscape (several textures by a splat: GET /textures/{id} says kind "landscape") has no
+// mode, parameters or exemplar of its own: only a seed, its maps and its splat.
+function isLandscape() { return Boolean(meta && meta.kind === 'landscape'); }
 
 function readHash() {
   const p = new URLSearchParams(location.hash.slice(1));
@@ -23,6 +28,7 @@ function readHash() {
   state.g = p.get('g') === '1';
   if (p.has('a')) state.a = p.get('a');
   if (p.has('l') && /^\d+$/.test(p.get('l'))) state.l = Number(p.get('l')) % 360;
+  state.o = p.get('o') === '1';
 }
 
 function hash() {
@@ -33,6 +39,7 @@ function hash() {
   if (state.g) p.set('g', '1');
   if (state.a !== 'albedo') p.set('a', state.a);
   if (state.a === 'lit') p.set('l', state.l);
+  if (state.o && isLandscape()) p.set('o', '1');
   return '#' + p.toString();
 }
 
@@ -52,9 +59,14 @@ function fromLatLng(ll) { const s = 2 ** native(); return { x: ll.lng * s, y: -l
 // lit view fetches the colour and the normals).
 function tileUrl(mapName) {
   const q = new URLSearchParams();
-  q.set('mode', state.m);
-  q.set('seed', state.s);
-  for (const [k, v] of Object.entries(state.p)) q.set(k, v);
+  if (isLandscape()) {
+    // Seed 0 is the landscape as configured; another reseeds the splat and every layer.
+    if (String(state.s) !== '0') q.set('seed', state.s);
+  } else {
+    q.set('mode', state.m);
+    q.set('seed', state.s);
+    for (const [k, v] of Object.entries(state.p)) q.set(k, v);
+  }
   const shown = mapName || state.a;
   if (shown !== 'albedo' && shown !== 'lit') q.set('map', shown);
   return `/tiles/${encodeURIComponent(state.t)}/{z}/{x}/{y}.png?` + q.toString();
@@ -63,6 +75,7 @@ function tileUrl(mapName) {
 // The maps the current texture offers in the current mode (from /textures/{id}), plus 'lit'
 // when it has a normal map; the coordinates (uv) are for programs, not for looking at.
 function mapChoices() {
+  if (isLandscape()) return meta.maps.filter((m) => m !== 'splat');
   const maps = (meta.maps || []).filter((m) => m.name === 'albedo' || (m.kind !== 'coordinates' && m.modes.includes(state.m)));
   const names = maps.map((m) => m.name);
   if (maps.some((m) => m.kind === 'normal')) names.push('lit');
@@ -163,6 +176,7 @@ function refreshLayer() {
   } else if (layer._url !== url) {
     layer.setUrl(url);
   }
+  if (splatLayer && splatLayer._url !== tileUrl('splat')) splatLayer.setUrl(tileUrl('splat'));
   writeHash();
 }
 
@@ -265,12 +279,59 @@ function buildControls() {
   if (!params.length) box.textContent = 'This mode has no parameters besides the seed.';
 }
 
+// The splat of a landscape over the map, half transparent, and its legend.
+function setSplat(on) {
+  state.o = on;
+  $('splat').checked = on;
+  if (splatLayer) { map.removeLayer(splatLayer); splatLayer = null; }
+  if (on && isLandscape()) {
+    splatLayer = L.tileLayer(tileUrl('splat'), {
+      tileSize: 256, noWrap: true, opacity: 0.5, zIndex: 5, className: 'splat-tile',
+      minZoom: meta.minzoom, maxZoom: meta.maxzoom + 2, minNativeZoom: meta.minzoom, maxNativeZoom: meta.maxzoom,
+    }).addTo(map);
+  }
+  writeHash();
+}
+
+function showLandscape() {
+  const land = isLandscape();
+  for (const id of ['moderow', 'params', 'thumbbox', 'structureinfo']) $(id).hidden = land;
+  $('landscapebox').hidden = !land;
+  const legend = $('legend');
+  legend.textContent = '';
+  if (!land) { setSplat(false); return; }
+  for (const l of meta.layers) {
+    const li = document.createElement('li');
+    const sw = document.createElement('span');
+    sw.className = 'swatch';
+    sw.style.background = l.colour;
+    li.append(sw, `${l.name} (${l.mode}${l.scale ? `, scale ${l.scale}` : ''})`);
+    legend.append(li);
+  }
+  $('landscapeinfo').textContent = `A landscape of ${meta.layers.length} textures: a ${meta.splat.kind} splat, ${meta.blend.kind} blend.`;
+}
+
 async function selectTexture(id, keepView) {
   const r = await fetch(`/textures/${encodeURIComponent(id)}`);
   if (!r.ok) throw new Error(`texture ${id}: ${r.status}`);
   meta = await r.json();
   state.t = id;
   $('texture').value = id;
+  if (isLandscape()) {
+    showLandscape();
+    buildMapPicker();
+    setLattice(false);
+    $('latticerow').hidden = true;
+    map.setMinZoom(meta.minzoom);
+    map.setMaxZoom(meta.maxzoom + 2);
+    if (layer) { map.removeLayer(layer); layer = null; }
+    if (!keepView || state.z === null || Number.isNaN(state.z)) state.z = meta.native_zoom;
+    map.setView(toLatLng(state.x, state.y), state.z, { animate: false });
+    refreshLayer();
+    setSplat(state.o);
+    return;
+  }
+  showLandscape();
   const entry = catalog.textures.find((t) => t.id === id);
   $('thumb').src = entry ? entry.exemplar : '';
   state.m = window.TextileModes.fill($('mode'), meta, state.m);
@@ -500,8 +561,16 @@ async function init() {
   readHash();
   catalog = await (await fetch('/catalog')).json();
   const sel = $('texture');
-  for (const t of catalog.textures) sel.append(new Option(t.name, t.id));
-  if (!catalog.textures.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
+  const group = (label, list) => {
+    const g = document.createElement('optgroup');
+    g.label = label;
+    for (const t of list) g.append(new Option(t.name, t.id));
+    sel.append(g);
+  };
+  group('Textures', catalog.textures);
+  if ((catalog.landscapes || []).length) group('Landscapes', catalog.landscapes);
+  const known = [...catalog.textures, ...(catalog.landscapes || [])];
+  if (!known.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
   map = L.map('map', { crs: L.CRS.Simple, zoomSnap: 1, keyboard: true, worldCopyJump: false });
   window.textileMap = map;
   map.on('moveend', onMove);
@@ -535,6 +604,7 @@ async function init() {
   $('resetp').addEventListener('click', () => { state.p = {}; buildControls(); refreshLayer(); });
   $('grid').addEventListener('change', (e) => setGrid(e.target.checked));
   $('lattice').addEventListener('change', (e) => setLattice(e.target.checked));
+  $('splat').addEventListener('change', (e) => setSplat(e.target.checked));
   setupUpload();
   $('worldlink').addEventListener('click', (e) => {
     e.currentTarget.href = `/world.html#t=${encodeURIComponent(state.t)}&m=${state.m}&s=${state.s}`;

@@ -453,6 +453,40 @@ test('the exemplar thumbnail shows its detected structure: lattice, tile repeate
   await page.close();
 });
 
+test('a landscape is picked beside the textures, lists its layers, and overlays its splat with a legend', async () => {
+  const { page, errors, tiles } = await open('/#t=meadow&z=7&x=0&y=0');
+  await settled(page);
+  assertTexture(await tileStats(page));
+  assert.ok(tiles.every((t) => t.status === 200 && !t.url.includes('mode=')), JSON.stringify(tiles.slice(0, 3)));
+  const groups = await page.$$eval('#texture optgroup', (gs) => gs.map((g) => [g.label, [...g.children].map((o) => o.value)]));
+  assert.deepEqual(groups.map((g) => g[0]), ['Textures', 'Landscapes']);
+  assert.ok(groups[1][1].includes('meadow'));
+  assert.equal(await page.isVisible('#mode'), false, 'a landscape has no mode of its own');
+  const legend = await page.$$eval('#legend li', (l) => l.map((li) => [li.textContent, li.querySelector('.swatch').style.background]));
+  assert.equal(legend.length, 3, JSON.stringify(legend));
+  assert.ok(legend[0][0].startsWith('Grass') && legend[0][1].length > 0, JSON.stringify(legend));
+  await page.check('#splat');
+  await page.waitForFunction(() => [...document.querySelectorAll('.splat-tile img')].some((i) => i.complete && i.naturalWidth === 256 && i.src.includes('map=splat')));
+  assert.match(page.url(), /[#&]o=1/);
+  // The overlay's colours are the legend's: somewhere a pixel is (nearly) the grass colour.
+  const greenish = await page.evaluate(() => [...document.querySelectorAll('.splat-tile img')].filter((i) => i.complete && i.naturalWidth).some((img) => {
+    const c = document.createElement('canvas');
+    c.width = c.height = 256;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, 256, 256).data;
+    for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - 0x5a) < 4 && Math.abs(d[i + 1] - 0x8f) < 4 && Math.abs(d[i + 2] - 0x3c) < 4) return true;
+    return false;
+  }));
+  assert.ok(greenish, 'the splat overlay shows the grass colour');
+  // The permalink keeps the overlay.
+  const again = await open(new URL(page.url()).hash ? '/' + new URL(page.url()).hash : '/');
+  await again.page.waitForFunction(() => document.querySelector('#splat').checked && document.querySelector('.splat-tile img'));
+  assert.deepEqual([...errors, ...again.errors], []);
+  await again.page.close();
+  await page.close();
+});
+
 test('readable on a phone-sized viewport', async () => {
   const { page, errors } = await open('/', { width: 390, height: 844 });
   await settled(page, 1);

@@ -117,9 +117,14 @@ async fn serve(cfg: Config) -> CliResult {
                         crate::uploads::analyse_in_background(state.clone(), tex);
                     }
                 }
-                let n = state.registry().map(|r| r.list.len()).unwrap_or(0);
-                let plural = if n == 1 { "" } else { "s" };
-                println!("textile ready: viewer at http://{addr}/ ({n} texture{plural})");
+                let reg = state.registry();
+                let (n, l) = reg.map(|r| (r.list.len(), r.landscapes.len())).unwrap_or((0, 0));
+                let plural = |k: usize| if k == 1 { "" } else { "s" };
+                let landscapes = match l {
+                    0 => String::new(),
+                    l => format!(", {l} landscape{}", plural(l)),
+                };
+                println!("textile ready: viewer at http://{addr}/ ({n} texture{}{landscapes})", plural(n));
                 use std::io::Write;
                 let _ = std::io::stdout().flush();
             }
