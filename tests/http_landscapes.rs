@@ -225,7 +225,10 @@ async fn render_writes_the_landscape_tile_the_server_serves() {
     let data = common::shared_data_dir();
     for (args, path) in [
         (vec!["--z", "7", "--x", "3", "--y", "0"], "/tiles/ground/7/3/0.png"),
-        (vec!["--z", "6", "--x", "1", "--y", "0", "--seed", "9", "--map", "height"], "/tiles/ground/6/1/0.png?seed=9&map=height"),
+        (
+            vec!["--z", "6", "--x", "1", "--y", "0", "--seed", "9", "--map", "height"],
+            "/tiles/ground/6/1/0.png?seed=9&map=height",
+        ),
     ] {
         let out = dir.path().join("tile.png");
         let run = Command::new(binary())
@@ -239,5 +242,41 @@ async fn render_writes_the_landscape_tile_the_server_serves() {
         assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
         let (_, served) = s.get_bytes(path).await;
         assert!(std::fs::read(&out).expect("written") == served, "render {args:?} writes what {path} serves");
+    }
+}
+
+/// Mean |a − b| per channel, in 1/255, between a tile and its four children box-filtered 2×2.
+async fn zoom_error(s: &Server, id: &str, z: u32, x: u32, y: u32) -> f64 {
+    let parent = s.image(&format!("/tiles/{id}/{z}/{x}/{y}.png")).await;
+    let mut children = image::RgbImage::new(512, 512);
+    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let c = s.image(&format!("/tiles/{id}/{}/{}/{}.png", z + 1, 2 * x + dx, 2 * y + dy)).await;
+        common::paste(&mut children, &c, 256 * dx, 256 * dy);
+    }
+    let mut sum = 0.0;
+    for (px, py, p) in parent.enumerate_pixels() {
+        for c in 0..3 {
+            let mean: f64 = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                .iter()
+                .map(|(u, v)| children.get_pixel(2 * px + u, 2 * py + v)[c] as f64)
+                .sum::<f64>()
+                / 4.0;
+            sum += (p[c] as f64 - mean).abs();
+        }
+    }
+    sum / (3.0 * 256.0 * 256.0)
+}
+
+#[tokio::test]
+async fn a_zoomed_out_landscape_is_as_close_to_its_native_tiles_as_its_layers_are() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let s = start(dir.path(), &[]);
+    // Tiles one step out across the transition (texels 512–1535 at native zoom 7).
+    for x in [1, 2] {
+        let land = zoom_error(&s, "ground", 6, x, 0).await;
+        let gravel = zoom_error(&s, "gravel", 6, x, 0).await;
+        let grass = zoom_error(&s, "grass", 6, x, 0).await;
+        eprintln!("zoom 6/{x}/0 against its children: landscape {land:.2}, gravel {gravel:.2}, grass {grass:.2}");
+        assert!(land <= gravel.max(grass) * 1.15 + 0.5, "landscape {land:.2} vs layers {gravel:.2}, {grass:.2}");
     }
 }

@@ -33,6 +33,9 @@ impl Blend {
     /// weight at a pixel takes no part there, whatever its height.
     pub fn weights(&self, splat: &Weights, heights: &[Option<Heights>]) -> Weights {
         let Blend::Height { depth } = *self else { return splat.clone() };
+        if splat.used().iter().filter(|u| **u).count() < 2 {
+            return splat.clone();
+        }
         let mut out = splat.clone();
         let layers = splat.layers;
         for (p, px) in out.w.chunks_exact_mut(layers).enumerate() {
@@ -109,7 +112,7 @@ mod tests {
     use super::*;
 
     fn weights(w: &[f32]) -> Weights {
-        Weights { layers: 2, width: w.len() / 2, height: 1, w: w.to_vec() }
+        Weights { layers: 2, width: w.len() / 2, height: 1, w: w.to_vec(), same: None }
     }
 
     #[test]

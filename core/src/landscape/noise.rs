@@ -73,30 +73,59 @@ impl Noise {
     /// lookups. The grid is fixed to absolute pixel coordinates: any window equals the same
     /// area cut from any other.
     pub fn window(&self, view: crate::View, period: Option<i64>) -> Vec<f32> {
+        self.grid(view, period).pixels()
+    }
+
+    /// The exact values under a window ([`Noise::window`] before joining them).
+    pub fn grid(&self, view: crate::View, period: Option<i64>) -> Grid {
         let zoom = view.zoom_out as i64 - view.zoom_in as i64;
         let st = STRIDE as i64;
         let r = view.rect;
-        let (w, h) = (r.width() as usize, r.height() as usize);
         let (gx0, gy0) = (r.x0.div_euclid(st), r.y0.div_euclid(st));
         let gw = ((r.x0 + r.width() - 1).div_euclid(st) - gx0 + 2) as usize;
         let gh = ((r.y0 + r.height() - 1).div_euclid(st) - gy0 + 2) as usize;
-        let mut grid = vec![0f64; gw * gh];
+        let mut values = vec![0f64; gw * gh];
         for gj in 0..gh {
             let y = super::texel_centre((gy0 + gj as i64) * st, 0, zoom);
             for gi in 0..gw {
                 let x = super::texel_centre((gx0 + gi as i64) * st, 0, zoom);
-                grid[gj * gw + gi] = self.at(x, y, period);
+                values[gj * gw + gi] = self.at(x, y, period);
             }
         }
+        Grid { values, gw, gx0, gy0, rect: r }
+    }
+}
+
+/// Noise values at every [`STRIDE`]-th pixel under a window, and the window.
+#[derive(Debug, Clone)]
+pub struct Grid {
+    values: Vec<f64>,
+    gw: usize,
+    gx0: i64,
+    gy0: i64,
+    rect: crate::Rect,
+}
+
+impl Grid {
+    /// The least and the greatest value: every pixel's lies between (bilinear joins never
+    /// leave the range of their corners).
+    pub fn range(&self) -> (f64, f64) {
+        self.values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)))
+    }
+
+    /// Every pixel's value, row-major.
+    pub fn pixels(&self) -> Vec<f32> {
+        let (st, s) = (STRIDE as i64, STRIDE as f64);
+        let r = self.rect;
+        let (w, h) = (r.width() as usize, r.height() as usize);
         let mut out = Vec::with_capacity(w * h);
-        let s = STRIDE as f64;
         for j in 0..h {
             let py = r.y0 + j as i64;
-            let (gj, fy) = ((py.div_euclid(st) - gy0) as usize, py.rem_euclid(st) as f64 / s);
+            let (gj, fy) = ((py.div_euclid(st) - self.gy0) as usize, py.rem_euclid(st) as f64 / s);
             for i in 0..w {
                 let px = r.x0 + i as i64;
-                let (gi, fx) = ((px.div_euclid(st) - gx0) as usize, px.rem_euclid(st) as f64 / s);
-                let at = |a: usize, b: usize| grid[(gj + b) * gw + gi + a];
+                let (gi, fx) = ((px.div_euclid(st) - self.gx0) as usize, px.rem_euclid(st) as f64 / s);
+                let at = |a: usize, b: usize| self.values[(gj + b) * self.gw + gi + a];
                 let top = at(0, 0) + (at(1, 0) - at(0, 0)) * fx;
                 let bottom = at(0, 1) + (at(1, 1) - at(0, 1)) * fx;
                 out.push((top + (bottom - top) * fy) as f32);

@@ -39,7 +39,8 @@ pub enum SplatError {
 }
 
 /// Per-pixel weights of every layer over a window: `w[p * layers + i]` is layer `i`'s at pixel
-/// `p` (row-major); each pixel's weights are non-negative and sum to one.
+/// `p` (row-major); each pixel's weights are non-negative and sum to one. A window whose every
+/// pixel has the same weights holds them once (`same`, and `w` empty).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Weights {
     /// Layers.
@@ -50,19 +51,24 @@ pub struct Weights {
     pub height: usize,
     /// The weights.
     pub w: Vec<f32>,
+    /// The weights of every pixel, when they are all the same.
+    pub same: Option<Vec<f32>>,
 }
 
 impl Weights {
     /// The weights of pixel `p`.
     #[inline]
     pub fn at(&self, p: usize) -> &[f32] {
-        &self.w[p * self.layers..(p + 1) * self.layers]
+        match &self.same {
+            Some(one) => one,
+            None => &self.w[p * self.layers..(p + 1) * self.layers],
+        }
     }
 
     /// Which layers have a weight above zero anywhere in the window.
     pub fn used(&self) -> Vec<bool> {
         let mut used = vec![false; self.layers];
-        for px in self.w.chunks_exact(self.layers) {
+        for px in self.w.chunks_exact(self.layers).chain(self.same.as_deref()) {
             for (u, &v) in used.iter_mut().zip(px) {
                 *u |= v > 0.0;
             }
@@ -73,6 +79,14 @@ impl Weights {
     /// Pixels in the window.
     pub fn pixels(&self) -> usize {
         self.width * self.height
+    }
+
+    /// The same weights at every pixel of the window (`raw` normalised as [`Weights::from_fn`]
+    /// would).
+    fn constant(layers: usize, view: View, raw: &[f32]) -> Weights {
+        let one = Weights::from_fn(layers, View::native(crate::Rect::new(0, 0, 1, 1)), |_, px| px.copy_from_slice(raw));
+        let (width, height) = (view.rect.width() as usize, view.rect.height() as usize);
+        Weights { layers, width, height, w: Vec::new(), same: Some(one.w) }
     }
 
     /// Weights of `layers` layers from a function of the pixel index writing each pixel's raw
@@ -90,7 +104,7 @@ impl Weights {
                 px[0] = 1.0;
             }
         }
-        Weights { layers, width, height, w }
+        Weights { layers, width, height, w, same: None }
     }
 }
 
@@ -204,9 +218,26 @@ impl NoiseSplat {
     }
 
     fn weights(&self, view: View, seed: u64, period: Option<i64>) -> Weights {
-        let field = Noise::new(TAG_SPLAT, seed, self.feature, self.octaves).window(view, period);
+        let grid = Noise::new(TAG_SPLAT, seed, self.feature, self.octaves).grid(view, period);
+        let layers = self.boundaries.len() + 1;
+        // A window whose values all lie between two cuts, clear of their transitions, is one
+        // layer's alone: no pixel need be looked at.
+        let (lo, hi) = grid.range();
+        // With a margin well beyond what rounding a pixel's value can move it, so that every
+        // pixel's own evaluation would give the same.
+        let (ulo, uhi) = (self.uniform(lo) - 1e-6, self.uniform(hi) + 1e-6);
+        let half = self.transition / 2.0;
+        let band = self.boundaries.partition_point(|&b| b + half <= ulo);
+        let clear = self.boundaries.get(band).is_none_or(|&b| uhi < b - half)
+            && (band == 0 || self.boundaries[band - 1] + half <= ulo);
+        if clear {
+            let mut raw = vec![0f32; layers];
+            raw[band] = 1.0;
+            return Weights::constant(layers, view, &raw);
+        }
+        let field = grid.pixels();
         let t = self.transition;
-        Weights::from_fn(self.boundaries.len() + 1, view, |p, px| {
+        Weights::from_fn(layers, view, |p, px| {
             let u = self.uniform(field[p] as f64);
             // How far past each cut: 1 beyond it, 0 before it, smooth within the transition.
             let past = |b: f64| -> f64 {
@@ -357,41 +388,119 @@ impl ImageSplat {
         }
     }
 
+    /// The layer a map cell (or the ground outside the map) gives all its weight to, if one.
+    fn sole(&self, cx: i64, cy: i64) -> Option<usize> {
+        let (mw, mh) = (self.width as i64, self.height as i64);
+        let inside = (0..mw).contains(&cx) && (0..mh).contains(&cy);
+        if let (false, Outside::Layer(l)) = (inside, self.place.outside) {
+            return Some(l);
+        }
+        let c = (cy.rem_euclid(mh) * mw + cx.rem_euclid(mw)) as usize * self.layers;
+        let cell = &self.cells[c..c + self.layers];
+        let mut nonzero = cell.iter().enumerate().filter(|(_, v)| **v > 0);
+        match (nonzero.next(), nonzero.next()) {
+            (Some((l, _)), None) => Some(l),
+            _ => None,
+        }
+    }
+
+    /// The layer every pixel of the window is wholly, if one: when every map cell the window's
+    /// samples can reach (warp included) gives all its weight to that layer. Its pixels'
+    /// own evaluation gives exactly that weight (one cell's one layer, normalised, is 1).
+    fn sole_over(&self, view: View) -> Option<usize> {
+        let p = &self.place;
+        let zoom = view.zoom_out as i64 - view.zoom_in as i64;
+        let r = view.rect;
+        let edge = |x0: i64, n: i64, origin: f64| {
+            let lo = (texel_centre(x0, 0, zoom) - p.warp - 1.0 - origin) / p.texels_per_pixel - 0.5;
+            let hi = (texel_centre(x0, (n - 1) as usize, zoom) + p.warp + 1.0 - origin) / p.texels_per_pixel - 0.5;
+            (lo.floor() as i64, hi.floor() as i64 + 1)
+        };
+        let (x0, x1) = edge(r.x0, r.width(), p.origin.0);
+        let (y0, y1) = edge(r.y0, r.height(), p.origin.1);
+        // A window over many cells is decided pixel by pixel.
+        if (x1 - x0 + 1).saturating_mul(y1 - y0 + 1) > 4096 {
+            return None;
+        }
+        let first = self.sole(x0, y0)?;
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                if self.sole(cx, cy) != Some(first) {
+                    return None;
+                }
+            }
+        }
+        Some(first)
+    }
+
     fn weights(&self, view: View, seed: u64, period: Option<i64>) -> Weights {
+        if let Some(l) = self.sole_over(view) {
+            let mut raw = vec![0f32; self.layers];
+            raw[l] = 1.0;
+            return Weights::constant(self.layers, view, &raw);
+        }
         let p = &self.place;
         let zoom = view.zoom_out as i64 - view.zoom_in as i64;
         let warp = |tag| {
             (p.warp > 0.0).then(|| Noise::new(tag, seed, (4.0 * p.texels_per_pixel).max(4.0), 2).window(view, period))
         };
         let (wx, wy) = (warp(TAG_WARP_X), warp(TAG_WARP_Y));
-        let w = view.rect.width() as usize;
+        let (w, h) = (view.rect.width() as usize, view.rect.height() as usize);
         let (mw, mh) = (self.width as i64, self.height as i64);
+        let q = |t: f64, origin: f64| (t - origin) / p.texels_per_pixel - 0.5;
+        // Unwarped, a pixel's place in the map is its column's and its row's: found once each.
+        let (cols, rows): (Vec<Axis>, Vec<Axis>) = match (&wx, &wy) {
+            (Some(_), _) | (_, Some(_)) => (Vec::new(), Vec::new()),
+            _ => (
+                (0..w).map(|i| Axis::at(q(texel_centre(view.rect.x0, i, zoom), p.origin.0), mw)).collect(),
+                (0..h).map(|j| Axis::at(q(texel_centre(view.rect.y0, j, zoom), p.origin.1), mh)).collect(),
+            ),
+        };
         Weights::from_fn(self.layers, view, |i, px| {
-            let (mut x, mut y) = (texel_centre(view.rect.x0, i % w, zoom), texel_centre(view.rect.y0, i / w, zoom));
-            if let (Some(wx), Some(wy)) = (&wx, &wy) {
-                x += (2.0 * wx[i] as f64 - 1.0) * p.warp;
-                y += (2.0 * wy[i] as f64 - 1.0) * p.warp;
-            }
-            let qx = (x - p.origin.0) / p.texels_per_pixel - 0.5;
-            let qy = (y - p.origin.1) / p.texels_per_pixel - 0.5;
-            let (fx, fy) = (qx - qx.floor(), qy - qy.floor());
-            let (ix, iy) = (qx.floor() as i64, qy.floor() as i64);
-            for (dx, dy, f) in
-                [(0, 0, (1.0 - fx) * (1.0 - fy)), (1, 0, fx * (1.0 - fy)), (0, 1, (1.0 - fx) * fy), (1, 1, fx * fy)]
-            {
-                let (cx, cy) = (ix + dx, iy + dy);
-                let inside = (0..mw).contains(&cx) && (0..mh).contains(&cy);
-                match (inside, p.outside) {
-                    (false, Outside::Layer(l)) => px[l] += f as f32,
-                    _ => {
-                        let c = (cy.rem_euclid(mh) * mw + cx.rem_euclid(mw)) as usize * self.layers;
-                        for (v, &cell) in px.iter_mut().zip(&self.cells[c..c + self.layers]) {
-                            *v += (f * cell as f64) as f32;
+            let (ax, ay) = match (&wx, &wy) {
+                (Some(wx), Some(wy)) => {
+                    let x = texel_centre(view.rect.x0, i % w, zoom) + (2.0 * wx[i] as f64 - 1.0) * p.warp;
+                    let y = texel_centre(view.rect.y0, i / w, zoom) + (2.0 * wy[i] as f64 - 1.0) * p.warp;
+                    (Axis::at(q(x, p.origin.0), mw), Axis::at(q(y, p.origin.1), mh))
+                }
+                _ => (cols[i % w], rows[i / w]),
+            };
+            for (b, fy) in [(0, 1.0 - ay.f), (1, ay.f)] {
+                for (a, fx) in [(0, 1.0 - ax.f), (1, ax.f)] {
+                    let f = fx * fy;
+                    match (ax.inside[a] && ay.inside[b], p.outside) {
+                        (false, Outside::Layer(l)) => px[l] += f as f32,
+                        _ => {
+                            let c = (ay.cell[b] * self.width + ax.cell[a]) * self.layers;
+                            for (v, &cell) in px.iter_mut().zip(&self.cells[c..c + self.layers]) {
+                                *v += (f * cell as f64) as f32;
+                            }
                         }
                     }
                 }
             }
         })
+    }
+}
+
+/// Where a sample falls along one axis of a painted map: the two cells it lies between
+/// (wrapped into the map), whether each is inside it, and how far past the first.
+#[derive(Debug, Clone, Copy)]
+struct Axis {
+    cell: [usize; 2],
+    inside: [bool; 2],
+    f: f64,
+}
+
+impl Axis {
+    /// At `q` map pixels (pixel centres at whole numbers) along an axis of `n` pixels.
+    fn at(q: f64, n: i64) -> Axis {
+        let i = q.floor() as i64;
+        Axis {
+            cell: [i.rem_euclid(n) as usize, (i + 1).rem_euclid(n) as usize],
+            inside: [(0..n).contains(&i), (0..n).contains(&(i + 1))],
+            f: q - q.floor(),
+        }
     }
 }
 

@@ -250,6 +250,7 @@ impl LandscapeJob {
                 });
             }
         }
+        let first = used.iter().position(|u| *u).unwrap_or(0);
         let weights = if n > 1 { self.land.blend.weights(&splat, &heights) } else { splat };
         let images: Vec<Option<Vec<u8>>> = match &self.map {
             LandscapeMap::Albedo => albedo,
@@ -269,14 +270,16 @@ impl LandscapeJob {
             }
             LandscapeMap::Splat => unreachable!("answered above"),
         };
-        let refs: Vec<Option<&[u8]>> = images.iter().map(|i| i.as_deref()).collect();
-        let mut px = mix(&weights, &refs);
+        let mut px = match n {
+            // One layer alone: its image as it is.
+            1 => images.into_iter().nth(first).flatten().unwrap_or_default(),
+            _ => mix(&weights, &images.iter().map(|i| i.as_deref()).collect::<Vec<_>>()),
+        };
         if self.map == LandscapeMap::Map("normal".into()) {
             textile_core::maps::renormalise(&mut px);
         }
         // Encoded as the first visible layer's own image is, so that a tile of one layer alone
         // is that layer's tile, byte for byte.
-        let first = used.iter().position(|u| *u).unwrap_or(0);
         let enc = match &self.map {
             LandscapeMap::Map(n) => ImageJob { map: MapChoice::Map(n.clone()), ..self.layers[first].clone() },
             _ => self.layers[first].clone(),
