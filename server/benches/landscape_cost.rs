@@ -36,7 +36,7 @@ fn tile(z: u32, x: i64, y: i64) -> Target {
 fn own(reg: &Registry, id: &str, mode: &str, t: Target) -> ImageJob {
     let tex = reg.get(id).expect("texture").clone();
     let p = params(&tex, ParamReader::request([("mode", mode)]).expect("query")).expect("params");
-    ImageJob { tex, params: p, target: t, map: MapChoice::Albedo }
+    ImageJob { tex, params: p, target: t, map: MapChoice::Albedo, dem: None }
 }
 
 fn time(f: impl FnOnce()) -> Duration {
@@ -77,7 +77,7 @@ fn main() {
             LandscapeJob::new(
                 l.clone(),
                 t,
-                LandscapeMap::Albedo,
+                (LandscapeMap::Albedo, None),
                 ParamReader::request(Vec::<(String, String)>::new()).expect("q"),
             )
             .expect("job")

@@ -28,6 +28,7 @@ pub mod robustness;
 pub mod sampling;
 pub mod scene;
 pub mod state;
+pub mod terrain;
 pub mod textures;
 pub mod uploads;
 

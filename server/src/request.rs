@@ -12,6 +12,7 @@ use textile_core::{ModeParams, ParamReader};
 
 use crate::encode::Format;
 use crate::error::ApiError;
+use crate::terrain::Dem;
 use crate::textures::{Texture, Zooms};
 
 /// Smallest tile coordinate.
@@ -61,6 +62,24 @@ pub fn params(tex: &Texture, mut r: ParamReader) -> Result<ModeParams, ApiError>
         Needs::Analysis if tex.analysis().is_none() => Err(textile_core::CoreError::NotAnalysed { mode }.into()),
         Needs::Prepared if !tex.prepared.has(mode) => Err(textile_core::CoreError::NotPrepared { mode }.into()),
         _ => Ok(p),
+    }
+}
+
+/// Read `map=` and, with `map=height`, a raster-dem's `encoding`, `height_scale` and `base`
+/// (see [`Dem::read`]): a raster-dem renders the texture's height map, or, when it has none,
+/// its colour, whose luma serves.
+pub fn map_and_dem(tex: &Texture, r: &mut ParamReader, format: Format) -> Result<(MapChoice, Option<Dem>), ApiError> {
+    let name = r.take("map");
+    if let Some(dem) = Dem::read(r, name.as_deref(), format, tex.height_scale())? {
+        let map = match tex.exemplar.map("height") {
+            Some(_) => MapChoice::Map("height".into()),
+            None => MapChoice::Albedo,
+        };
+        return Ok((map, Some(dem)));
+    }
+    match name {
+        Some(n) => Ok((parse_map(tex, &n, format)?, None)),
+        None => Ok((MapChoice::Albedo, None)),
     }
 }
 

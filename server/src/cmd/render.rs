@@ -165,7 +165,7 @@ pub fn run(a: RenderArgs) -> CliResult {
         }
         Target::Tile(TileSpec { z, x, y, scale: 1, format })
     };
-    let (bytes, r) = ImageJob { tex, params, target, map }.bytes(&Pyramid::off())?;
+    let (bytes, r) = ImageJob { tex, params, target, map, dem: None }.bytes(&Pyramid::off())?;
     write_atomic(&output, &bytes)?;
     println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
     Ok(())

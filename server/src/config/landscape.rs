@@ -32,6 +32,10 @@ pub struct LandscapeConfig {
     /// Shown in the viewer and TileJSON.
     #[serde(default)]
     pub attribution: String,
+    /// Metres per unit of height in its raster-dem tiles (unset: a relief of a few texels at
+    /// its native zoom).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_scale: Option<f64>,
 }
 
 /// One layer: a configured texture, rendered as its own tiles are.

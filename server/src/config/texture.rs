@@ -59,6 +59,10 @@ pub struct TextureConfig {
     /// Attribution shown in TileJSON.
     #[serde(default)]
     pub attribution: String,
+    /// Metres per unit of height (0–1) in its raster-dem tiles (`map=height&encoding=…`);
+    /// unset: a relief of a few texels at its native zoom.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_scale: Option<f64>,
     /// Co-registered material maps (`[textures.maps]`): map name → image (path or
     /// `embedded:NAME`, the size of the exemplar image), plus `normal_convention = "opengl" |
     /// "directx"` when there is a `normal` map.
@@ -104,6 +108,7 @@ impl TextureConfig {
             default_mode: default_mode(),
             default_seed: 0,
             attribution: String::new(),
+            height_scale: None,
             maps: BTreeMap::new(),
             modes: BTreeMap::new(),
             uploaded: false,

@@ -368,6 +368,7 @@ pub fn render_part(plan: &Plan, shard: Shard, output: &Path) -> Result<Report, S
                     params: plan.params.clone(),
                     target: Target::Tile(e.tile),
                     map: plan.map.clone(),
+                    dem: None,
                 };
                 job.bytes(&pyramid).map(|(b, _)| b).map_err(|err| err.message)
             })

@@ -18,7 +18,7 @@ use crate::output::Output;
 use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{
-    map_choice, params, parse_tile, parse_tile_in, parse_window, parse_window_in, query_reader, split_format,
+    map_and_dem, params, parse_tile, parse_tile_in, parse_window, parse_window_in, query_reader, split_format,
 };
 use crate::state::AppState;
 
@@ -52,9 +52,9 @@ pub async fn tile(
     let tex = texture(&reg, &id)?;
     let spec = parse_tile(&tex, &z, &x, &y)?;
     let mut r = query_reader(q.as_deref())?;
-    let map = map_choice(&tex, &mut r, spec.format)?;
+    let (map, dem) = map_and_dem(&tex, &mut r, spec.format)?;
     let params = params(&tex, r)?;
-    answer(&st, &headers, Output::Image(ImageJob { tex, params, target: Target::Tile(spec), map })).await
+    answer(&st, &headers, Output::Image(ImageJob { tex, params, target: Target::Tile(spec), map, dem })).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
@@ -86,7 +86,7 @@ pub async fn window(
     let tex = texture(&reg, id)?;
     let mut r = query_reader(q.as_deref())?;
     let spec = parse_window(&tex, &mut r, fmt)?;
-    let map = map_choice(&tex, &mut r, fmt)?;
+    let (map, dem) = map_and_dem(&tex, &mut r, fmt)?;
     let params = params(&tex, r)?;
-    answer(&st, &headers, Output::Image(ImageJob { tex, params, target: Target::Window(spec), map })).await
+    answer(&st, &headers, Output::Image(ImageJob { tex, params, target: Target::Window(spec), map, dem })).await
 }

@@ -368,7 +368,8 @@ pub async fn tilejson(
     if let Some(l) = reg.landscape(&id) {
         // Checked as its tiles' queries are (a layer not ready answers 503 as they do).
         let mut r = textile_core::ParamReader::request(q.clone())?;
-        crate::pipeline::landscape::LandscapeMap::read(l, &mut r, Format::Png)?;
+        let map = crate::pipeline::landscape::LandscapeMap::read(l, &mut r, Format::Png)?;
+        let encoding = map.1.map(|d| d.encoding.name());
         let target = crate::pipeline::Target::Tile(crate::request::TileSpec {
             z: l.native_zoom,
             x: 0,
@@ -376,12 +377,7 @@ pub async fn tilejson(
             scale: 1,
             format: Format::Png,
         });
-        crate::pipeline::landscape::LandscapeJob::new(
-            l.clone(),
-            target,
-            crate::pipeline::landscape::LandscapeMap::Albedo,
-            r,
-        )?;
+        crate::pipeline::landscape::LandscapeJob::new(l.clone(), target, map, r)?;
         let layers: Vec<String> = l
             .layers
             .iter()
@@ -397,6 +393,7 @@ pub async fn tilejson(
             version: &version.to_hex()[..12],
             zooms: l.zooms(),
             world,
+            encoding,
         };
         let textile = json!({
             "landscape": id, "native_zoom": l.native_zoom,
@@ -405,7 +402,9 @@ pub async fn tilejson(
         return Ok(Json(doc.tilejson(&base, q, caller_v, textile)));
     }
     let t = texture(&reg, &id)?;
-    params(&t, textile_core::ParamReader::request(q.clone())?)?;
+    let mut r = textile_core::ParamReader::request(q.clone())?;
+    let encoding = crate::request::map_and_dem(&t, &mut r, Format::Png)?.1.map(|d| d.encoding.name());
+    params(&t, r)?;
     // Everything that decides a tile's bytes besides its own request: engine, analysis, and the
     // texture's configured defaults of every mode with the modes' versions (a changed default
     // seed or κ, or a new mode version, must not hit stale immutable copies).
@@ -420,6 +419,7 @@ pub async fn tilejson(
         version,
         zooms: t.zooms(),
         world: true,
+        encoding,
     };
     let textile = json!({
         "texture": t.config.id, "native_zoom": t.native_zoom(), "exemplar_side": t.exemplar.size().longer(),
@@ -439,6 +439,8 @@ struct Document<'a> {
     zooms: crate::textures::Zooms,
     /// Whether its tiles may repeat around the Web-Mercator world.
     world: bool,
+    /// The raster-dem encoding of its tiles, when the query asks for one.
+    encoding: Option<&'static str>,
 }
 
 impl Document<'_> {
@@ -460,7 +462,7 @@ impl Document<'_> {
         for (k, v) in q.iter().filter(|(k, _)| k.as_str() != "v") {
             qs.append_pair(k, v);
         }
-        json!({
+        let mut doc = json!({
             "tilejson": "3.0.0",
             "name": self.name,
             "description": format!("Infinite example-based texture '{}' synthesized by textile", self.id),
@@ -474,7 +476,12 @@ impl Document<'_> {
             "center": [0.0, 0.0, self.zooms.native],
             "tileSize": TILE_SIZE,
             "textile": textile,
-        })
+        });
+        // MapLibre's raster-dem source reads the encoding from the TileJSON it is given.
+        if let Some(e) = self.encoding {
+            doc["encoding"] = json!(e);
+        }
+        doc
     }
 }
 

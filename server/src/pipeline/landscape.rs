@@ -16,6 +16,7 @@ use super::{engine_version, etag_for, view_of, ImageJob, Target, PIECE};
 use crate::encode::{encode, Effort, Format};
 use crate::error::ApiError;
 use crate::request::{params, MAX_V};
+use crate::terrain::Dem;
 use crate::textures::Landscape;
 
 /// Hash tag of the seeds layers derive from a request's `seed`.
@@ -34,9 +35,15 @@ pub enum LandscapeMap {
 
 impl LandscapeMap {
     /// Read `map=` of a landscape's request (default `albedo`): the colour, a map every layer
-    /// has, or `splat` (PNG only).
-    pub fn read(land: &Landscape, r: &mut ParamReader, format: Format) -> Result<LandscapeMap, ApiError> {
-        let Some(name) = r.take("map") else { return Ok(LandscapeMap::Albedo) };
+    /// has, or `splat` (PNG only); with `map=height`, a raster-dem's parameters too.
+    pub fn read(
+        land: &Landscape,
+        r: &mut ParamReader,
+        format: Format,
+    ) -> Result<(LandscapeMap, Option<Dem>), ApiError> {
+        let name = r.take("map");
+        let dem = Dem::read(r, name.as_deref(), format, land.height_scale())?;
+        let Some(name) = name else { return Ok((LandscapeMap::Albedo, None)) };
         let maps = land.maps();
         let map = match name.as_str() {
             "albedo" => LandscapeMap::Albedo,
@@ -62,7 +69,7 @@ impl LandscapeMap {
                 "map 'splat' is served as PNG only (use .png)".to_string(),
             ));
         }
-        Ok(map)
+        Ok((map, dem))
     }
 }
 
@@ -81,13 +88,20 @@ pub struct LandscapeJob {
     pub seed: u64,
     /// The period in texels (`world=`), if any.
     pub period: Option<i64>,
+    /// Its heights as a raster-dem (with `map=height`).
+    pub dem: Option<Dem>,
 }
 
 impl LandscapeJob {
     /// Read a request of a landscape: `v`, `seed`, `world` (the rest of a layer's parameters
     /// come from the configuration only). A layer that is not ready answers as its texture's
     /// tiles would (503 with `Retry-After`).
-    pub fn new(land: Arc<Landscape>, target: Target, map: LandscapeMap, mut r: ParamReader) -> Result<Self, ApiError> {
+    pub fn new(
+        land: Arc<Landscape>,
+        target: Target,
+        (map, dem): (LandscapeMap, Option<Dem>),
+        mut r: ParamReader,
+    ) -> Result<Self, ApiError> {
         if r.take("v").is_some_and(|v| v.len() > MAX_V) {
             return Err(ApiError::bad_request(
                 "invalid_parameter",
@@ -142,13 +156,14 @@ impl LandscapeJob {
             let p = params(&y.tex, ParamReader::request(pairs)?)
                 .map_err(|e| e.prefixed(&format!("layer '{}': ", y.tex.config.id)))?;
             layers.push(ImageJob {
+                dem: None,
                 tex: y.tex.clone(),
                 params: p,
                 target: layer_target(target, y.config.scale),
                 map: MapChoice::Albedo,
             });
         }
-        Ok(LandscapeJob { seed: seed.unwrap_or_else(|| land.splat_seed()), land, target, map, layers, period })
+        Ok(LandscapeJob { seed: seed.unwrap_or_else(|| land.splat_seed()), land, target, map, layers, period, dem })
     }
 
     /// The encoding.
@@ -167,6 +182,7 @@ impl LandscapeJob {
             LandscapeMap::Map(n) => format!("map={n}"),
             LandscapeMap::Splat => "splat".to_string(),
         };
+        let map = format!("{map}{}", self.dem.map(|d| d.key()).unwrap_or_default());
         let target = match self.target {
             Target::Tile(t) => format!("tile|{}|{}|{}|{}", t.z, t.x, t.y, t.scale),
             Target::Window(w) => format!("window|{}|{}|{}|{}|{}", w.z, w.x, w.y, w.w, w.h),
@@ -262,7 +278,7 @@ impl LandscapeJob {
                         // Only `height` gets here (the request checked the others): the luma.
                         None => {
                             let a = albedo[i].take().map_or_else(|| render(job), Ok)?;
-                            luma_heights(&a).iter().flat_map(|h| [(h * 255.0).round() as u8; 3]).collect()
+                            super::luma_grey(&a)
                         }
                     });
                 }
@@ -277,6 +293,9 @@ impl LandscapeJob {
         };
         if self.map == LandscapeMap::Map("normal".into()) {
             textile_core::maps::renormalise(&mut px);
+        }
+        if let Some(dem) = &self.dem {
+            return dem.png(&px, weights.width as u32, weights.height as u32);
         }
         // Encoded as the first visible layer's own image is, so that a tile of one layer alone
         // is that layer's tile, byte for byte.

@@ -20,6 +20,7 @@ use crate::encode::{encode, Effort, Format, ENCODER_VERSION, MAP_ENCODER_VERSION
 use crate::error::ApiError;
 use crate::request::{TileSpec, WindowSpec};
 use crate::state::AppState;
+use crate::terrain::Dem;
 use crate::textures::Texture;
 
 /// Version of everything besides the analysis and the mode that determines bytes (each mode's
@@ -75,6 +76,8 @@ pub struct ImageJob {
     pub target: Target,
     /// The colour, a material map or the coordinates.
     pub map: MapChoice,
+    /// Heights as a raster-dem: `map` is then the height map, or the colour whose luma serves.
+    pub dem: Option<Dem>,
 }
 
 impl ImageJob {
@@ -98,14 +101,18 @@ impl ImageJob {
                 format!("|map={n}:{hash}:enc{MAP_ENCODER_VERSION}")
             }
         };
+        // Empty unless a raster-dem is asked for, so that every other key stays as it was.
+        let dem = self.dem.map(|d| d.key()).unwrap_or_default();
         match self.target {
-            Target::Tile(t) => {
-                cache_key(&self.tex, &self.params, format_args!("tile|{}|{}|{}|{}|{f}{map}", t.z, t.x, t.y, t.scale))
-            }
+            Target::Tile(t) => cache_key(
+                &self.tex,
+                &self.params,
+                format_args!("tile|{}|{}|{}|{}|{f}{map}{dem}", t.z, t.x, t.y, t.scale),
+            ),
             Target::Window(w) => cache_key(
                 &self.tex,
                 &self.params,
-                format_args!("window|{}|{}|{}|{}|{}|{f}{map}", w.z, w.x, w.y, w.w, w.h),
+                format_args!("window|{}|{}|{}|{}|{}|{f}{map}{dem}", w.z, w.x, w.y, w.w, w.h),
             ),
         }
     }
@@ -200,6 +207,15 @@ impl ImageJob {
             return self.uv_bytes(cache);
         }
         let r = self.render_until(cache, cancel)?;
+        if let Some(dem) = &self.dem {
+            let (w, h) = (r.image.width, r.image.height);
+            let bytes = match self.map {
+                MapChoice::Map(_) => dem.png(&r.image.pixels, w, h)?,
+                // A texture without a height map: its luma serves.
+                _ => dem.png(&luma_grey(&r.image.pixels), w, h)?,
+            };
+            return Ok((bytes, r));
+        }
         Ok((self.encode(&r.image)?, r))
     }
 
@@ -318,6 +334,11 @@ fn render_pieces(
     Ok(Rendered { image: RgbWindow { width: w as u32, height: h as u32, pixels }, synthesized })
 }
 
+/// RGB pixels as grey ones of their luma (Rec. 601), for heights where no height map is.
+pub fn luma_grey(rgb: &[u8]) -> Vec<u8> {
+    textile_core::landscape::blend::luma_heights(rgb).iter().flat_map(|h| [(h * 255.0).round() as u8; 3]).collect()
+}
+
 fn upscale2(img: &RgbWindow) -> RgbWindow {
     let (w, h) = (img.width as usize, img.height as usize);
     let mut px = Vec::with_capacity(12 * w * h);
@@ -346,7 +367,7 @@ mod tests {
         let target = Target::Tile(TileSpec { z: 7, x: 1, y: -2, scale: 1, format: Format::Png });
         let key = |tex: &Arc<Texture>, mode: &str| {
             let params = tex.defaults.request(&tex.source(), ParamReader::request([("mode", mode)]).unwrap()).unwrap();
-            ImageJob { tex: tex.clone(), params, target, map: MapChoice::Albedo }.key()
+            ImageJob { tex: tex.clone(), params, target, map: MapChoice::Albedo, dem: None }.key()
         };
         let a = Arc::new(tex);
         // The same texture with another analysis file (e.g. a new analysis version).

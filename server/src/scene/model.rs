@@ -151,6 +151,7 @@ impl Model {
             params: self.params.clone(),
             target: Target::Window(window),
             map: MapChoice::Albedo,
+            dem: None,
         }
     }
 

@@ -165,6 +165,11 @@ impl Landscape {
         Zooms { min: self.min_zoom, max: self.max_zoom, native: self.native_zoom }
     }
 
+    /// Metres per unit of height in its raster-dem tiles, unless a request says.
+    pub fn height_scale(&self) -> f64 {
+        self.config.height_scale.unwrap_or_else(|| crate::terrain::default_height_scale(self.native_zoom))
+    }
+
     /// The splat's seed, unless a request gives one.
     pub fn splat_seed(&self) -> u64 {
         match &self.config.splat {

@@ -206,6 +206,11 @@ impl Texture {
     pub fn zooms(&self) -> Zooms {
         Zooms { min: self.min_zoom(), max: self.max_zoom(), native: self.native_zoom() }
     }
+    /// Metres per unit of height in its raster-dem tiles, unless a request says: configured,
+    /// else [`crate::terrain::default_height_scale`] of its native zoom.
+    pub fn height_scale(&self) -> f64 {
+        self.config.height_scale.unwrap_or_else(|| crate::terrain::default_height_scale(self.native_zoom()))
+    }
     /// Smallest zoom served.
     pub fn min_zoom(&self) -> u32 {
         0
