@@ -1,5 +1,5 @@
-//! The web viewer in headless Chromium, driven by Playwright (`tests/browser/viewer.test.mjs`)
-//! against the real binary. Needs node and Debian's `chromium` (.ci/run installs it); the test
+//! The web viewer in headless Chromium, driven by Playwright (`tests/browser/viewer.test.mjs`,
+//! and MapLibre on the terrain tiles: `tests/browser/terrain.test.mjs`) against the real binary. Needs node and Debian's `chromium` (.ci/run installs it); the test
 //! runs `npm ci` in `tests/browser` itself when its packages are missing. Without them the test
 //! says on the terminal that it skipped, and why; under CI it fails instead.
 
@@ -52,6 +52,15 @@ fn viewer_in_headless_chromium() {
         .expect("run node");
     assert!(status.success(), "browser tests failed (see the node test output above)");
     eprintln!("viewer screenshot: {}", shot.display());
+    // MapLibre on the same server: the README's terrain style and the terrain page.
+    let status = Command::new("node")
+        .args(["--test", "--test-concurrency=1", "terrain.test.mjs"])
+        .current_dir(&dir)
+        .env("TEXTILE_URL", &server.base)
+        .env("CHROMIUM", &chromium)
+        .status()
+        .expect("run node");
+    assert!(status.success(), "terrain tests failed (see the node test output above)");
 }
 
 #[test]

@@ -606,6 +606,9 @@ async function init() {
   $('lattice').addEventListener('change', (e) => setLattice(e.target.checked));
   $('splat').addEventListener('change', (e) => setSplat(e.target.checked));
   setupUpload();
+  $('terrainlink').addEventListener('click', (e) => {
+    e.currentTarget.href = `/terrain.html#t=${encodeURIComponent(state.t)}`;
+  });
   $('worldlink').addEventListener('click', (e) => {
     e.currentTarget.href = `/world.html#t=${encodeURIComponent(state.t)}&m=${state.m}&s=${state.s}`;
   });

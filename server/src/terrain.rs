@@ -143,10 +143,10 @@ impl Dem {
 
     /// The PNG of heights given as RGB bytes whose red channel is the height (0–255).
     pub fn png(&self, heights: &[u8], w: u32, h: u32) -> Result<Vec<u8>, ApiError> {
-        let rgb: Vec<u8> = heights
-            .chunks_exact(3)
-            .flat_map(|p| self.encoding.rgb(self.base + p[0] as f64 / 255.0 * self.height_scale))
-            .collect();
+        // 256 heights at most: each encoded once.
+        let table: Vec<[u8; 3]> =
+            (0..=255u8).map(|v| self.encoding.rgb(self.base + v as f64 / 255.0 * self.height_scale)).collect();
+        let rgb: Vec<u8> = heights.chunks_exact(3).flat_map(|p| table[p[0] as usize]).collect();
         encode(&rgb, w, h, Format::Png, Effort::Map).map_err(|e| ApiError::internal(format!("encoding: {e}")))
     }
 }

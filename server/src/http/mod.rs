@@ -100,6 +100,7 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/", get(static_files::index))
         .route("/world.html", get(static_files::world))
         .route("/3d.html", get(static_files::three_d))
+        .route("/terrain.html", get(static_files::terrain))
         .route("/static/{*path}", get(static_files::static_file))
         .route("/health", get(meta::health))
         .route("/ready", get(meta::ready))

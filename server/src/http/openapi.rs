@@ -33,6 +33,7 @@ use utoipa::{Modify, OpenApi};
         crate::http::static_files::index,
         crate::http::static_files::world,
         crate::http::static_files::three_d,
+        crate::http::static_files::terrain,
         crate::http::models::gltf_tile,
         crate::http::models::gltf_patch,
         crate::http::models::x3d_tile,

@@ -1,5 +1,5 @@
-//! The web viewer's files, compiled into the binary (`web/`): pages at `/`, `/world.html` and
-//! `/3d.html`,
+//! The web viewer's files, compiled into the binary (`web/`): pages at `/`, `/world.html`,
+//! `/3d.html` and `/terrain.html`,
 //! the archive page `/static/pmtiles.html`, scripts, styles and the vendored libraries (with their licences) under `/static/`.
 
 use axum::extract::Path;
@@ -14,6 +14,14 @@ const FILES: &[(&str, &str, &[u8])] = &[
     ("controls.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/controls.js")),
     ("modes.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/modes.js")),
     ("world.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/world.js")),
+    ("terrain.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/terrain.js")),
+    ("vendor/maplibre-gl.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/vendor/maplibre-gl.js")),
+    ("vendor/maplibre-gl.css", "text/css; charset=utf-8", include_bytes!("../../../web/vendor/maplibre-gl.css")),
+    (
+        "vendor/LICENSE-maplibre-gl",
+        "text/plain; charset=utf-8",
+        include_bytes!("../../../web/vendor/LICENSE-maplibre-gl"),
+    ),
     ("pmtiles.html", "text/html; charset=utf-8", include_bytes!("../../../web/pmtiles.html")),
     ("pmtiles.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/pmtiles.js")),
     ("vendor/pmtiles.js", "text/javascript; charset=utf-8", include_bytes!("../../../web/vendor/pmtiles.js")),
@@ -121,6 +129,12 @@ pub async fn index() -> Response {
 #[utoipa::path(get, path = "/world.html", tag = "viewer", responses((status = 200, description = "HTML")))]
 pub async fn world() -> Response {
     file(include_bytes!("../../../web/world.html"), "text/html; charset=utf-8")
+}
+
+/// The terrain page: the texture over its own heights in MapLibre GL JS.
+#[utoipa::path(get, path = "/terrain.html", tag = "viewer", responses((status = 200, description = "HTML")))]
+pub async fn terrain() -> Response {
+    file(include_bytes!("../../../web/terrain.html"), "text/html; charset=utf-8")
 }
 
 /// The 3D viewer: the texture's 3D Tiles tileset in three.js with 3DTilesRendererJS.
