@@ -322,12 +322,7 @@ async function selectTexture(id, keepView) {
     buildMapPicker();
     setLattice(false);
     $('latticerow').hidden = true;
-    map.setMinZoom(meta.minzoom);
-    map.setMaxZoom(meta.maxzoom + 2);
-    if (layer) { map.removeLayer(layer); layer = null; }
-    if (!keepView || state.z === null || Number.isNaN(state.z)) state.z = meta.native_zoom;
-    map.setView(toLatLng(state.x, state.y), state.z, { animate: false });
-    refreshLayer();
+    showView(keepView);
     setSplat(state.o);
     return;
   }
@@ -339,6 +334,12 @@ async function selectTexture(id, keepView) {
   buildControls();
   showLatticeRow();
   showStructure();
+  showView(keepView);
+}
+
+// The map for the texture just described: its zooms, the view (kept, or at its native zoom),
+// and its tiles.
+function showView(keepView) {
   map.setMinZoom(meta.minzoom);
   map.setMaxZoom(meta.maxzoom + 2);
   if (layer) { map.removeLayer(layer); layer = null; }

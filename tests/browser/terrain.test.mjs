@@ -31,7 +31,7 @@ function readmeSnippet() {
 
 async function page(path) {
   // Small: software WebGL draws terrain slowly.
-  const p = await browser.newPage({ viewport: { width: 640, height: 420 } });
+  const p = await browser.newPage({ viewport: { width: 512, height: 340 } });
   const errors = [];
   p.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
   p.on('pageerror', (e) => errors.push(String(e)));

@@ -145,7 +145,16 @@ pub fn run(a: RenderArgs) -> CliResult {
         return Ok(());
     }
     let format = output_format(&output)?;
-    let target = if let Some(win) = &a.window {
+    let target = target_of(&a, z, format)?;
+    let (bytes, r) = ImageJob { tex, params, target, map, dem: None }.bytes(&Pyramid::off())?;
+    write_atomic(&output, &bytes)?;
+    println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
+    Ok(())
+}
+
+/// The tile (`--x`, `--y`) or window (`--window X,Y,W,H`) at zoom `z` the flags ask for.
+fn target_of(a: &RenderArgs, z: u32, format: Format) -> Result<Target, Box<dyn std::error::Error>> {
+    if let Some(win) = &a.window {
         let v: Vec<i64> = win
             .split(',')
             .map(|s| s.trim().parse::<i64>())
@@ -157,18 +166,13 @@ pub fn run(a: RenderArgs) -> CliResult {
         if !(1..=MAX_WINDOW_SIDE).contains(&w) || !(1..=MAX_WINDOW_SIDE).contains(&h) {
             return Err(format!("--window width and height must be 1..={MAX_WINDOW_SIDE}").into());
         }
-        Target::Window(WindowSpec { z, x, y, w, h, format })
-    } else {
-        let (x, y) = (a.x.unwrap_or(0), a.y.unwrap_or(0));
-        if !(COORD_MIN..=COORD_MAX).contains(&x) || !(COORD_MIN..=COORD_MAX).contains(&y) {
-            return Err("--x and --y must be in [-2^31, 2^31-1]".into());
-        }
-        Target::Tile(TileSpec { z, x, y, scale: 1, format })
-    };
-    let (bytes, r) = ImageJob { tex, params, target, map, dem: None }.bytes(&Pyramid::off())?;
-    write_atomic(&output, &bytes)?;
-    println!("wrote {} ({}x{})", output.display(), r.image.width, r.image.height);
-    Ok(())
+        return Ok(Target::Window(WindowSpec { z, x, y, w, h, format }));
+    }
+    let (x, y) = (a.x.unwrap_or(0), a.y.unwrap_or(0));
+    if !(COORD_MIN..=COORD_MAX).contains(&x) || !(COORD_MIN..=COORD_MAX).contains(&y) {
+        return Err("--x and --y must be in [-2^31, 2^31-1]".into());
+    }
+    Ok(Target::Tile(TileSpec { z, x, y, scale: 1, format }))
 }
 
 /// `textile render --texture LANDSCAPE`: a tile or window of a landscape, the bytes the server
@@ -184,18 +188,7 @@ fn render_landscape(a: &RenderArgs, land: Arc<Landscape>, output: &Path) -> CliR
     if !(land.min_zoom..=land.max_zoom).contains(&z) {
         return Err(format!("--z {z} is outside {}..={}", land.min_zoom, land.max_zoom).into());
     }
-    let target = match &a.window {
-        Some(win) => {
-            let v: Vec<i64> = win
-                .split(',')
-                .map(|s| s.trim().parse::<i64>())
-                .collect::<Result<_, _>>()
-                .map_err(|_| "--window must be X,Y,W,H integers")?;
-            let [x, y, w, h] = v[..] else { return Err("--window must be X,Y,W,H".into()) };
-            Target::Window(WindowSpec { z, x, y, w, h, format })
-        }
-        None => Target::Tile(TileSpec { z, x: a.x.unwrap_or(0), y: a.y.unwrap_or(0), scale: 1, format }),
-    };
+    let target = target_of(a, z, format)?;
     let mut pairs = param_pairs(&[], &None, a.seed, a.world)?;
     pairs.push(("map".into(), a.map.clone()));
     let mut r = ParamReader::request(pairs)?;
