@@ -241,46 +241,49 @@ impl LandscapeJob {
         }
         let used = splat.used();
         let n = used.iter().filter(|u| **u).count();
+        let blend_heights = n > 1 && self.land.blend.needs_heights();
+        let height_map = self.map == LandscapeMap::Map("height".into());
         let mut albedo: Vec<Option<Vec<u8>>> = vec![None; used.len()];
         let mut heights: Vec<Option<Heights>> = vec![None; used.len()];
+        let mut grey: Vec<Option<Vec<u8>>> = vec![None; used.len()];
         let render = |job: &ImageJob| -> Result<Vec<u8>, ApiError> {
             if cancel.is_set() {
                 return Err(textile_core::CoreError::Cancelled.into());
             }
             Ok(job.render(cache)?.image.pixels)
         };
-        let height_job = |job: &ImageJob| ImageJob { map: MapChoice::Map("height".into()), ..job.clone() };
+        let map_job = |job: &ImageJob, name: &str| ImageJob { map: MapChoice::Map(name.into()), ..job.clone() };
+        // Each layer's colour and height map rendered at most once: a layer without a height map
+        // gives its luma, from its colour.
         for (i, job) in self.layers.iter().enumerate().filter(|(i, _)| used[*i]) {
             let has_height = job.tex.exemplar.map("height").is_some();
-            let wants_albedo = self.map == LandscapeMap::Albedo
-                || (!has_height
-                    && (n > 1 && self.land.blend.needs_heights() || self.map == LandscapeMap::Map("height".into())));
-            if wants_albedo {
+            if self.map == LandscapeMap::Albedo || (!has_height && (blend_heights || height_map)) {
                 albedo[i] = Some(render(job)?);
             }
-            if n > 1 && self.land.blend.needs_heights() {
-                heights[i] = Some(match (has_height, &albedo[i]) {
-                    (true, _) => grey_heights(&render(&height_job(job))?),
-                    (false, Some(a)) => luma_heights(a),
-                    (false, None) => luma_heights(&render(job)?),
-                });
+            let own = match has_height && (blend_heights || height_map) {
+                true => Some(render(&map_job(job, "height"))?),
+                false => None,
+            };
+            if blend_heights {
+                heights[i] = match (&own, &albedo[i]) {
+                    (Some(h), _) => Some(grey_heights(h)),
+                    (None, a) => a.as_deref().map(luma_heights),
+                };
+            }
+            if height_map {
+                grey[i] = own.or_else(|| albedo[i].as_deref().map(super::luma_grey));
             }
         }
         let first = used.iter().position(|u| *u).unwrap_or(0);
         let weights = if n > 1 { self.land.blend.weights(&splat, &heights) } else { splat };
         let images: Vec<Option<Vec<u8>>> = match &self.map {
             LandscapeMap::Albedo => albedo,
+            _ if height_map => grey,
             LandscapeMap::Map(name) => {
+                // Any other map is every layer's (the request checked).
                 let mut out = vec![None; used.len()];
                 for (i, job) in self.layers.iter().enumerate().filter(|(i, _)| used[*i]) {
-                    out[i] = Some(match job.tex.exemplar.map(name) {
-                        Some(_) => render(&ImageJob { map: MapChoice::Map(name.clone()), ..job.clone() })?,
-                        // Only `height` gets here (the request checked the others): the luma.
-                        None => {
-                            let a = albedo[i].take().map_or_else(|| render(job), Ok)?;
-                            super::luma_grey(&a)
-                        }
-                    });
+                    out[i] = Some(render(&map_job(job, name))?);
                 }
                 out
             }
@@ -297,21 +300,14 @@ impl LandscapeJob {
         if let Some(dem) = &self.dem {
             return dem.png(&px, weights.width as u32, weights.height as u32);
         }
-        // Encoded as the first visible layer's own image is, so that a tile of one layer alone
-        // is that layer's tile, byte for byte.
+        // Encoded as the first visible layer's own image is (a map, luma heights too, as a map),
+        // so that a tile of one layer alone is that layer's tile, byte for byte.
         let enc = match &self.map {
             LandscapeMap::Map(n) => ImageJob { map: MapChoice::Map(n.clone()), ..self.layers[first].clone() },
             _ => self.layers[first].clone(),
         };
         let img = textile_core::RgbWindow { width: weights.width as u32, height: weights.height as u32, pixels: px };
-        match (&self.map, enc.tex.exemplar.map("height")) {
-            // A luma height is a grey map, encoded as one.
-            (LandscapeMap::Map(n), None) if n == "height" => {
-                encode(&img.pixels, img.width, img.height, self.format(), Effort::Map)
-                    .map_err(|e| ApiError::internal(format!("encoding: {e}")))
-            }
-            _ => enc.encode(&img),
-        }
+        enc.encode(&img)
     }
 }
 
