@@ -145,7 +145,7 @@ async fn a_landscape_is_served_like_a_texture_and_its_layers_show_through() {
         ("/tiles/island/7/0/0.png?world=64", 400, "does not repeat"),
         ("/tiles/ground/7/0/0.png?world=4", 400, "divide"),
         ("/tiles/ground/11/0/0.png", 400, "outside"),
-        ("/gltf/ground/7/0/0.glb", 404, "landscape"),
+        ("/gltf/ground/7/0/0.glb?mode=synth", 400, "configuration"),
     ] {
         let (st, body) = s.get_bytes(path).await;
         let body = String::from_utf8_lossy(&body);

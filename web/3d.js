@@ -1,7 +1,9 @@
 // textile 3D viewer: the texture's OGC 3D Tiles tileset (/3dtiles/{id}/tileset.json) streamed by
 // 3DTilesRendererJS into a three.js scene, with a map-style camera (pan, orbit, dolly) and the
 // texture, mode, seed and mode-parameter pickers built from /catalog and the texture's parameter
-// specs, as the 2D viewer's are. The view and the choices live in the URL hash (the permalink).
+// specs, as the 2D viewer's are; landscapes (several textures in one ground) are offered beside
+// the textures, with their seed and relief. The view and the choices live in the URL hash (the
+// permalink; its keys are listed in the README's "3D viewer" section).
 import * as THREE from 'three';
 import { MapControls } from 'three/addons/controls/MapControls.js';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
@@ -11,9 +13,10 @@ import { ImplicitTilingPlugin } from '3d-tiles-renderer/core/plugins';
 const $ = (id) => document.getElementById(id);
 const num = (v) => String(Number(Number(v).toFixed(3)));
 
-// t: texture, m: mode, seed, p: mode parameters as given, cam: eye and target, sun: the sun's
-// direction in degrees (materials with normals), relief: the height map's white in texels
-// (textures with a height map; 0: flat tiles).
+// t: texture or landscape, m: mode (textures), seed, p: mode parameters as given, cam: eye and
+// target, sun: the sun's direction in degrees (materials with normals), relief: the height
+// map's white in texels (textures with a height map, and landscapes; 0: flat tiles).
+const MAX_RELIEF = 32;
 const state = { t: null, m: null, seed: '0', p: {}, cam: null, sun: 135, relief: 0 };
 let catalog = null, meta = null, tiles = null, debounce = null, retry = null;
 // Every content tile the renderer asked for, by level (the test and the readout use them).
@@ -29,7 +32,7 @@ function readHash() {
   const sun = Number(h.get('sun'));
   if (h.has('sun') && Number.isFinite(sun)) state.sun = ((Math.round(sun) % 360) + 360) % 360;
   const relief = Number(h.get('relief'));
-  state.relief = h.has('relief') && Number.isFinite(relief) ? Math.min(32, Math.max(0, Math.round(relief))) : 0;
+  state.relief = h.has('relief') && Number.isFinite(relief) ? Math.min(MAX_RELIEF, Math.max(0, Math.round(relief))) : 0;
   const cam = (h.get('cam') || '').split(',').map(Number);
   state.cam = cam.length === 6 && cam.every(Number.isFinite) ? cam : null;
 }
@@ -37,7 +40,7 @@ function readHash() {
 function writeHash() {
   const h = new URLSearchParams();
   h.set('t', state.t);
-  h.set('m', state.m);
+  if (!landscape()) h.set('m', state.m);
   h.set('seed', state.seed);
   for (const [k, v] of Object.entries(state.p)) h.set(`p.${k}`, v);
   if (lit()) h.set('sun', state.sun);
@@ -51,7 +54,7 @@ function writeHash() {
 /** The tileset URL of the current choices: the tiles' query parameters. */
 function tilesetUrl() {
   const q = new URLSearchParams();
-  if (state.m !== meta.default_mode) q.set('mode', state.m);
+  if (!landscape() && state.m !== meta.default_mode) q.set('mode', state.m);
   if (state.seed !== '0') q.set('seed', state.seed);
   for (const [k, v] of Object.entries(state.p)) q.set(k, v);
   if (raised()) q.set('relief', state.relief);
@@ -73,9 +76,21 @@ const ambient = new THREE.AmbientLight(0xffffff, Math.PI);
 const sun = new THREE.DirectionalLight(0xffffff, 0);
 scene.add(ambient, sun, sun.target);
 
-/** Whether the texture has a height map the mode renders: its tiles can be displaced. */
+/** Whether a landscape is shown (its maps are names; a texture's are objects with modes). */
+function landscape() {
+  return meta?.kind === 'landscape';
+}
+
+/** Whether the texture or landscape has map `name` (for a texture, one the mode renders). */
+function hasMap(test) {
+  if (landscape()) return (meta.maps || []).some((n) => test({ name: n, kind: n }));
+  return Boolean(meta && (meta.maps || []).some((m) => test(m) && (m.modes || []).includes(state.m)));
+}
+
+/** Whether the tiles can be displaced: a texture's height map the mode renders, or a landscape's
+ * blended heights. */
 function hasHeight() {
-  return Boolean(meta && (meta.maps || []).some((m) => m.name === 'height' && (m.modes || []).includes(state.m)));
+  return hasMap((m) => m.name === 'height');
 }
 
 /** Whether the tiles are displaced: a relief asked for, on a texture with a height map. */
@@ -85,13 +100,15 @@ function raised() {
 
 /** Whether the current texture and mode show a lit material (a normal map the mode renders). */
 function lit() {
-  return Boolean(meta && (meta.maps || []).some((m) => m.kind === 'normal' && m.modes.includes(state.m)));
+  return hasMap((m) => m.kind === 'normal');
 }
 
 function placeSun() {
   const on = lit();
   $('sunrow').hidden = !on;
   $('reliefrow').hidden = !hasHeight();
+  $('sunvalue').textContent = `${state.sun}°`;
+  $('reliefvalue').textContent = state.relief > 0 ? `${state.relief} texels` : 'flat';
   ambient.intensity = on ? 0.9 : Math.PI;
   sun.intensity = on ? 2.6 : 0;
   // Azimuth from east, counter-clockwise seen from above (north is −Z).
@@ -248,9 +265,12 @@ function control(name, spec) {
 }
 
 function buildParams() {
-  $('modename').textContent = state.m;
   const box = $('controls');
   box.textContent = '';
+  $('moderow').hidden = landscape();
+  $('params').hidden = landscape();
+  if (landscape()) return;
+  $('modename').textContent = state.m;
   const specs = Object.entries(meta.parameters).filter(([, s]) => s.modes && s.modes.includes(state.m) && s.scope === 'request');
   for (const name of Object.keys(state.p)) if (!specs.some(([n]) => n === name)) delete state.p[name];
   for (const [name, spec] of specs) {
@@ -264,7 +284,7 @@ async function selectTexture(id, keepView) {
   if (!r.ok) throw new Error(`texture ${id}: HTTP ${r.status}`);
   meta = await r.json();
   state.t = id;
-  state.m = window.TextileModes.fill($('mode'), meta, state.m);
+  if (!landscape()) state.m = window.TextileModes.fill($('mode'), meta, state.m);
   buildParams();
   $('sun').value = state.sun;
   $('relief').value = state.relief;
@@ -325,13 +345,22 @@ async function main() {
   resize();
   catalog = await (await fetch('/catalog')).json();
   const sel = $('texture');
-  for (const t of catalog.textures) sel.append(new Option(t.name, t.id));
-  if (!catalog.textures.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
+  const group = (label, items) => {
+    const g = document.createElement('optgroup');
+    g.label = label;
+    for (const t of items) g.append(new Option(t.name, t.id));
+    sel.append(g);
+  };
+  group('Textures', catalog.textures);
+  if ((catalog.landscapes || []).length) group('Landscapes', catalog.landscapes);
+  const all = catalog.textures.concat(catalog.landscapes || []);
+  if (!all.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
   sel.value = state.t;
   $('seed').value = state.seed;
   sel.addEventListener('change', () => { state.p = {}; selectTexture(sel.value, false); });
   $('mode').addEventListener('change', () => { state.m = $('mode').value; buildParams(); placeSun(); changed(); });
   $('sun').addEventListener('input', () => { state.sun = Number($('sun').value); placeSun(); writeHash(); });
+  $('relief').addEventListener('input', () => { state.relief = Number($('relief').value); placeSun(); });
   $('relief').addEventListener('change', () => { state.relief = Number($('relief').value); changed(); });
   $('seed').addEventListener('change', () => { state.seed = String(Math.max(0, Math.floor(Number($('seed').value) || 0))); changed(); });
   $('newseed').addEventListener('click', () => {

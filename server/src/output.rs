@@ -14,9 +14,9 @@ use axum::body::Bytes;
 use textile_core::Pyramid;
 
 use crate::error::ApiError;
-use crate::metrics::{GLTF_LABEL, LANDSCAPE_LABEL};
+use crate::metrics::GLTF_LABEL;
 use crate::pipeline::landscape::LandscapeJob;
-use crate::pipeline::{self, etag_for, ImageJob};
+use crate::pipeline::{self, etag_for, ImageJob, Picture};
 use crate::scene::assets::{glb, gltf_json, x3d, Relief, Slot};
 use crate::scene::model::{generator, material_images, Model};
 use crate::state::AppState;
@@ -54,6 +54,15 @@ pub enum Output {
         /// The server's base URL.
         base: String,
     },
+}
+
+impl From<Picture> for Output {
+    fn from(p: Picture) -> Output {
+        match p {
+            Picture::Texture(job) => Output::Image(job),
+            Picture::Landscape(job) => Output::Landscape(job),
+        }
+    }
 }
 
 impl Output {
@@ -103,7 +112,7 @@ impl Output {
     }
 
     /// The images it is assembled from, in the order [`Output::assemble`] takes them.
-    pub fn parts(&self) -> Vec<ImageJob> {
+    pub fn parts(&self) -> Vec<Picture> {
         match self {
             Output::Image(_) | Output::Landscape(_) | Output::Gltf { .. } | Output::X3d { .. } => Vec::new(),
             Output::Glb(m) if m.tiles > 1 => m.tile_specs().map(|t| m.image_at(t)).collect(),
@@ -177,7 +186,8 @@ impl Output {
             Output::Landscape(job) => return job.bytes(cache, &textile_core::Cancel::default()),
             _ => {}
         }
-        let parts = self.parts().iter().map(|job| Ok(job.bytes(cache)?.0)).collect::<Result<Vec<_>, ApiError>>()?;
+        let cancel = textile_core::Cancel::default();
+        let parts = self.parts().iter().map(|p| p.bytes(cache, &cancel)).collect::<Result<Vec<_>, ApiError>>()?;
         self.assemble(parts)
     }
 
@@ -197,10 +207,7 @@ impl Output {
 pub async fn produce(st: &Arc<AppState>, etag: &str, out: Output) -> (Result<Bytes, ApiError>, bool) {
     let out = match out {
         Output::Image(job) => return pipeline::produce(st, etag, job).await,
-        Output::Landscape(job) => {
-            let pyramid = st.pyramid.clone();
-            return pipeline::cached(st, etag, LANDSCAPE_LABEL, move |cancel| job.bytes(&pyramid, cancel)).await;
-        }
+        Output::Landscape(job) => return pipeline::produce_picture(st, etag, Picture::Landscape(job)).await,
         out => out,
     };
     if out.kept() {
@@ -214,8 +221,8 @@ pub async fn produce(st: &Arc<AppState>, etag: &str, out: Output) -> (Result<Byt
             bytes => Some(st.reserve(bytes).await?),
         };
         let mut parts = Vec::new();
-        for job in out.parts() {
-            parts.push(pipeline::produce(st, &job.etag(), job).await.0?.to_vec());
+        for p in out.parts() {
+            parts.push(pipeline::produce_picture(st, &p.etag(), p).await.0?.to_vec());
         }
         if !out.kept() {
             return Ok((Bytes::from(out.assemble(parts)?), false));

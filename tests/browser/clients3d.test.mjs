@@ -218,6 +218,12 @@ test('X_ITE: a tile document shows the tile, seen from above', async () => {
   const rp = await page.evaluate((url) => window.pixels.correlate(url, 3, 4), tile);
   console.log(`X_ITE patch: centre tile correlation ${rp.toFixed(3)}`);
   assert.ok(rp > 0.8, `patch centre correlation ${rp}`);
+  // A landscape's tile document (the meadow, where its layers meet): the landscape's tile.
+  const land = await x3dShot(page, '/x3d/meadow/8/3/4.x3d?seed=3');
+  save('x3d-landscape.png', land.url);
+  const rl = await page.evaluate((url) => window.pixels.correlate(url, 1, 1), `${BASE}/tiles/meadow/8/3/4.png?seed=3`);
+  console.log(`X_ITE landscape tile vs the landscape's tile image: correlation ${rl.toFixed(3)}`);
+  assert.ok(rl > 0.9, `landscape correlation ${rl}`);
   assert.deepEqual(errors, []);
   await page.close();
 });
@@ -367,13 +373,14 @@ test('/3d.html lights a material with a sun whose direction a slider turns', asy
   await page.close();
 });
 
-test('/3d.html shows relief without cracks: no sky through the ground near, oblique or at the horizon', async () => {
-  // Flagstones (65 536 texels across), relief 8 texels high: tiles of several levels meet in
-  // every view, their edges at other heights; the skirts must close every gap.
-  const { page, errors } = await open3d('t=flagstones&m=synth&seed=2&relief=8&cam=32768,30,32800,32768,0,32768');
+/** Open /3d.html at `hash` (relief 8, camera near texel (32768, 32768)) and count the
+ * background pixels through the ground in a near, an oblique and a horizon view. */
+async function reliefCracks(hash, label) {
+  const { page, errors } = await open3d(`${hash}&relief=8&cam=32768,30,32800,32768,0,32768`);
   assert.match(await page.evaluate(() => document.querySelector('#tilesetlink').href), /relief=8/);
-  assert.equal(await page.isVisible('#reliefrow'), true, 'a texture with a height map offers relief');
+  assert.equal(await page.isVisible('#reliefrow'), true, `${label} offers relief`);
   assert.equal(await page.inputValue('#relief'), '8');
+  assert.equal(await page.textContent('#reliefvalue'), '8 texels', 'the relief slider shows its value');
   // The scene's background (0xbfd1e5) where the ground should be: the rows below `from` (a
   // share of the height: the oblique and horizon views show the sky above the horizon).
   const sky = (from) => page.evaluate((from) => {
@@ -399,12 +406,33 @@ test('/3d.html shows relief without cracks: no sky through the ground near, obli
     await page.evaluate(([e, t]) => window.textile3d.look(e, t), [eye, target]);
     await settled3d(page);
     found[name] = await sky(from);
-    save(`3d-relief-${name}.png`, `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
+    save(`3d-relief-${label}-${name}.png`, `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
   }
-  console.log(`3D page, flagstones relief=8: background pixels through the ground ${JSON.stringify(found)}`);
+  console.log(`3D page, ${label} relief=8: background pixels through the ground ${JSON.stringify(found)}`);
+  save(`3d-relief-${label}.png`, `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
+  await page.close();
+  return { found, errors };
+}
+
+test('/3d.html shows relief without cracks: no sky through the ground near, oblique or at the horizon', async () => {
+  // Flagstones (65 536 texels across), relief 8 texels high: tiles of several levels meet in
+  // every view, their edges at other heights; the skirts must close every gap.
+  const { found, errors } = await reliefCracks('t=flagstones&m=synth&seed=2', 'flagstones');
   assert.deepEqual(found, { near: 0, oblique: 0, horizon: 0 });
   assert.deepEqual(errors, []);
+});
+
+test('/3d.html lists landscapes and shows one with relief by its blended heights, without cracks', async () => {
+  const { page, errors } = await open3d('t=gravel&m=synth&seed=4');
+  const groups = await page.$$eval('#texture optgroup', (gs) => gs.map((g) => [g.label, [...g.children].map((o) => o.value)]));
+  assert.ok(groups.some(([l, ids]) => l === 'Landscapes' && ids.includes('meadow')), JSON.stringify(groups));
   await page.close();
+  assert.deepEqual(errors, []);
+  // The meadow: grass, gravel and flagstones, their heights (the flagstones' map, the others'
+  // luma) blended; the mode row and parameters are a texture's, not shown.
+  const r = await reliefCracks('t=meadow&seed=0', 'meadow');
+  assert.deepEqual(r.found, { near: 0, oblique: 0, horizon: 0 });
+  assert.deepEqual(r.errors, []);
 });
 
 test('/3d.html: the world has no edge, from the highest the page allows and at the end of panning', async () => {

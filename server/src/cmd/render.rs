@@ -21,7 +21,7 @@ use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
 use crate::pipeline::{ImageJob, Target};
 use crate::request::{TileSpec, WindowSpec, COORD_MAX, COORD_MIN, MAX_WINDOW_SIDE};
 use crate::scene::model::Model;
-use crate::textures::{Landscape, Texture};
+use crate::textures::{Landscape, Served, Texture};
 
 /// `textile render --sheet`: a picture of what the mode prepared for the texture.
 fn sheet(tex: &Texture, params: &ModeParams, output: &Path) -> CliResult {
@@ -138,7 +138,7 @@ pub fn run(a: RenderArgs) -> CliResult {
             return Err("--x and --y must be in [-2^31, 2^31-1]".into());
         }
         let spec = TileSpec { z, x, y, scale: 1, format: Format::Png };
-        let model = Model::read(tex, spec, 1, ParamReader::texture(model_pairs)?, Default::default())?;
+        let model = Model::read(Served::Texture(tex), spec, 1, ParamReader::texture(model_pairs)?, Default::default())?;
         let bytes = Output::Glb(model).bytes(&Pyramid::off())?;
         write_atomic(&output, &bytes)?;
         println!("wrote {} (GLB of tile {z}/{}/{}, {} bytes)", output.display(), spec.x, spec.y, bytes.len());

@@ -14,7 +14,7 @@ use axum::http::{header, HeaderMap};
 
 use crate::error::ApiError;
 use crate::state::AppState;
-use crate::textures::{Registry, Texture};
+use crate::textures::{Registry, Served, Texture};
 
 /// The texture with `id`, or a 404 naming the available ones.
 pub fn texture(reg: &Registry, id: &str) -> Result<Arc<Texture>, ApiError> {
@@ -34,6 +34,14 @@ pub fn texture(reg: &Registry, id: &str) -> Result<Arc<Texture>, ApiError> {
         let known: Vec<String> = reg.list.iter().map(|t| t.config.id.clone()).collect();
         ApiError::unknown_texture(id, &known)
     })
+}
+
+/// The texture or landscape with `id`, or a 404 naming the available ones.
+pub fn served(reg: &Registry, id: &str) -> Result<Served, ApiError> {
+    match reg.landscape(id) {
+        Some(l) => Ok(Served::Landscape(l.clone())),
+        None => texture(reg, id).map(Served::Texture),
+    }
 }
 
 /// The media type of a request body, without parameters, lower-cased (empty if none).

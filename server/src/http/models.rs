@@ -16,9 +16,9 @@ use textile_core::ParamReader;
 
 use crate::error::ApiError;
 use crate::http::content::answer;
-use crate::http::extract::{base_url, path_error, texture, Peer};
+use crate::http::extract::{base_url, path_error, served, Peer};
 use crate::output::Output;
-use crate::request::{parse_tile, query_pairs};
+use crate::request::{parse_tile_in, query_pairs};
 use crate::scene::assets::Slot;
 use crate::scene::model::{Model, MAX_PATCH, SLOT};
 use crate::state::AppState;
@@ -59,7 +59,7 @@ fn tile_request(
 ) -> Result<(Model, String, Option<Slot>), ApiError> {
     let reg = st.ready()?;
     let Path((id, z, x, y)) = path.map_err(path_error)?;
-    let tex = texture(&reg, &id)?;
+    let subject = served(&reg, &id)?;
     let (y, ext) = split_ext(&y, exts)?;
     let (y, raw) = match (ext, y.split_once('.')) {
         ("png", Some((y, token))) if raw.is_none() => {
@@ -74,14 +74,14 @@ fn tile_request(
         }
         _ => (y, raw),
     };
-    let spec = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
+    let spec = parse_tile_in(subject.zooms(), &z, &x, &format!("{y}.png"))?;
     let pairs = query_pairs(raw.as_deref());
     if ext != "png" {
-        return Ok((Model::request(tex, spec, pairs)?, ext.to_string(), None));
+        return Ok((Model::request(subject, spec, pairs)?, ext.to_string(), None));
     }
     // The slot is read after the parameters, as a key of the sibling's own.
     let without: Vec<(String, String)> = pairs.iter().filter(|(k, _)| k != SLOT).cloned().collect();
-    let model = Model::request(tex, spec, without)?;
+    let model = Model::request(subject, spec, without)?;
     let slot = sibling_slot(&model, &pairs)?;
     Ok((model, ext.to_string(), slot))
 }
@@ -89,7 +89,7 @@ fn tile_request(
 /// A tile as a glTF 2.0 ground quad: `.glb` embeds the PNG tile, `.gltf` references the tile
 /// endpoint (a URI relative to the document; the absolute URL is in `images[0].extras.tile_url`).
 #[utoipa::path(get, path = "/gltf/{id}/{z}/{x}/{y}.{ext}", tag = "3d",
-    params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
+    params(("id" = String, Path, description = "texture or landscape id"), ("z" = u32, Path, description = "zoom"),
            ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row"),
            ("ext" = String, Path, description = "glb (binary, image embedded), gltf (JSON, image beside it), or png: the image itself, as `{y}.png` or `{y}.{token}.png` (a material image's token has slot=normal|occlusion|specular|metallic_roughness)"),
            ("relief" = Option<f32>, Query, description = "glb of a texture with a height map: the mesh displaced, white this many texels high, (0, 256]")),
@@ -108,7 +108,7 @@ pub async fn gltf_tile(
     }
     let out = match (ext.as_str(), slot) {
         ("png", Some(slot)) => Output::MaterialImage { model, slot },
-        ("png", None) => Output::Image(model.image()),
+        ("png", None) => Output::from(model.image()),
         ("gltf", _) => Output::Gltf { base: base_url(&st, &headers, peer), model },
         _ => Output::Glb(model),
     };
@@ -124,7 +124,7 @@ fn patch_request(
 ) -> Result<Model, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let tex = texture(&reg, &id)?;
+    let subject = served(&reg, &id)?;
     let pairs = query_pairs(raw.as_deref());
     let mut reader = ParamReader::request(pairs.clone())?;
     let mut need = |k: &str| {
@@ -137,14 +137,14 @@ fn patch_request(
             format!("parameter 'tiles': '{n}' is not an integer in 1..={MAX_PATCH}"),
         )
     })?;
-    let origin = parse_tile(&tex, &z, &x, &format!("{y}.png"))?;
+    let origin = parse_tile_in(subject.zooms(), &z, &x, &format!("{y}.png"))?;
     let query = pairs.into_iter().filter(|(k, _)| !["z", "x", "y", "tiles"].contains(&k.as_str())).collect();
-    Model::read(tex, origin, n, reader, query)
+    Model::read(subject, origin, n, reader, query)
 }
 
 /// An N×N patch of tiles (top-left tile `x, y`) as one GLB scene, one node per tile.
 #[utoipa::path(get, path = "/gltf/{id}/patch.glb", tag = "3d",
-    params(("id" = String, Path, description = "texture id"), ("z" = u32, Query, description = "zoom"),
+    params(("id" = String, Path, description = "texture or landscape id"), ("z" = u32, Query, description = "zoom"),
            ("x" = i64, Query, description = "left tile column"), ("y" = i64, Query, description = "top tile row"),
            ("tiles" = u32, Query, description = "patch side in tiles, 1..=8")),
     responses((status = 200, description = "model/gltf-binary"), (status = 400, description = "bad parameters"),
@@ -164,7 +164,7 @@ pub async fn gltf_patch(
 /// the tile's image (border included) — for a material, a `PhysicalMaterial` with its maps' images
 /// too — and a `Viewpoint` looking down at it.
 #[utoipa::path(get, path = "/x3d/{id}/{z}/{x}/{y}.x3d", tag = "3d",
-    params(("id" = String, Path, description = "texture id"), ("z" = u32, Path, description = "zoom"),
+    params(("id" = String, Path, description = "texture or landscape id"), ("z" = u32, Path, description = "zoom"),
            ("x" = i64, Path, description = "column"), ("y" = i64, Path, description = "row")),
     responses((status = 200, description = "model/x3d+xml"), (status = 400, description = "bad coordinates or parameters"),
               (status = 404, description = "unknown texture")))]
@@ -182,7 +182,7 @@ pub async fn x3d_tile(
 
 /// An N×N patch of tiles (top-left tile `x, y`) as one X3D scene, one `Transform` per tile.
 #[utoipa::path(get, path = "/x3d/{id}/patch.x3d", tag = "3d",
-    params(("id" = String, Path, description = "texture id"), ("z" = u32, Query, description = "zoom"),
+    params(("id" = String, Path, description = "texture or landscape id"), ("z" = u32, Query, description = "zoom"),
            ("x" = i64, Query, description = "left tile column"), ("y" = i64, Query, description = "top tile row"),
            ("tiles" = u32, Query, description = "patch side in tiles, 1..=8")),
     responses((status = 200, description = "model/x3d+xml"), (status = 400, description = "bad parameters"),

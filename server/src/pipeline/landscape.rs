@@ -166,6 +166,17 @@ impl LandscapeJob {
         Ok(LandscapeJob { seed: seed.unwrap_or_else(|| land.splat_seed()), land, target, map, layers, period, dem })
     }
 
+    /// The same landscape, seed and period, showing `map` of another place.
+    pub fn at(&self, target: Target, map: LandscapeMap) -> LandscapeJob {
+        let layers = self
+            .layers
+            .iter()
+            .zip(&self.land.layers)
+            .map(|(j, y)| ImageJob { target: layer_target(target, y.config.scale), ..j.clone() })
+            .collect();
+        LandscapeJob { target, map, layers, dem: None, ..self.clone() }
+    }
+
     /// The encoding.
     pub fn format(&self) -> Format {
         match self.target {

@@ -302,6 +302,58 @@ pub async fn produce(st: &Arc<AppState>, etag: &str, job: ImageJob) -> (Result<B
         .await
 }
 
+/// An image of a texture or of a landscape: what 3D models and exports are made of.
+#[derive(Clone)]
+pub enum Picture {
+    /// A texture's image.
+    Texture(ImageJob),
+    /// A landscape's image.
+    Landscape(landscape::LandscapeJob),
+}
+
+impl Picture {
+    /// The cache key.
+    pub fn key(&self) -> String {
+        match self {
+            Picture::Texture(j) => j.key(),
+            Picture::Landscape(j) => j.key(),
+        }
+    }
+
+    /// The strong ETag.
+    pub fn etag(&self) -> String {
+        etag_for(&self.key())
+    }
+
+    /// The encoding.
+    pub fn format(&self) -> Format {
+        match self {
+            Picture::Texture(j) => j.format(),
+            Picture::Landscape(j) => j.format(),
+        }
+    }
+
+    /// Render and encode here and now (`textile render`, exports).
+    pub fn bytes(&self, cache: &Pyramid, cancel: &Cancel) -> Result<Vec<u8>, ApiError> {
+        match self {
+            Picture::Texture(j) => Ok(j.bytes_until(cache, cancel)?.0),
+            Picture::Landscape(j) => j.bytes(cache, cancel),
+        }
+    }
+}
+
+/// A picture's bytes through the tile cache and the pool, as [`produce`] makes a texture's
+/// (`etag`: its [`Picture::etag`]).
+pub async fn produce_picture(st: &Arc<AppState>, etag: &str, p: Picture) -> (Result<Bytes, ApiError>, bool) {
+    match p {
+        Picture::Texture(job) => produce(st, etag, job).await,
+        Picture::Landscape(job) => {
+            let pyramid = st.pyramid.clone();
+            cached(st, etag, crate::metrics::LANDSCAPE_LABEL, move |cancel| job.bytes(&pyramid, cancel)).await
+        }
+    }
+}
+
 /// Side of the pieces big views are rendered in.
 pub const PIECE: i64 = 1024;
 

@@ -1,5 +1,5 @@
 //! What a 3D model of tiles is made of: a tile (or an N×N patch of tiles) of a texture with a
-//! mode's parameters, `relief`, and the query carried into its URLs — its ground quads, the
+//! mode's parameters or of a landscape ([`Subject`]), `relief`, and the query carried into its URLs — its ground quads, the
 //! images they show (each tile with a border of the neighbouring texture, [`BORDER`] texels, a
 //! window of the one texture), its glTF material's maps, and the parts of its cache keys.
 //! [`crate::output::Output`] turns a [`Model`] into GLB, glTF and X3D bytes; `http/` only
@@ -14,10 +14,11 @@ use textile_core::{ModeParams, ParamReader, TILE_SIZE};
 
 use crate::encode::Format;
 use crate::error::ApiError;
-use crate::pipeline::{cache_key, engine_version, ImageJob, Target};
+use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
+use crate::pipeline::{cache_key, engine_version, ImageJob, Picture, Target};
 use crate::request::{params, query_string, TileSpec, WindowSpec, COORD_MAX};
 use crate::scene::assets::{image_side, metallic_roughness, Quad, Slot, BORDER, LAYOUT};
-use crate::textures::Texture;
+use crate::textures::{Served, Texture};
 
 /// A request's parameters, sorted, as carried into tile URLs.
 pub type Query = BTreeMap<String, String>;
@@ -33,20 +34,97 @@ pub fn generator() -> String {
     format!("textile {} ({})", env!("CARGO_PKG_VERSION"), engine_version())
 }
 
-/// A model of `tiles × tiles` tiles from `spec` (its top-left tile) of a texture.
+/// What a model shows.
+#[derive(Clone)]
+pub enum Subject {
+    /// A texture with a mode's parameters.
+    Texture {
+        /// The texture.
+        tex: Arc<Texture>,
+        /// The mode and its parameters.
+        params: ModeParams,
+    },
+    /// A landscape: its job for the model's (top-left) tile, whose seed and period every image
+    /// of the model keeps.
+    Landscape(LandscapeJob),
+}
+
+impl Subject {
+    /// The id of the texture or landscape.
+    pub fn id(&self) -> &str {
+        match self {
+            Subject::Texture { tex, .. } => &tex.config.id,
+            Subject::Landscape(j) => &j.land.config.id,
+        }
+    }
+
+    /// Zoom at which a tile pixel is a texel (of the finest layer, for a landscape).
+    pub fn native_zoom(&self) -> u32 {
+        match self {
+            Subject::Texture { tex, .. } => tex.native_zoom(),
+            Subject::Landscape(j) => j.land.native_zoom,
+        }
+    }
+
+    /// The names of its maps: a texture's own; a landscape's that every layer has.
+    fn maps(&self) -> Vec<String> {
+        match self {
+            Subject::Texture { tex, .. } => tex.exemplar.maps.iter().map(|m| m.name.clone()).collect(),
+            Subject::Landscape(j) => j.land.maps(),
+        }
+    }
+
+    /// The hashes of map `name`'s images (every layer's, for a landscape), for cache keys.
+    fn map_hashes(&self, name: &str) -> Option<String> {
+        match self {
+            Subject::Texture { tex, .. } => tex.exemplar.map(name).map(|m| m.hash.clone()),
+            Subject::Landscape(j) => {
+                let each: Vec<&str> =
+                    j.land.layers.iter().filter_map(|y| y.tex.exemplar.map(name).map(|m| m.hash.as_str())).collect();
+                (!each.is_empty()).then(|| each.join("+"))
+            }
+        }
+    }
+
+    /// Its picture of `target`: the colour, or map `name`.
+    fn picture(&self, target: Target, map: Option<&str>) -> Picture {
+        match self {
+            Subject::Texture { tex, params } => Picture::Texture(ImageJob {
+                tex: tex.clone(),
+                params: params.clone(),
+                target,
+                map: map.map_or(MapChoice::Albedo, |n| MapChoice::Map(n.to_string())),
+                dem: None,
+            }),
+            Subject::Landscape(j) => {
+                Picture::Landscape(j.at(target, map.map_or(LandscapeMap::Albedo, |n| LandscapeMap::Map(n.to_string()))))
+            }
+        }
+    }
+
+    /// A cache key of something made of it: a texture's as its tiles' keys are made (so
+    /// textures' 3D keys stay as they were); a landscape's after its job's key.
+    pub fn key(&self, what: std::fmt::Arguments) -> String {
+        match self {
+            Subject::Texture { tex, params } => cache_key(tex, params, what),
+            Subject::Landscape(j) => format!("{}|model|{what}", j.key()),
+        }
+    }
+}
+
+/// A model of `tiles × tiles` tiles from `spec` (its top-left tile) of a texture or landscape.
 #[derive(Clone)]
 pub struct Model {
-    /// The texture.
-    pub tex: Arc<Texture>,
+    /// What it shows.
+    pub subject: Subject,
     /// The (top-left) tile.
     pub spec: TileSpec,
     /// Side in tiles: 1 for a tile, up to [`MAX_PATCH`] for a patch.
     pub tiles: i64,
     /// The request's parameters, carried into URLs.
     pub query: Query,
-    /// The mode and its parameters.
-    pub params: ModeParams,
-    /// `relief=SCALE`: a GLB's mesh displaced by the height map, white `SCALE` texels high.
+    /// `relief=SCALE`: a GLB's mesh displaced by the height map (a landscape's blended heights),
+    /// white `SCALE` texels high.
     pub relief: Option<f32>,
     /// Above zoom 0 (3D Tiles' levels over the XYZ pyramid): the quad spans `2^span` zoom-0
     /// tiles a side from `spec`'s, and shows zoom 0's uniform colour. 0 for a tile.
@@ -58,15 +136,9 @@ pub struct Model {
 const LIFTED_IMAGE: i64 = 8;
 
 impl Model {
-    /// Tile `spec` of `tex` (a patch of `tiles` from it) with the parameters `r` reads (its
-    /// `relief` first), carrying `query` into URLs.
-    pub fn read(
-        tex: Arc<Texture>,
-        spec: TileSpec,
-        tiles: i64,
-        r: ParamReader,
-        query: Query,
-    ) -> Result<Model, ApiError> {
+    /// Tile `spec` of a texture or landscape (a patch of `tiles` from it) with the parameters
+    /// `r` reads (its `relief` first), carrying `query` into URLs.
+    pub fn read(served: Served, spec: TileSpec, tiles: i64, r: ParamReader, query: Query) -> Result<Model, ApiError> {
         if !(1..=MAX_PATCH).contains(&tiles) {
             return Err(ApiError::bad_request(
                 "invalid_parameter",
@@ -79,14 +151,14 @@ impl Model {
                 format!("the patch must end at or before {COORD_MAX}"),
             ));
         }
-        let (params, relief) = params_with_relief(&tex, r)?;
-        Ok(Model { tex, spec, tiles, query, params, relief, span: 0 })
+        let (subject, relief) = subject_with_relief(served, spec, r)?;
+        Ok(Model { subject, spec, tiles, query, relief, span: 0 })
     }
 
-    /// Tile `spec` of `tex` with the request parameters of the query's `pairs`.
-    pub fn request(tex: Arc<Texture>, spec: TileSpec, pairs: Vec<(String, String)>) -> Result<Model, ApiError> {
+    /// Tile `spec` with the request parameters of the query's `pairs`.
+    pub fn request(served: Served, spec: TileSpec, pairs: Vec<(String, String)>) -> Result<Model, ApiError> {
         let r = ParamReader::request(pairs.clone())?;
-        Model::read(tex, spec, 1, r, pairs.into_iter().collect())
+        Model::read(served, spec, 1, r, pairs.into_iter().collect())
     }
 
     /// This zoom-0 tile's model spanning `2^span` zoom-0 tiles a side (3D Tiles' levels above
@@ -115,7 +187,7 @@ impl Model {
     /// The ground quad of tile `t`.
     pub fn quad(&self, t: &TileSpec) -> Quad {
         // Native texels per tile side (a fraction of a tile when magnified).
-        let size = TILE_SIZE as f64 * 2f64.powi(self.tex.native_zoom() as i32 - t.z as i32);
+        let size = TILE_SIZE as f64 * 2f64.powi(self.subject.native_zoom() as i32 - t.z as i32);
         let origin = (size * t.x as f64, size * t.y as f64);
         if self.span > 0 {
             let name = format!("tiles_0_{}_{}_span_{}", t.x, t.y, self.span);
@@ -127,13 +199,18 @@ impl Model {
     }
 
     /// The image of the (top-left) tile.
-    pub fn image(&self) -> ImageJob {
+    pub fn image(&self) -> Picture {
         self.image_at(self.spec)
     }
 
-    /// The image of the tile at `spec` with this model's texture and parameters: the PNG window
-    /// of the tile and [`BORDER`] texels around it, at the tile's zoom.
-    pub fn image_at(&self, spec: TileSpec) -> ImageJob {
+    /// The image of the tile at `spec` with this model's texture and parameters (or landscape):
+    /// the PNG window of the tile and [`BORDER`] texels around it, at the tile's zoom.
+    pub fn image_at(&self, spec: TileSpec) -> Picture {
+        self.picture_at(spec, None)
+    }
+
+    /// [`Model::image_at`] of the colour or of map `map`.
+    fn picture_at(&self, spec: TileSpec, map: Option<&str>) -> Picture {
         let (b, side) = (BORDER as i64, image_side() as i64);
         let window = match self.span {
             0 => WindowSpec {
@@ -146,24 +223,18 @@ impl Model {
             },
             _ => WindowSpec { z: 0, x: 0, y: 0, w: LIFTED_IMAGE, h: LIFTED_IMAGE, format: Format::Png },
         };
-        ImageJob {
-            tex: self.tex.clone(),
-            params: self.params.clone(),
-            target: Target::Window(window),
-            map: MapChoice::Albedo,
-            dem: None,
-        }
+        self.subject.picture(Target::Window(window), map)
     }
 
     /// The tile's image of material map `name`.
-    pub fn map_image(&self, name: &str) -> ImageJob {
-        ImageJob { map: MapChoice::Map(name.to_string()), ..self.image() }
+    pub fn map_image(&self, name: &str) -> Picture {
+        self.picture_at(self.spec, Some(name))
     }
 
     /// The material maps of this tile that go into its glTF material, `(slot, name)`: those of
-    /// the texture with a glTF slot.
+    /// the texture (every layer of the landscape) with a glTF slot.
     pub fn material_maps(&self) -> Vec<(Slot, String)> {
-        self.tex.exemplar.maps.iter().filter_map(|m| Slot::of(&m.name).map(|s| (s, m.name.clone()))).collect()
+        self.subject.maps().into_iter().filter_map(|n| Slot::of(&n).map(|s| (s, n))).collect()
     }
 
     /// The material maps that fill image `only` (all, without one): roughness and metallic
@@ -189,7 +260,7 @@ impl Model {
         let each: Vec<String> = self
             .material_maps()
             .iter()
-            .filter_map(|(_, n)| self.tex.exemplar.map(n).map(|m| format!("{n}:{}", m.hash)))
+            .filter_map(|(_, n)| self.subject.map_hashes(n).map(|h| format!("{n}:{h}")))
             .collect();
         if each.is_empty() {
             String::new()
@@ -211,14 +282,14 @@ impl Model {
     pub fn key(&self, kind: &str, extra: &str) -> String {
         let s = self.spec;
         let span = if self.span > 0 { format!("|span{}", self.span) } else { String::new() };
-        cache_key(&self.tex, &self.params, format_args!("{kind}{LAYOUT}|{}|{}|{}{span}|{extra}", s.z, s.x, s.y))
+        self.subject.key(format_args!("{kind}{LAYOUT}|{}|{}|{}{span}|{extra}", s.z, s.x, s.y))
     }
 
     /// The tile URL (absolute) with the request's parameters.
     pub fn tile_url(&self, base: &str, t: &TileSpec) -> String {
         let qs = query_string(&self.query);
         let sep = if qs.is_empty() { "" } else { "?" };
-        format!("{base}/tiles/{}/{}/{}/{}.png{sep}{qs}", self.tex.config.id, t.z, t.x, t.y)
+        format!("{base}/tiles/{}/{}/{}/{}.png{sep}{qs}", self.subject.id(), t.z, t.x, t.y)
     }
 
     /// The relative URI of a tile's image served beside its .gltf document: `{y}.png`, or
@@ -238,7 +309,7 @@ impl Model {
     /// The absolute URL of a tile's image (border included) for X3D documents, or of one of its
     /// material images (`slot`).
     pub fn image_url(&self, base: &str, spec: &TileSpec, slot: Option<Slot>) -> String {
-        format!("{base}/gltf/{}/{}/{}/{}", self.tex.config.id, spec.z, spec.x, self.sibling_image(spec, slot))
+        format!("{base}/gltf/{}/{}/{}/{}", self.subject.id(), spec.z, spec.x, self.sibling_image(spec, slot))
     }
 
     /// The absolute URLs of a tile's material images by slot, for X3D documents.
@@ -247,21 +318,37 @@ impl Model {
     }
 }
 
-/// A 3D asset's query: the mode's parameters and `relief`.
-pub fn params_with_relief(tex: &Texture, mut r: ParamReader) -> Result<(ModeParams, Option<f32>), ApiError> {
-    let relief = r.take("relief").map(|v| relief_scale(tex, &v)).transpose()?;
-    Ok((params(tex, r)?, relief))
+/// A 3D asset's query for tile `spec`: the mode's parameters (a landscape's `seed` and `world`)
+/// and `relief`.
+pub fn subject_with_relief(
+    served: Served,
+    spec: TileSpec,
+    mut r: ParamReader,
+) -> Result<(Subject, Option<f32>), ApiError> {
+    let relief = r.take("relief");
+    match served {
+        Served::Texture(tex) => {
+            let relief = relief.map(|v| relief_scale(Some(&tex), &v)).transpose()?;
+            let params = params(&tex, r)?;
+            Ok((Subject::Texture { tex, params }, relief))
+        }
+        Served::Landscape(land) => {
+            let relief = relief.map(|v| relief_scale(None, &v)).transpose()?;
+            let job = LandscapeJob::new(land, Target::Tile(spec), (LandscapeMap::Albedo, None), r)?;
+            Ok((Subject::Landscape(job), relief))
+        }
+    }
 }
 
-/// Read `relief=SCALE`: the height in texels of the height map's white, in (0, 256]; the
-/// texture must have a height map.
-fn relief_scale(tex: &Texture, v: &str) -> Result<f32, ApiError> {
+/// Read `relief=SCALE`: the height in texels of the height map's white, in (0, 256]; a
+/// texture must have a height map (a landscape always has its blended heights).
+fn relief_scale(tex: Option<&Texture>, v: &str) -> Result<f32, ApiError> {
     let bad = |m: String| ApiError::bad_request("invalid_parameter", format!("parameter 'relief': {m}"));
     let scale: f32 = v.parse().map_err(|_| bad(format!("'{}' is not a number", textile_core::error::clip(v))))?;
     if !(scale > 0.0 && scale <= 256.0) {
         return Err(bad(format!("{scale} is outside (0, 256] texels")));
     }
-    if tex.exemplar.map("height").is_none() {
+    if let Some(tex) = tex.filter(|t| t.exemplar.map("height").is_none()) {
         return Err(bad(format!("texture '{}' has no height map", tex.config.id)));
     }
     Ok(scale)

@@ -41,6 +41,33 @@ pub struct Zooms {
     pub native: u32,
 }
 
+/// What an id names in the catalogue: a texture or a landscape.
+#[derive(Clone)]
+pub enum Served {
+    /// A texture.
+    Texture(Arc<Texture>),
+    /// A landscape.
+    Landscape(Arc<Landscape>),
+}
+
+impl Served {
+    /// Its id.
+    pub fn id(&self) -> &str {
+        match self {
+            Served::Texture(t) => &t.config.id,
+            Served::Landscape(l) => &l.config.id,
+        }
+    }
+
+    /// The zooms it serves.
+    pub fn zooms(&self) -> Zooms {
+        match self {
+            Served::Texture(t) => t.zooms(),
+            Served::Landscape(l) => l.zooms(),
+        }
+    }
+}
+
 /// A texture ready to serve.
 pub struct Texture {
     /// Its configuration.
