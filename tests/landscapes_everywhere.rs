@@ -85,3 +85,87 @@ async fn a_landscape_in_3d() {
     assert_eq!(pj["nodes"].as_array().map(Vec::len), Some(4));
     assert_eq!(glb_image(&pj, &pb, 0), glb_image(&json, &bin, 0));
 }
+
+/// A landscape's samples: at a tile's pixel centre, the tile's pixel (its colour, a map, at the
+/// native zoom and coarser, as JSON and binary records); footprints between levels lie between
+/// them; too many tiles at once is a 400 naming the limit.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_landscape_sampled() {
+    let s = Server::builder().start();
+    let native = s.json("/textures/meadow").await["native_zoom"].as_u64().expect("native") as i64;
+    let post = |body: serde_json::Value, query: &'static str| {
+        let url = s.url(&format!("/samples/meadow{query}"));
+        let client = s.client.clone();
+        async move {
+            let r = client.post(url).json(&body).send().await.expect("post");
+            let code = r.status().as_u16();
+            (code, r.json::<serde_json::Value>().await.expect("JSON"))
+        }
+    };
+    let colours =
+        |v: &serde_json::Value| -> Vec<[u8; 3]> { serde_json::from_value(v["colors"].clone()).expect("colours") };
+    // Pixels of tile (3, 4) at native zoom and of (1, 2) one zoom out; seed 5.
+    let tile = s.image(&format!("/tiles/meadow/{native}/3/4.png?seed=5")).await;
+    let coarse = s.image(&format!("/tiles/meadow/{}/1/2.png?seed=5", native - 1)).await;
+    let height = s.image(&format!("/tiles/meadow/{native}/3/4.png?seed=5&map=height")).await;
+    let picks: Vec<(u32, u32)> = vec![(0, 0), (255, 255), (17, 200), (128, 3), (201, 99)];
+    let points: Vec<[i64; 3]> = picks
+        .iter()
+        .flat_map(|&(x, y)| [[768 + x as i64, 1024 + y as i64, native], [256 + x as i64, 512 + y as i64, native - 1]])
+        .collect();
+    let (code, body) = post(serde_json::json!({ "points": points }), "?seed=5").await;
+    assert_eq!(code, 200, "{body}");
+    let got = colours(&body);
+    for (i, &(x, y)) in picks.iter().enumerate() {
+        assert_eq!(got[2 * i], tile.get_pixel(x, y).0, "native pixel ({x}, {y})");
+        assert_eq!(got[2 * i + 1], coarse.get_pixel(x, y).0, "coarser pixel ({x}, {y})");
+    }
+    // Footprints at texel centres, lod 0: the native tile's pixels; map=height: the height tile's.
+    let fps: Vec<[f64; 3]> = picks.iter().map(|&(x, y)| [768.5 + x as f64, 1024.5 + y as f64, 0.0]).collect();
+    let (code, body) = post(serde_json::json!({ "footprints": fps }), "?seed=5&map=height").await;
+    assert_eq!(code, 200, "{body}");
+    for (c, &(x, y)) in colours(&body).iter().zip(&picks) {
+        assert_eq!(*c, height.get_pixel(x, y).0, "height at ({x}, {y})");
+    }
+    // Halfway between the levels: between the native pixel's mean with its neighbours and the
+    // coarser one (every channel within the two levels' bilinear values' range).
+    let (code, body) = post(serde_json::json!({ "footprints": [[768.0 + 40.0, 1024.0 + 40.0, 0.5]] }), "?seed=5").await;
+    assert_eq!(code, 200, "{body}");
+    let c = colours(&body)[0];
+    let near: Vec<[u8; 3]> =
+        [(39, 39), (40, 39), (39, 40), (40, 40)].iter().map(|&(x, y)| tile.get_pixel(x, y).0).collect();
+    let far: Vec<[u8; 3]> =
+        [(19, 19), (20, 19), (19, 20), (20, 20)].iter().map(|&(x, y)| coarse.get_pixel(x, y).0).collect();
+    for ch in 0..3 {
+        let all: Vec<u8> = near.iter().chain(&far).map(|p| p[ch]).collect();
+        let (lo, hi) = (*all.iter().min().unwrap(), *all.iter().max().unwrap());
+        assert!((lo..=hi).contains(&c[ch]), "channel {ch}: {} outside {lo}..={hi}", c[ch]);
+    }
+    // Binary texel records: the same pixels, packed.
+    let mut rec = Vec::new();
+    for &(x, y) in &picks {
+        rec.extend_from_slice(&(768 + x as i64).to_le_bytes());
+        rec.extend_from_slice(&(1024 + y as i64).to_le_bytes());
+        rec.extend_from_slice(&(native as u32).to_le_bytes());
+    }
+    let r = s
+        .client
+        .post(s.url("/samples/meadow?seed=5"))
+        .header("content-type", "application/octet-stream")
+        .body(rec)
+        .send()
+        .await
+        .expect("post");
+    assert_eq!(r.status().as_u16(), 200);
+    let rgb = r.bytes().await.expect("body");
+    for (c, &(x, y)) in rgb.chunks(3).zip(&picks) {
+        assert_eq!(c, tile.get_pixel(x, y).0, "binary sample ({x}, {y})");
+    }
+    // Samples spread over more tiles than a request may read; a texture's parameter.
+    let spread: Vec<[i64; 2]> = (0..300).map(|i| [i * 256, 0]).collect();
+    let (code, body) = post(serde_json::json!({ "points": spread }), "").await;
+    assert_eq!((code, body["error"].as_str()), (400, Some("too_many_tiles")), "{body}");
+    assert!(body["message"].as_str().unwrap_or("").contains("256"), "{body}");
+    let (code, body) = post(serde_json::json!({ "points": [[0, 0]] }), "?mode=synth").await;
+    assert_eq!((code, body["error"].as_str()), (400, Some("invalid_parameter")), "{body}");
+}

@@ -94,9 +94,9 @@ pub fn samples_body(data: &[u8]) {
     let Some((&kind, body)) = data.split_first() else { return };
     let tex = texture();
     let _ = match kind % 3 {
-        0 => parse_json(tex, body),
-        1 => parse_binary(tex, body, Records::Texels),
-        _ => parse_binary(tex, body, Records::Footprints),
+        0 => parse_json(tex.zooms(), body),
+        1 => parse_binary(tex.zooms(), body, Records::Texels),
+        _ => parse_binary(tex.zooms(), body, Records::Footprints),
     };
 }
 

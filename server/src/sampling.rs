@@ -1,7 +1,8 @@
 //! Per-sample requests (`POST /samples/{id}`), without HTTP: bodies — JSON, or little-endian
 //! binary records — parsed and checked against the limits into typed samples, run on the
 //! synthesis pool through the pyramidal cache (textile-core's [`textile_core::samples`]), and
-//! the colours packed for the answer.
+//! the colours packed for the answer. A landscape's samples are read from its tiles (each made
+//! through the tile cache as it is served) and filtered the same way.
 //!
 //! Binary records are 20 bytes each: `texels` (the default) are `i64 x, i64 y, u32 z` — a pixel
 //! of the tile grid at zoom `z`; `footprints` are `f64 u, f64 v, f32 lod` — a position in native
@@ -16,9 +17,12 @@ use textile_core::samples::{self, Footprint, Texel};
 use textile_core::{ModeParams, Pyramid, TILE_SIZE};
 
 use crate::error::{ApiError, Kind};
+use crate::pipeline::landscape::LandscapeJob;
+use crate::pipeline::{produce_picture, Target};
+use crate::request::TileSpec;
 use crate::request::{COORD_MAX, COORD_MIN};
 use crate::state::AppState;
-use crate::textures::Texture;
+use crate::textures::{Texture, Zooms};
 
 /// Most samples in one request.
 pub const MAX_SAMPLES: usize = 262_144;
@@ -90,10 +94,10 @@ fn invalid(index: usize, message: String) -> ApiError {
     ApiError::bad_request("invalid_sample", format!("sample {index}: {message}"))
 }
 
-/// A tile-grid pixel checked against the texture's zoom and coordinate ranges.
-fn texel(tex: &Texture, index: usize, x: i64, y: i64, z: i64) -> Result<Texel, ApiError> {
+/// A tile-grid pixel checked against the texture's (or landscape's) zoom and coordinate ranges.
+fn texel(zooms: Zooms, index: usize, x: i64, y: i64, z: i64) -> Result<Texel, ApiError> {
     // Samples are texels of the tile grid at native zoom or coarser (not magnified).
-    let (zmin, zmax) = (tex.min_zoom() as i64, tex.native_zoom() as i64);
+    let (zmin, zmax) = (zooms.min as i64, zooms.native as i64);
     if !(zmin..=zmax).contains(&z) {
         return Err(invalid(index, format!("z = {z} is outside {zmin}..={zmax} (samples are not magnified)")));
     }
@@ -102,7 +106,7 @@ fn texel(tex: &Texture, index: usize, x: i64, y: i64, z: i64) -> Result<Texel, A
             return Err(invalid(index, format!("{name} = {v} is outside the tile range {PIXEL_MIN}..={PIXEL_MAX}")));
         }
     }
-    Ok(Texel { x, y, zoom_out: tex.native_zoom() - z as u32 })
+    Ok(Texel { x, y, zoom_out: zooms.native - z as u32 })
 }
 
 /// A footprint checked against the native tile range; a finite `lod` is clamped when sampled,
@@ -134,8 +138,8 @@ struct JsonBody {
     footprints: Option<Vec<[f64; 3]>>,
 }
 
-/// Parse a JSON body for a texture.
-pub fn parse_json(tex: &Texture, body: &[u8]) -> Result<Points, ApiError> {
+/// Parse a JSON body for a texture or landscape serving `zooms`.
+pub fn parse_json(zooms: Zooms, body: &[u8]) -> Result<Points, ApiError> {
     let b: JsonBody = serde_json::from_slice(body)
         .map_err(|e| ApiError::bad_request("invalid_body", format!("not a samples JSON body: {e}")))?;
     match (b.points, b.footprints) {
@@ -143,13 +147,13 @@ pub fn parse_json(tex: &Texture, body: &[u8]) -> Result<Points, ApiError> {
             if pts.len() > MAX_SAMPLES {
                 return Err(too_many(pts.len()));
             }
-            let z = b.z.unwrap_or(tex.native_zoom() as i64);
+            let z = b.z.unwrap_or(zooms.native as i64);
             let out = pts
                 .iter()
                 .enumerate()
                 .map(|(i, p)| match p[..] {
-                    [x, y] => texel(tex, i, x, y, z),
-                    [x, y, z] => texel(tex, i, x, y, z),
+                    [x, y] => texel(zooms, i, x, y, z),
+                    [x, y, z] => texel(zooms, i, x, y, z),
                     _ => Err(invalid(i, format!("{} numbers; a point is [x, y] or [x, y, z]", p.len()))),
                 })
                 .collect::<Result<_, _>>()?;
@@ -173,8 +177,8 @@ pub fn parse_json(tex: &Texture, body: &[u8]) -> Result<Points, ApiError> {
     }
 }
 
-/// Parse a binary body of `records` for a texture.
-pub fn parse_binary(tex: &Texture, body: &[u8], records: Records) -> Result<Points, ApiError> {
+/// Parse a binary body of `records` for a texture or landscape serving `zooms`.
+pub fn parse_binary(zooms: Zooms, body: &[u8], records: Records) -> Result<Points, ApiError> {
     if !body.len().is_multiple_of(RECORD) {
         return Err(ApiError::bad_request(
             "invalid_body",
@@ -200,7 +204,7 @@ pub fn parse_binary(tex: &Texture, body: &[u8], records: Records) -> Result<Poin
         Records::Texels => Points::Texels(
             recs.map(|(i, r)| {
                 texel(
-                    tex,
+                    zooms,
                     i,
                     i64::from_le_bytes(f8(r, 0)),
                     i64::from_le_bytes(f8(r, 8)),
@@ -281,4 +285,66 @@ pub async fn run(
         computed: figures[0].load(Ordering::Relaxed),
         windows: figures[1].load(Ordering::Relaxed),
     })
+}
+
+/// Most tiles one request of a landscape's samples may read (each a tile the landscape serves,
+/// made through the tile cache: 256 cold tiles are about a minute of work on two cores).
+pub const MAX_LANDSCAPE_TILES: usize = 256;
+
+/// A landscape's samples: every texel a sample reads (one for a texel, up to eight for a
+/// footprint, as for a texture) taken from the landscape's tile that holds it, made as it is
+/// served (through the tile cache and the pool), then filtered and blended as a texture's
+/// samples are. `job` is the landscape with the request's seed, period and map. A sample at a
+/// tile's pixel centre is that pixel.
+pub async fn run_landscape(st: &Arc<AppState>, job: LandscapeJob, points: Points) -> Result<Answer, ApiError> {
+    let zooms = job.land.zooms();
+    let taps: Vec<Vec<(Texel, u32)>> = match &points {
+        Points::Texels(t) => t.iter().map(|&texel| vec![(texel, 1 << 24)]).collect(),
+        Points::Footprints(f) => {
+            samples::filter::taps(f, zooms.native - zooms.min)?.iter().map(|t| t.iter().copied().collect()).collect()
+        }
+    };
+    // The tiles the taps fall in, each with the taps it answers.
+    let mut tiles: std::collections::BTreeMap<(u32, i64, i64), Vec<(usize, usize)>> = Default::default();
+    for (i, t) in taps.iter().enumerate() {
+        for (j, (texel, _)) in t.iter().enumerate() {
+            let key = (texel.zoom_out, texel.x.div_euclid(TILE_SIZE), texel.y.div_euclid(TILE_SIZE));
+            tiles.entry(key).or_default().push((i, j));
+        }
+    }
+    if tiles.len() > MAX_LANDSCAPE_TILES {
+        return Err(ApiError::bad_request(
+            "too_many_tiles",
+            format!(
+                "landscape '{}': these samples lie in {} tiles; at most {MAX_LANDSCAPE_TILES} per request",
+                job.land.config.id,
+                tiles.len()
+            ),
+        ));
+    }
+    let mut colours: Vec<Vec<[u8; 3]>> = taps.iter().map(|t| vec![[0; 3]; t.len()]).collect();
+    let mut computed = 0;
+    for (&(k, tx, ty), at) in &tiles {
+        let z = zooms.native - k;
+        let spec = TileSpec { z, x: tx, y: ty, scale: 1, format: crate::encode::Format::Png };
+        let picture = crate::pipeline::Picture::Landscape(job.at(Target::Tile(spec), job.map.clone()));
+        let (bytes, hit) = produce_picture(st, &picture.etag(), picture).await;
+        let img = image::load_from_memory(&bytes?)
+            .map_err(|e| ApiError::internal(format!("a landscape tile: {e}")))?
+            .to_rgb8();
+        if !hit {
+            computed += (TILE_SIZE * TILE_SIZE) as u64;
+        }
+        for &(i, j) in at {
+            let t = taps[i][j].0;
+            let (x, y) = (t.x.rem_euclid(TILE_SIZE) as u32, t.y.rem_euclid(TILE_SIZE) as u32);
+            colours[i][j] = img.get_pixel(x, y).0;
+        }
+    }
+    let mut rgb: Vec<u8> =
+        taps.iter().zip(&colours).flat_map(|(t, c)| samples::filter::blend(t.iter().map(|&(_, w)| w).zip(c))).collect();
+    if job.map == crate::pipeline::landscape::LandscapeMap::Map("normal".into()) {
+        textile_core::maps::renormalise(&mut rgb);
+    }
+    Ok(Answer { rgb, computed, windows: tiles.len() as u64 })
 }

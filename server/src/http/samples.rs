@@ -2,7 +2,8 @@
 //! (`application/json`) or binary records (`application/octet-stream`, kind chosen by
 //! `records=`) — is read up to its limit and parsed by [`crate::sampling`]; the answer is JSON
 //! colours or packed RGB, in request order, with the work it took in `X-Textile-Computed`
-//! (pixels computed at all levels) and `X-Textile-Windows`.
+//! (pixels computed at all levels) and `X-Textile-Windows`. A landscape's samples are its
+//! tiles' pixels (its blended colour, or a map every layer has), filtered as a texture's.
 
 use std::sync::Arc;
 
@@ -14,17 +15,30 @@ use axum::response::{IntoResponse, Response};
 use axum::Json;
 use textile_core::maps::MapChoice;
 
+use crate::encode::Format;
 use crate::error::{ApiError, Kind};
-use crate::http::extract::{media_type, path_error, texture};
-use crate::request::{params, query_reader};
+use crate::http::extract::{media_type, path_error, served};
+use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
+use crate::pipeline::Target;
+use crate::request::{params, query_reader, TileSpec};
 use crate::sampling::{self, parse_binary, parse_json, Records, MAX_BODY};
 use crate::state::AppState;
+use crate::textures::Served;
+
+/// What a request samples.
+enum Sampled {
+    /// A texture with a mode's parameters, showing a map.
+    Texture(Arc<crate::textures::Texture>, textile_core::ModeParams, MapChoice),
+    /// A landscape (its seed, period and map).
+    Landscape(LandscapeJob),
+}
 
 /// Colours of scattered samples of the texture, equal to the pixels of the tiles that hold them.
 #[utoipa::path(post, path = "/samples/{id}", tag = "tiles",
-    params(("id" = String, Path, description = "texture id"),
+    params(("id" = String, Path, description = "texture or landscape id"),
            ("records" = Option<String>, Query, description = "binary bodies: `texels` (default; 20-byte records i64 x, i64 y, u32 z, little-endian: pixel (x, y) of the tile grid at zoom z) or `footprints` (20-byte records f64 u, f64 v, f32 lod: a position in native texels, filtered bilinearly within a level and linearly between levels)"),
-           ("map" = Option<String>, Query, description = "albedo (default) or one of the texture's material maps (normals filtered as vectors)"),
+           ("map" = Option<String>, Query, description = "albedo (default) or one of the texture's material maps (normals filtered as vectors); a landscape's: a map every layer has, or splat"),
+           ("seed" = Option<u64>, Query, description = "a landscape's seed (reseeds its splat and layers), as its tiles take it"),
            ("v" = Option<String>, Query, description = "cache-busting version (content unchanged)")),
     request_body(description = "JSON `{\"points\": [[x, y], …], \"z\": Z}` (a point may be [x, y, z]; z defaults to the native zoom) or `{\"footprints\": [[u, v, lod], …]}`; or binary records (application/octet-stream). At most 262144 samples and 8 MiB.",
         content(("application/json"), ("application/octet-stream"))),
@@ -44,17 +58,35 @@ pub async fn samples(
 ) -> Result<Response, ApiError> {
     let reg = st.ready()?;
     let Path(id) = path.map_err(path_error)?;
-    let tex = texture(&reg, &id)?;
+    let subject = served(&reg, &id)?;
+    let zooms = subject.zooms();
     let mut r = query_reader(q.as_deref())?;
     let records = r.take("records").map(|s| Records::parse(&s)).transpose()?;
-    let map = crate::request::map_choice(&tex, &mut r, crate::encode::Format::Png)?;
-    if map == MapChoice::Uv {
-        return Err(ApiError::bad_request(
-            "invalid_map",
-            "map 'uv': samples answer colours; the coordinates come as map=uv tiles and windows",
-        ));
-    }
-    let params = params(&tex, r)?;
+    // What is sampled: a texture's mode, parameters and map, or a landscape's job for its map.
+    let what = match subject {
+        Served::Texture(tex) => {
+            let map = crate::request::map_choice(&tex, &mut r, Format::Png)?;
+            if map == MapChoice::Uv {
+                return Err(ApiError::bad_request(
+                    "invalid_map",
+                    "map 'uv': samples answer colours; the coordinates come as map=uv tiles and windows",
+                ));
+            }
+            let params = params(&tex, r)?;
+            Sampled::Texture(tex, params, map)
+        }
+        Served::Landscape(land) => {
+            let (map, dem) = LandscapeMap::read(&land, &mut r, Format::Png)?;
+            if dem.is_some() {
+                return Err(ApiError::bad_request(
+                    "invalid_parameter",
+                    "parameter 'encoding': samples answer colours, not raster-dem heights",
+                ));
+            }
+            let zero = Target::Tile(TileSpec { z: land.native_zoom, x: 0, y: 0, scale: 1, format: Format::Png });
+            Sampled::Landscape(LandscapeJob::new(land, zero, (map, None), r)?)
+        }
+    };
     let binary = match media_type(&headers).as_str() {
         "application/json" => false,
         "application/octet-stream" => true,
@@ -85,11 +117,14 @@ pub async fn samples(
     let bytes =
         to_bytes(body, MAX_BODY).await.map_err(|e| crate::http::extract::body_error(&e.to_string(), too_large))?;
     let points = if binary {
-        parse_binary(&tex, &bytes, records.unwrap_or(Records::Texels))?
+        parse_binary(zooms, &bytes, records.unwrap_or(Records::Texels))?
     } else {
-        parse_json(&tex, &bytes)?
+        parse_json(zooms, &bytes)?
     };
-    let a = sampling::run(&st, tex, params, map, points).await?;
+    let a = match what {
+        Sampled::Texture(tex, params, map) => sampling::run(&st, tex, params, map, points).await?,
+        Sampled::Landscape(job) => sampling::run_landscape(&st, job, points).await?,
+    };
     let mut resp = if binary {
         ([(header::CONTENT_TYPE, "application/octet-stream")], a.rgb).into_response()
     } else {
