@@ -169,3 +169,85 @@ async fn a_landscape_sampled() {
     let (code, body) = post(serde_json::json!({ "points": [[0, 0]] }), "?mode=synth").await;
     assert_eq!((code, body["error"].as_str()), (400, Some("invalid_parameter")), "{body}");
 }
+
+fn textile(args: &[&str]) -> (bool, String) {
+    let out = std::process::Command::new(common::binary()).args(args).output().expect("run textile");
+    (out.status.success(), format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr)))
+}
+
+/// The meadow exported as a 16-tile world: one process's archive and three shards merged are
+/// the same bytes; an independent reader reads every tile back equal to the server's; merge
+/// refuses a part of another version of the landscape, naming its identity; a splat that does
+/// not repeat refuses a world export.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_landscape_exported_whole_and_in_shards() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let data = common::shared_data_dir();
+    let data = data.to_str().expect("utf-8");
+    let out = |name: &str| dir.path().join(name).to_str().expect("utf-8").to_string();
+    let base = ["export", "--texture", "meadow", "--world", "16", "--data-dir", data];
+    let whole = out("whole.pmtiles");
+    let (ok, log) = textile(&[&base[..], &["-o", &whole]].concat());
+    assert!(ok, "{log}");
+    let parts: Vec<String> = (0..3).map(|i| out(&format!("p{i}.part"))).collect();
+    let running: Vec<_> = (0..3)
+        .map(|i| {
+            let shard = format!("{i}/3");
+            let args = [&base[..], &["--shard", &shard, "--workers", "1", "-o", &parts[i]]].concat();
+            std::process::Command::new(common::binary()).args(&args).output()
+        })
+        .collect();
+    for r in running {
+        let r = r.expect("shard");
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    }
+    let merged = out("merged.pmtiles");
+    let (ok, log) =
+        textile(&[&["merge"][..], &parts.iter().map(String::as_str).collect::<Vec<_>>(), &["-o", &merged]].concat());
+    assert!(ok, "{log}");
+    let (a, b) = (std::fs::read(&whole).expect("whole"), std::fs::read(&merged).expect("merged"));
+    eprintln!("meadow world 16: {} bytes, whole and merged equal: {}", a.len(), a == b);
+    assert!(a == b, "three shards merged differ from the whole export");
+    if common::reader_available() {
+        let s = Server::builder().start();
+        common::check_archive(std::path::Path::new(&whole), &s, 1000);
+    } else {
+        common::skip("a_landscape_exported_whole_and_in_shards (reader)", "python pmtiles is not installed");
+    }
+
+    // Another version of the meadow (two layers, other shares): its part is refused.
+    let cfg = dir.path().join("other.toml");
+    std::fs::write(
+        &cfg,
+        "[[textures]]\nid = \"gravel\"\nexemplar = \"embedded:gravel.png\"\n\n[[textures]]\nid = \"grass\"\n\
+         exemplar = \"embedded:grass.png\"\n\n[[landscapes]]\nid = \"meadow\"\n\n[[landscapes.layers]]\n\
+         texture = \"grass\"\nshare = 0.7\n\n[[landscapes.layers]]\ntexture = \"gravel\"\nshare = 0.3\n\n\
+         [landscapes.splat]\nkind = \"noise\"\nfeature = 384\n",
+    )
+    .expect("config");
+    let other = out("other.part");
+    let cfg = cfg.to_str().expect("utf-8");
+    let (ok, log) = textile(&[&base[..], &["--config", cfg, "--shard", "1/3", "-o", &other]].concat());
+    assert!(ok, "{log}");
+    let (ok, log) = textile(&["merge", &parts[0], &other, &parts[2], "-o", &out("mixed.pmtiles")]);
+    assert!(!ok && log.contains("another export") && log.contains("parameters"), "{log}");
+    assert!(!dir.path().join("mixed.pmtiles").exists());
+
+    // A splat shown once does not repeat: no world of it.
+    let img = image::RgbImage::from_fn(4, 4, |x, _| image::Rgb(if x < 2 { [255, 0, 0] } else { [0, 0, 255] }));
+    img.save(dir.path().join("splat.png")).expect("splat");
+    let once = dir.path().join("once.toml");
+    std::fs::write(
+        &once,
+        "[[textures]]\nid = \"gravel\"\nexemplar = \"embedded:gravel.png\"\n\n[[textures]]\nid = \"grass\"\n\
+         exemplar = \"embedded:grass.png\"\n\n[[landscapes]]\nid = \"island\"\n\n[[landscapes.layers]]\n\
+         texture = \"gravel\"\ncolour = \"#ff0000\"\n\n[[landscapes.layers]]\ntexture = \"grass\"\ncolour = \"#0000ff\"\n\n\
+         [landscapes.splat]\nkind = \"image\"\nimage = \"splat.png\"\ntexels_per_pixel = 128\noutside = \"gravel\"\n",
+    )
+    .expect("config");
+    let once = once.to_str().expect("utf-8");
+    let args = ["export", "--texture", "island", "--world", "16", "--config", once, "--data-dir", data];
+    let (ok, log) = textile(&[&args[..], &["-o", &out("island.pmtiles")]].concat());
+    assert!(!ok && log.contains("world"), "{log}");
+    eprintln!("island world export: {}", log.lines().last().unwrap_or(""));
+}

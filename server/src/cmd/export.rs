@@ -1,10 +1,11 @@
-//! `textile export`: tiles of a configured texture into a PMTiles or MBTiles archive, or one
-//! shard's part file of it; `textile merge`: parts into the archive.
+//! `textile export`: tiles of a configured texture or landscape into a PMTiles or MBTiles
+//! archive, or one shard's part file of it; `textile merge`: parts into the archive.
 
 use super::args::{CliResult, ExportArgs, MergeArgs};
-use super::{configured_texture, param_pairs};
+use super::{configured_landscape, configured_texture, param_pairs};
 use crate::encode::Format;
 use crate::export;
+use crate::textures::Served;
 
 /// `textile export`: tiles into a PMTiles or MBTiles archive.
 pub fn run(a: ExportArgs) -> CliResult {
@@ -13,7 +14,17 @@ pub fn run(a: ExportArgs) -> CliResult {
         .num_threads(a.workers)
         .thread_name(|i| format!("textile-export-{i}"))
         .build_global()?;
-    let tex = configured_texture(&a.config, &a.texture)?;
+    let served = match configured_landscape(&a.config, &a.texture)? {
+        Some(land) => {
+            if a.mode.is_some() || !a.params.is_empty() {
+                return Err("a landscape exports with --seed, --world and --map only (its layers' parameters are \
+                            its configuration's)"
+                    .into());
+            }
+            Served::Landscape(land)
+        }
+        None => Served::Texture(configured_texture(&a.config, &a.texture)?),
+    };
     let mut pairs = param_pairs(&a.params, &a.mode, a.seed, None)?;
     if a.map != "albedo" {
         pairs.push(("map".into(), a.map.clone()));
@@ -41,7 +52,7 @@ pub fn run(a: ExportArgs) -> CliResult {
         None => None,
     };
     let format = Format::from_ext(&a.format).ok_or("--format must be png, jpg or webp")?;
-    let plan = export::Plan::new(tex, pairs, a.world, bbox, zooms, format)?;
+    let plan = export::Plan::new(served, pairs, a.world, bbox, zooms, format)?;
     if let Some(shard) = shard {
         let (start, end) = shard.range(plan.count());
         eprintln!(
@@ -49,7 +60,7 @@ pub fn run(a: ExportArgs) -> CliResult {
             shard.index,
             shard.count,
             plan.count(),
-            plan.tex.config.id,
+            plan.what.id(),
             plan.query_suffix(),
             a.output.display()
         );
@@ -63,7 +74,7 @@ pub fn run(a: ExportArgs) -> CliResult {
     eprintln!(
         "exporting {} tiles of '{}{}' (archive zooms {}..={}) to {}",
         plan.count(),
-        plan.tex.config.id,
+        plan.what.id(),
         plan.query_suffix(),
         plan.zooms.0,
         plan.zooms.1,

@@ -18,7 +18,7 @@ use super::part::{self, Header};
 use super::{open_sink, Report};
 
 /// The fields of the archive identity a refusal names when two parts differ.
-const IDENTITY: &[&str] = &["world", "texture", "mode", "parameters", "query", "engine", "analysis"];
+const IDENTITY: &[&str] = &["world", "texture", "landscape", "mode", "parameters", "query", "engine", "analysis"];
 
 /// Why part `b` is not of `a`'s export, if it is not.
 fn differs(a: &(PathBuf, Header), b: &(PathBuf, Header)) -> Option<String> {

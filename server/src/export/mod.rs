@@ -7,8 +7,8 @@
 //! show a seamless world. A sub-rectangle (`--bbox`, tile coordinates at the highest zoom) keeps
 //! textile's own zooms and coordinates.
 //!
-//! Tiles are made by the same [`ImageJob`] as served tiles (an exported tile's bytes equal the
-//! server's answer for the same URL), rendered in parallel in chunks, in ascending Hilbert tile
+//! Tiles are made by the same [`Picture`] as served tiles (an exported tile's bytes equal the
+//! server's answer for the same URL; a landscape's are its [`LandscapeJob`]'s), rendered in parallel in chunks, in ascending Hilbert tile
 //! id (the order PMTiles needs to be clustered), with progress and bounded memory, into a
 //! [`part`] file with a checkpoint after every chunk (an interrupted export resumes); [`merge`]
 //! then lays parts into the archive, written under a temporary name and renamed when complete,
@@ -34,9 +34,10 @@ use textile_core::{ModeParams, ParamReader, Pyramid};
 pub use layout::Layout;
 
 use crate::encode::Format;
-use crate::pipeline::{engine_version, ImageJob, Target};
+use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
+use crate::pipeline::{engine_version, ImageJob, Picture, Target};
 use crate::request::TileSpec;
-use crate::textures::Texture;
+use crate::textures::{Served, Texture, Zooms};
 
 /// Tiles rendered per chunk per pool thread: what is held in memory before it is written.
 const CHUNK_PER_THREAD: usize = 32;
@@ -66,15 +67,58 @@ pub enum Area {
     },
 }
 
+/// What an export's tiles show.
+#[derive(Clone)]
+pub enum Exported {
+    /// A texture.
+    Texture {
+        /// The texture.
+        tex: Arc<Texture>,
+        /// The mode and parameters (request parameters only: what a tile URL can carry).
+        params: ModeParams,
+        /// The colour or a material map (`map=` among the pairs).
+        map: MapChoice,
+    },
+    /// A landscape, with its seed, period and map (its job for tile 0/0/0 at zoom 0).
+    Landscape(LandscapeJob),
+}
+
+impl Exported {
+    /// The id of the texture or landscape.
+    pub fn id(&self) -> &str {
+        match self {
+            Exported::Texture { tex, .. } => &tex.config.id,
+            Exported::Landscape(j) => &j.land.config.id,
+        }
+    }
+
+    fn zooms(&self) -> Zooms {
+        match self {
+            Exported::Texture { tex, .. } => tex.zooms(),
+            Exported::Landscape(j) => j.land.zooms(),
+        }
+    }
+
+    /// Its picture of tile `t`: what the server answers for the tile's URL.
+    fn picture(&self, t: TileSpec) -> Picture {
+        match self {
+            Exported::Texture { tex, params, map } => Picture::Texture(ImageJob {
+                tex: tex.clone(),
+                params: params.clone(),
+                target: Target::Tile(t),
+                map: map.clone(),
+                dem: None,
+            }),
+            Exported::Landscape(j) => Picture::Landscape(j.at(Target::Tile(t), j.map.clone())),
+        }
+    }
+}
+
 /// An export, validated.
 #[derive(Clone)]
 pub struct Plan {
-    /// The texture.
-    pub tex: Arc<Texture>,
-    /// The mode and parameters (request parameters only: what a tile URL can carry).
-    pub params: ModeParams,
-    /// The colour or a material map (`map=` among the pairs).
-    pub map: MapChoice,
+    /// What its tiles show.
+    pub what: Exported,
     /// The query string that gives the server's tiles the same bytes (`world` included).
     pub query: String,
     /// The area.
@@ -134,19 +178,19 @@ impl Plan {
     /// `world` the period in native tiles (world exports), `bbox` a rectangle instead, `zooms`
     /// the archive zooms (default: all the area has).
     pub fn new(
-        tex: Arc<Texture>,
+        served: Served,
         mut pairs: Vec<(String, String)>,
         world: Option<u64>,
         bbox: Option<(u32, u32, u32, u32)>,
         zooms: Option<(u32, u32)>,
         format: Format,
     ) -> Result<Plan, String> {
-        let native = tex.native_zoom();
+        let (native, min_zoom) = (served.zooms().native, served.zooms().min);
         let (area, all) = match bbox {
             Some((x0, y0, x1, y1)) => {
                 let (lo, hi) = zooms.unwrap_or((native, native));
                 if hi > native || lo > hi {
-                    return Err(format!("--zoom {lo}..{hi}: a bbox export has zooms {}..={native}", tex.min_zoom()));
+                    return Err(format!("--zoom {lo}..{hi}: a bbox export has zooms {min_zoom}..={native}"));
                 }
                 if x0 >= x1 || y0 >= y1 || x1 > 1 << hi || y1 > 1 << hi {
                     return Err(format!(
@@ -162,7 +206,7 @@ impl Plan {
                 }
                 let k = w.trailing_zeros();
                 pairs.push(("world".into(), w.to_string()));
-                let first = k.saturating_sub(native);
+                let first = (k + min_zoom).saturating_sub(native);
                 let (lo, hi) = zooms.unwrap_or((first, k));
                 if lo < first || hi > k || lo > hi {
                     return Err(format!(
@@ -174,18 +218,31 @@ impl Plan {
         };
         let query = form_urlencoded::Serializer::new(String::new()).extend_pairs(&pairs).finish();
         let mut r = ParamReader::request(pairs).map_err(|e| e.to_string())?;
-        let map = crate::request::map_choice(&tex, &mut r, format).map_err(|e| e.message)?;
-        if map == MapChoice::Uv {
-            return Err("map 'uv': coordinates are not exported; export albedo or a material map".into());
-        }
-        let params = tex.defaults.request(&tex.source(), r).map_err(|e| e.to_string())?;
-        Ok(Plan { tex, params, query, area, zooms: all, format, map })
+        let what = match served {
+            Served::Texture(tex) => {
+                let map = crate::request::map_choice(&tex, &mut r, format).map_err(|e| e.message)?;
+                if map == MapChoice::Uv {
+                    return Err("map 'uv': coordinates are not exported; export albedo or a material map".into());
+                }
+                let params = tex.defaults.request(&tex.source(), r).map_err(|e| e.to_string())?;
+                Exported::Texture { tex, params, map }
+            }
+            Served::Landscape(land) => {
+                let (map, dem) = LandscapeMap::read(&land, &mut r, format).map_err(|e| e.message)?;
+                if dem.is_some() {
+                    return Err("raster-dem encodings are served, not exported".into());
+                }
+                let zero = Target::Tile(TileSpec { z: 0, x: 0, y: 0, scale: 1, format });
+                Exported::Landscape(LandscapeJob::new(land, zero, (map, None), r).map_err(|e| e.message)?)
+            }
+        };
+        Ok(Plan { what, query, area, zooms: all, format })
     }
 
     /// Textile zoom of archive zoom `a`.
     fn textile_zoom(&self, a: u32) -> u32 {
         match self.area {
-            Area::World { k } => a + self.tex.native_zoom() - k,
+            Area::World { k } => a + self.what.zooms().native - k,
             Area::Bbox { .. } => a,
         }
     }
@@ -238,14 +295,24 @@ impl Plan {
 
     /// The archive's JSON metadata: what it shows, and how to make the same tiles again.
     pub fn metadata(&self) -> serde_json::Value {
-        let c = &self.tex.config;
         let (offset, world) = match self.area {
-            Area::World { k } => (self.tex.native_zoom() as i64 - k as i64, Some(1u64 << k)),
+            Area::World { k } => (self.what.zooms().native as i64 - k as i64, Some(1u64 << k)),
             Area::Bbox { .. } => (0, None),
         };
+        let tile_url = format!(
+            "/tiles/{}/{{z+{offset}}}/{{x}}/{{y}}.{}{}",
+            self.what.id(),
+            self.format.ext(),
+            self.query_suffix()
+        );
+        let (tex, params) = match &self.what {
+            Exported::Texture { tex, params, .. } => (tex, params),
+            Exported::Landscape(job) => return self.landscape_metadata(job, offset, world, tile_url),
+        };
+        let c = &tex.config;
         json!({
             "name": c.name,
-            "description": format!("textile texture '{}' ({}), exported by {}", c.id, self.params.name(), engine_version()),
+            "description": format!("textile texture '{}' ({}), exported by {}", c.id, params.name(), engine_version()),
             "attribution": c.attribution,
             "type": "baselayer",
             "format": self.format.ext(),
@@ -255,14 +322,53 @@ impl Plan {
             "bounds": self.bounds(),
             "textile": {
                 "texture": c.id,
-                "mode": self.params.name(),
-                "parameters": self.params.canonical(),
+                "mode": params.name(),
+                "parameters": params.canonical(),
                 "query": self.query,
                 "world": world,
                 "zoom_offset": offset,
                 "engine": engine_version(),
-                "analysis": self.tex.file_hash(),
-                "tile_url": format!("/tiles/{}/{{z+{offset}}}/{{x}}/{{y}}.{}{}", c.id, self.format.ext(), self.query_suffix()),
+                "analysis": tex.file_hash(),
+                "tile_url": tile_url,
+            }
+        })
+    }
+
+    /// A landscape's archive metadata: its identity is the landscape's id and the hash of its
+    /// job (configuration, splat image, seed, period, map, and every layer's analysis, parameters
+    /// and maps), so that parts of another version of it are refused by the merge.
+    fn landscape_metadata(
+        &self,
+        job: &LandscapeJob,
+        offset: i64,
+        world: Option<u64>,
+        tile_url: String,
+    ) -> serde_json::Value {
+        let l = &job.land.config;
+        let layers: Vec<&str> = job.land.layers.iter().map(|y| y.tex.config.id.as_str()).collect();
+        let analyses: Vec<Option<&str>> = job.land.layers.iter().map(|y| y.tex.file_hash()).collect();
+        json!({
+            "name": l.name,
+            "description": format!("textile landscape '{}' of {}, exported by {}", l.id, layers.join(", "), engine_version()),
+            "attribution": l.attribution,
+            "type": "baselayer",
+            "format": self.format.ext(),
+            "version": engine_version(),
+            "minzoom": self.zooms.0,
+            "maxzoom": self.zooms.1,
+            "bounds": self.bounds(),
+            "textile": {
+                "texture": l.id,
+                "landscape": l.id,
+                "mode": "landscape",
+                "parameters": job.identity(),
+                "layers": layers,
+                "query": self.query,
+                "world": world,
+                "zoom_offset": offset,
+                "engine": engine_version(),
+                "analysis": analyses,
+                "tile_url": tile_url,
             }
         })
     }
@@ -363,14 +469,8 @@ pub fn render_part(plan: &Plan, shard: Shard, output: &Path) -> Result<Report, S
         let bytes: Vec<Result<Vec<u8>, String>> = part
             .par_iter()
             .map(|e| {
-                let job = ImageJob {
-                    tex: plan.tex.clone(),
-                    params: plan.params.clone(),
-                    target: Target::Tile(e.tile),
-                    map: plan.map.clone(),
-                    dem: None,
-                };
-                job.bytes(&pyramid).map(|(b, _)| b).map_err(|err| err.message)
+                let picture = plan.what.picture(e.tile);
+                picture.bytes(&pyramid, &textile_core::Cancel::default()).map_err(|err| err.message)
             })
             .collect();
         for (e, b) in part.iter().zip(bytes) {

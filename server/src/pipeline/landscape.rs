@@ -217,6 +217,14 @@ impl LandscapeJob {
         key
     }
 
+    /// What determines its images wherever they are (the landscape's configuration and splat,
+    /// the seed, period and map, every layer's analysis, parameters and height map), as a hash:
+    /// an export's identity.
+    pub fn identity(&self) -> String {
+        let zero = Target::Tile(crate::request::TileSpec { z: 0, x: 0, y: 0, scale: 1, format: self.format() });
+        blake3::hash(self.at(zero, self.map.clone()).key().as_bytes()).to_hex()[..32].to_string()
+    }
+
     /// The strong ETag.
     pub fn etag(&self) -> String {
         etag_for(&self.key())
