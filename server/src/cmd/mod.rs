@@ -139,7 +139,8 @@ pub(crate) fn configured_landscape(
     c: &ConfigArgs,
     id: &str,
 ) -> Result<Option<Arc<crate::textures::Landscape>>, Box<dyn std::error::Error>> {
-    let cfg = Config::load(c.config.as_deref(), &c.overrides(None))?;
+    let cfg =
+        crate::uploads::with_stored(&Config::load(c.config.as_deref(), &c.overrides(None))?, &|s| eprintln!("{s}"));
     let Some(l) = cfg.landscapes.iter().find(|l| l.id == id) else { return Ok(None) };
     let mut only = cfg.clone();
     only.textures.retain(|t| l.layers.iter().any(|y| y.texture == t.id));

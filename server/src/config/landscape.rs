@@ -36,6 +36,9 @@ pub struct LandscapeConfig {
     /// its native zoom).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub height_scale: Option<f64>,
+    /// Added through the admin API and stored in the data directory (not a field of any file).
+    #[serde(skip)]
+    pub uploaded: bool,
 }
 
 /// One layer: a configured texture, rendered as its own tiles are.

@@ -25,7 +25,7 @@ use crate::textures::{prepare_texture, LoadError};
 use crate::uploads;
 
 /// The admin routes exist (a token is configured) and the request carries the token.
-fn admit(st: &AppState, headers: &HeaderMap, uri: &axum::http::Uri) -> Result<(), ApiError> {
+pub(crate) fn admit(st: &AppState, headers: &HeaderMap, uri: &axum::http::Uri) -> Result<(), ApiError> {
     if st.config.admin_token.is_empty() {
         return Err(ApiError::not_found_route(uri.path()));
     }
@@ -41,7 +41,8 @@ fn admit(st: &AppState, headers: &HeaderMap, uri: &axum::http::Uri) -> Result<()
     Ok(())
 }
 
-fn too_large(limit: u64) -> ApiError {
+/// The answer to an upload over its limit.
+pub(crate) fn too_large(limit: u64) -> ApiError {
     ApiError::new(Kind::TooLarge, "body_too_large", format!("the upload is over {} MiB", limit >> 20))
 }
 
@@ -292,7 +293,7 @@ pub async fn upload(
     responses((status = 204, description = "removed"),
               (status = 401, description = "no or wrong bearer token"),
               (status = 404, description = "no such texture, or the admin API is off"),
-              (status = 409, description = "a configured texture (remove it from the configuration instead)"),
+              (status = 409, description = "a configured texture (remove it from the configuration instead), or a layer of a landscape (named)"),
               (status = 500, description = "its record could not be removed: the texture is kept"),
               (status = 503, description = "still loading")),
     security(("admin_token" = [])))]
@@ -312,6 +313,15 @@ pub async fn delete(
             Kind::Conflict,
             "configured_texture",
             format!("texture '{id}' is configured, not uploaded: remove it from the configuration"),
+        ));
+    }
+    // A layer of a landscape stays while the landscape does.
+    let users = reg.landscapes_using(&id);
+    if !users.is_empty() {
+        return Err(ApiError::new(
+            Kind::Conflict,
+            "texture_in_use",
+            format!("texture '{id}' is a layer of landscape '{}': delete the landscape first", users.join("', '")),
         ));
     }
     // Its record first: if that cannot go, nothing has changed and the answer says so (a

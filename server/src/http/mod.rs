@@ -6,6 +6,7 @@
 
 pub mod access;
 pub mod admin;
+pub mod admin_landscapes;
 mod bare_errors;
 pub mod content;
 pub mod error;
@@ -111,6 +112,8 @@ pub fn router(state: Arc<AppState>) -> Router {
         .route("/textures/{id}", get(meta::texture_meta).delete(admin::delete))
         .route("/admin/textures", reads_body(post(admin::upload).layer(upload_limit), &stalled))
         .route("/admin/textures/{id}", delete(admin::delete))
+        .route("/admin/landscapes", reads_body(post(admin_landscapes::upload).layer(upload_limit), &stalled))
+        .route("/admin/landscapes/{id}", delete(admin_landscapes::delete))
         .route("/textures/{id}/exemplar.png", get(meta::exemplar))
         .route("/textures/{id}/maps/{name}", get(meta::map_image))
         .route("/tiles/{id}/tilejson.json", get(meta::tilejson))

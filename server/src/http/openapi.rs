@@ -28,6 +28,8 @@ use utoipa::{Modify, OpenApi};
         crate::http::samples::samples,
         crate::http::admin::upload,
         crate::http::admin::delete,
+        crate::http::admin_landscapes::upload,
+        crate::http::admin_landscapes::delete,
         openapi,
         crate::http::meta::metrics,
         crate::http::static_files::index,

@@ -61,12 +61,19 @@ const OVERLAY: [[u8; 3]; 8] = [
 ];
 
 impl Landscape {
-    /// Make a configured landscape (the `index`-th) from the registry's textures; errors name
-    /// the landscape and the field.
-    pub fn build(cfg: &Config, l: &LandscapeConfig, index: usize, reg: &Registry) -> Result<Landscape, LoadError> {
+    /// Make a landscape from its configuration (at `at`: `landscapes[2]` in a file, `config` in
+    /// an upload) and the registry's textures, its painted splat from `splat` when given (an
+    /// upload's), else from the file it names; errors name the landscape and the field.
+    pub fn build(
+        cfg: &Config,
+        l: &LandscapeConfig,
+        at: &str,
+        reg: &Registry,
+        splat: Option<&[u8]>,
+    ) -> Result<Landscape, LoadError> {
         let fail = |field: String, message: String| LoadError::Landscape {
             id: l.id.clone(),
-            field: format!("landscapes[{index}].{field}"),
+            field: format!("{at}.{field}"),
             message,
         };
         let mut zooms = Vec::new();
@@ -116,13 +123,16 @@ impl Landscape {
                 )
             }
             SplatConfig::Image { image, key, texels_per_pixel, origin, outside, warp, .. } => {
-                let bytes = super::storage::file_bytes(
-                    cfg,
-                    &l.id,
-                    image,
-                    textile_core::landscape::splat::MAX_IMAGE_BYTES as u64,
-                )
-                .map_err(|e| fail("splat.image".into(), e.to_string()))?;
+                let bytes = match splat {
+                    Some(b) => b.to_vec(),
+                    None => super::storage::file_bytes(
+                        cfg,
+                        &l.id,
+                        image,
+                        textile_core::landscape::splat::MAX_IMAGE_BYTES as u64,
+                    )
+                    .map_err(|e| fail("splat.image".into(), e.to_string()))?,
+                };
                 h.update(&bytes);
                 let key = match key.as_str() {
                     "rgba" => Key::Channels,
@@ -205,9 +215,27 @@ impl Landscape {
     }
 }
 
-/// Make every configured landscape from the registry's textures.
-pub fn build_all(cfg: &Config, reg: &Registry) -> Result<Vec<Arc<Landscape>>, LoadError> {
-    cfg.landscapes.iter().enumerate().map(|(i, l)| Landscape::build(cfg, l, i, reg).map(Arc::new)).collect()
+/// Make every configured landscape from the registry's textures. A stored one (added through
+/// the admin API) that cannot be made — a layer's upload failed to load, a limit changed — is
+/// skipped with a warning, so it cannot stop the service.
+pub fn build_all(cfg: &Config, reg: &Registry, log: &dyn Fn(String)) -> Result<Vec<Arc<Landscape>>, LoadError> {
+    let mut out = Vec::new();
+    for (i, l) in cfg.landscapes.iter().enumerate() {
+        if !l.uploaded {
+            out.push(Arc::new(Landscape::build(cfg, l, &format!("landscapes[{i}]"), reg, None)?));
+            continue;
+        }
+        let ids: Vec<&str> = reg.list.iter().map(|t| t.config.id.as_str()).collect();
+        let made = l
+            .validate("landscape", &ids)
+            .map_err(|(field, message)| LoadError::Landscape { id: l.id.clone(), field, message })
+            .and_then(|()| Landscape::build(cfg, l, "landscape", reg, None));
+        match made {
+            Ok(land) => out.push(Arc::new(land)),
+            Err(e) => log(format!("warning: stored {e}; not served")),
+        }
+    }
+    Ok(out)
 }
 
 /// What `GET /textures/{id}` says of a landscape: its kind, layers, splat, blend and status.

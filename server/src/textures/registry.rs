@@ -42,6 +42,30 @@ impl Registry {
         self.landscapes.iter().find(|l| l.config.id == id)
     }
 
+    /// This registry with landscape `l` added at the end.
+    pub fn with_landscape(&self, l: Arc<Landscape>) -> Self {
+        let mut landscapes: Vec<_> = self.landscapes.iter().filter(|m| m.config.id != l.config.id).cloned().collect();
+        landscapes.push(l);
+        Registry::new(self.list.clone()).with_landscapes(landscapes)
+    }
+
+    /// This registry without the landscape `id`.
+    pub fn without_landscape(&self, id: &str) -> Self {
+        let landscapes = self.landscapes.iter().filter(|m| m.config.id != id).cloned().collect();
+        Registry::new(self.list.clone()).with_landscapes(landscapes)
+    }
+
+    /// The landscapes that have texture `id` as a layer.
+    pub fn landscapes_using(&self, id: &str) -> Vec<&str> {
+        let uses = |l: &&Arc<Landscape>| l.layers.iter().any(|y| y.tex.config.id == id);
+        self.landscapes.iter().filter(uses).map(|l| l.config.id.as_str()).collect()
+    }
+
+    /// Landscapes added through the admin API in it.
+    pub fn stored_landscapes(&self) -> usize {
+        self.landscapes.iter().filter(|l| l.config.uploaded).count()
+    }
+
     /// This registry with `tex` added at the end.
     pub fn with(&self, tex: Arc<Texture>) -> Self {
         let mut list: Vec<_> = self.list.iter().filter(|t| t.config.id != tex.config.id).cloned().collect();
@@ -119,6 +143,6 @@ pub fn prepare_registry(cfg: &Config, log: &dyn Fn(String)) -> Result<Registry, 
         }
     }
     let reg = Registry::new(list);
-    let landscapes = super::landscape::build_all(cfg, &reg)?;
+    let landscapes = super::landscape::build_all(cfg, &reg, log)?;
     Ok(reg.with_landscapes(landscapes))
 }

@@ -4,7 +4,9 @@
 //! (`ID.png|jpg|webp`) and its configuration (`ID.toml`), each written to a temporary file and
 //! renamed into place, the configuration last: a configuration present means a complete
 //! upload, and whatever an interrupted upload left is removed at start-up — and the background
-//! analysis of an upload.
+//! analysis of an upload. Landscapes added through the admin API are stored by [`landscapes`].
+
+pub mod landscapes;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -335,9 +337,9 @@ pub fn parse_record(text: &str) -> Result<TextureConfig, String> {
 }
 
 /// A configuration with the stored uploads added after its own textures (an upload whose id a
-/// configured texture has is left out, with a warning).
+/// configured texture has is left out, with a warning), and the stored landscapes after its own.
 pub fn with_stored(cfg: &Config, log: &dyn Fn(String)) -> Config {
-    let mut all = cfg.clone();
+    let mut all = landscapes::with_stored(cfg, log);
     for t in stored(&dir(cfg), log) {
         if cfg.textures.iter().any(|c| c.id == t.id) {
             log(format!("warning: uploaded texture '{}' is not served: a configured texture has its id", t.id));
