@@ -107,6 +107,20 @@ fn loadtest_runs_every_pattern_and_reports() {
             assert!(ratio < 0.5, "pan requests new tiles: {ratio}");
         }
     }
+    // A landscape takes every pattern too; its layers' syntheses are counted by their modes.
+    std::fs::write(dir.path().join("meadow.txt"), "/tiles/meadow/7/0/0.png\n/tiles/meadow/6/1/1.png?seed=2\n").unwrap();
+    let replay = dir.path().join("meadow.txt");
+    for pattern in ["pan", "zoom", "random", "hot", "replay"] {
+        let report = loadtest_json(
+            &s.base,
+            &["--texture", "meadow", "--pattern", pattern, "--concurrency", "4", "--file", replay.to_str().unwrap()],
+        );
+        assert_eq!(report["status"]["200"], 40, "meadow {pattern}: {report}");
+        if pattern == "pan" {
+            let ratio = report["server_computation_ratio"].as_f64().expect("a landscape's computation ratio");
+            assert!((1.0..2.5).contains(&ratio), "meadow pan computation ratio {ratio}");
+        }
+    }
     let text = Command::new(binary())
         .args(["loadtest", "--url", &s.base, "--texture", "grass", "--pattern", "hot", "--requests", "5"])
         .output()

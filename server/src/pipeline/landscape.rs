@@ -250,6 +250,18 @@ impl LandscapeJob {
 
     /// Render and encode.
     pub fn bytes(&self, cache: &Pyramid, cancel: &Cancel) -> Result<Vec<u8>, ApiError> {
+        self.bytes_counted(cache, cancel, &|_, _, _| {})
+    }
+
+    /// [`LandscapeJob::bytes`], telling `count` of each layer image it renders: the layer's
+    /// mode, the pixels synthesized at all levels and the pixels delivered (what the server's
+    /// metrics count for a texture's tile).
+    pub fn bytes_counted(
+        &self,
+        cache: &Pyramid,
+        cancel: &Cancel,
+        count: &(dyn Fn(&'static str, u64, u64) + Sync),
+    ) -> Result<Vec<u8>, ApiError> {
         let splat = self.splat_weights();
         if self.map == LandscapeMap::Splat {
             let colours: Vec<Vec<u8>> = self.land.layers.iter().map(|y| y.colour.repeat(splat.pixels())).collect();
@@ -269,7 +281,9 @@ impl LandscapeJob {
             if cancel.is_set() {
                 return Err(textile_core::CoreError::Cancelled.into());
             }
-            Ok(job.render(cache)?.image.pixels)
+            let r = job.render(cache)?;
+            count(job.params.name(), r.synthesized, r.image.width as u64 * r.image.height as u64);
+            Ok(r.image.pixels)
         };
         let map_job = |job: &ImageJob, name: &str| ImageJob { map: MapChoice::Map(name.into()), ..job.clone() };
         // Each layer's colour and height map rendered at most once: a layer without a height map

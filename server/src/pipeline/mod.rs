@@ -349,7 +349,14 @@ pub async fn produce_picture(st: &Arc<AppState>, etag: &str, p: Picture) -> (Res
         Picture::Texture(job) => produce(st, etag, job).await,
         Picture::Landscape(job) => {
             let pyramid = st.pyramid.clone();
-            cached(st, etag, crate::metrics::LANDSCAPE_LABEL, move |cancel| job.bytes(&pyramid, cancel)).await
+            let (synthesized, delivered) = (st.metrics.pixels_synthesized.clone(), st.metrics.pixels_delivered.clone());
+            // Its layers' syntheses are counted by their modes, as their own tiles' are.
+            let count = move |mode: &'static str, s: u64, d: u64| {
+                synthesized.with_label_values(&[mode]).inc_by(s);
+                delivered.with_label_values(&[mode]).inc_by(d);
+            };
+            cached(st, etag, crate::metrics::LANDSCAPE_LABEL, move |cancel| job.bytes_counted(&pyramid, cancel, &count))
+                .await
         }
     }
 }
