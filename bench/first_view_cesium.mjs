@@ -8,20 +8,27 @@
 //   node bench/first_view_cesium.mjs URL [TEXTURE …]
 // e.g. node bench/first_view_cesium.mjs http://127.0.0.1:8080 gravel flagstones
 // (CESIUM_OPTIONS='{…}' replaces the recipe's options to Cesium3DTileset.fromUrl, by default
-// {"skipLevelOfDetail": true}; SCENE='statements' runs them with `viewer` set up, before the
+// {"skipLevelOfDetail": true, "foveatedScreenSpaceError": false}; SCENE='statements' runs them with `viewer` set up, before the
 // tileset, e.g. SCENE='viewer.resolutionScale = 0.2'; SHOTS=DIR saves each settled view there)
 import { createRequire } from 'node:module';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 
 const require = createRequire(new URL('../tests/browser/package.json', import.meta.url));
-const { chromium } = require('playwright-core');
+// The libraries are tests/browser's: installed by `npm ci` there (what .ci/run does).
+let chromium;
+try {
+  ({ chromium } = require('playwright-core'));
+} catch {
+  console.error('bench: the browser libraries are missing; install them first: (cd tests/browser && npm ci)');
+  process.exit(2);
+}
 const MODULES = new URL('../tests/browser/node_modules/', import.meta.url).pathname;
 const TYPES = { js: 'text/javascript', css: 'text/css', json: 'application/json', wasm: 'application/wasm', png: 'image/png', jpg: 'image/jpeg', glb: 'model/gltf-binary' };
 
 const [base, ...textures] = process.argv.slice(2);
 // Cesium3DTileset options (JSON): the recipe's unless given.
-const OPTIONS = JSON.parse(process.env.CESIUM_OPTIONS || '{"skipLevelOfDetail": true}');
+const OPTIONS = JSON.parse(process.env.CESIUM_OPTIONS || '{"skipLevelOfDetail": true, "foveatedScreenSpaceError": false}');
 const SCENE = process.env.SCENE || '';
 const PAGE = `<!doctype html><html><head><meta charset="utf-8">
 <script>window.CESIUM_BASE_URL = '/__3d/cesium/Build/Cesium/';</script>

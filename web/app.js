@@ -7,7 +7,7 @@
 // p: the parameters the user changed, by name, as the query string carries them.
 // a: the map shown (albedo, a material map, or 'lit': colour shaded by the normal map); l: the
 // light's direction in degrees for 'lit'; o: the splat overlay of a landscape shown.
-const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false, a: 'albedo', l: 135, o: false };
+const state = { t: null, m: null, s: 0, p: {}, z: null, x: 0, y: 0, g: false, a: 'albedo', l: 135, o: false, k: false };
 let catalog = null, meta = null, map = null, layer = null, grid = null, latticeLayer = null, debounce = null;
 let splatLayer = null;
 const $ = (id) => document.getElementById(id);
@@ -29,6 +29,7 @@ function readHash() {
   if (p.has('a')) state.a = p.get('a');
   if (p.has('l') && /^\d+$/.test(p.get('l'))) state.l = Number(p.get('l')) % 360;
   state.o = p.get('o') === '1';
+  state.k = p.get('k') === '1';
 }
 
 function hash() {
@@ -40,6 +41,7 @@ function hash() {
   if (state.a !== 'albedo') p.set('a', state.a);
   if (state.a === 'lit') p.set('l', state.l);
   if (state.o && isLandscape()) p.set('o', '1');
+  if (state.k && !isLandscape()) p.set('k', '1');
   return '#' + p.toString();
 }
 
@@ -472,6 +474,7 @@ function showLatticeRow() {
   const lat = meta && meta.exemplar.lattice;
   $('latticerow').hidden = !lat;
   if (!lat) { setLattice(false); return; }
+  if (state.k && !latticeLayer) setLattice(true);
   const waves = lat.waves.map((w) => `${w.period.toFixed(2)} px at ${w.angle.toFixed(1)}°`).join(', ');
   $('latticeinfo').textContent = `${lat.kind}: ${waves} (${lat.origin}, confidence ${lat.confidence})`;
   if (latticeLayer) latticeLayer.redraw();
@@ -479,6 +482,7 @@ function showLatticeRow() {
 
 function setLattice(on) {
   $('lattice').checked = on;
+  state.k = on;
   if (on && !latticeLayer) {
     latticeLayer = L.gridLayer({ tileSize: 256, noWrap: true, zIndex: 11 });
     latticeLayer.createTile = (c) => {
@@ -604,7 +608,7 @@ async function init() {
   });
   $('resetp').addEventListener('click', () => { state.p = {}; buildControls(); refreshLayer(); });
   $('grid').addEventListener('change', (e) => setGrid(e.target.checked));
-  $('lattice').addEventListener('change', (e) => setLattice(e.target.checked));
+  $('lattice').addEventListener('change', (e) => { setLattice(e.target.checked); writeHash(); });
   $('splat').addEventListener('change', (e) => setSplat(e.target.checked));
   setupUpload();
   $('terrainlink').addEventListener('click', (e) => {

@@ -363,6 +363,7 @@ test('/3d.html lights a material with a sun whose direction a slider turns', asy
   console.log(`3D page, flagstones: the sun from the east vs the west changes pixels by ${diff.toFixed(1)} levels on average`);
   assert.ok(diff > 6, `turning the sun barely changes the relief: ${diff}`);
   assert.match(page.url(), /sun=180/);
+  assert.equal(await page.textContent('#sunvalue'), '180°', 'the sun slider shows its value');
   save('3d-page-material.png', `data:image/png;base64,${(await page.screenshot()).toString('base64')}`);
   // A texture without maps is shown as it is: no sun.
   await page.selectOption('#texture', 'gravel');
@@ -495,8 +496,10 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
   const r = await page.evaluate(async (base) => {
     const viewer = window.dayViewer();
     const failures = [];
+    // The README's options: foveated screen-space error left on, the view's upper corners were
+    // never refined, and the globe showed there.
     const tileset = await Cesium.Cesium3DTileset.fromUrl(`${base}/3dtiles/gravel/tileset.json?lon=2.35&lat=48.85&height=35&seed=4`,
-      { skipLevelOfDetail: true });
+      { skipLevelOfDetail: true, foveatedScreenSpaceError: false });
     tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
     viewer.scene.primitives.add(tileset);
     const centre = Cesium.Cartesian3.fromDegrees(2.35, 48.85, 35);
@@ -525,6 +528,19 @@ test('CesiumJS loads the tileset anchored on the globe and requests its content'
   const lit = sum / (d.length / 4);
   console.log(`CesiumJS: the middle of the view at midday has mean luminance ${lit.toFixed(1)}`);
   assert.ok(lit > 85, `the texture is lit by day: mean ${lit}`);
+  // The upper corners of the view (an eighth of its width and height each) are gravel too, not
+  // the bare globe: the globe is one flat colour (standard deviation of the luminance about 1),
+  // gravel a field of stones (about 14 at this distance).
+  const spread = async (box) => {
+    const { data } = await screenshot(page, box);
+    const l = [];
+    for (let i = 0; i < data.length; i += 4) l.push((data[i] + data[i + 1] + data[i + 2]) / 3);
+    const mean = l.reduce((a, b) => a + b, 0) / l.length;
+    return Math.sqrt(l.reduce((a, b) => a + (b - mean) ** 2, 0) / l.length);
+  };
+  const corners = { left: await spread([0, 0, 1 / 8, 1 / 8]), right: await spread([7 / 8, 0, 1 / 8, 1 / 8]) };
+  console.log(`CesiumJS: luminance spread in the view's upper corners ${JSON.stringify(corners)} (bare globe: about 1)`);
+  assert.ok(corners.left > 8 && corners.right > 8, `an upper corner shows no ground: ${JSON.stringify(corners)}`);
   const levels = [...content].sort((a, b) => a - b);
   console.log(`CesiumJS: tileset loaded ${r.loaded}, content levels requested [${levels}], bounding sphere at ` +
     `${r.lon.toFixed(4)}°, ${r.lat.toFixed(4)}°; root transform ${r.anchor.toFixed(3)} m from the anchor`);

@@ -406,11 +406,21 @@ test('a near-regular texture shows its lattice, overlays it, and greys out the m
   }));
   // Stripes every ~18 texels: about 14 one-pixel lines down each 256 px tile.
   assert.ok(lines.length > 0 && lines.every((n) => n > 256 * 8), JSON.stringify(lines));
+  // The overlay is in the permalink, and a page opened at it shows the overlay.
+  await page.waitForFunction(() => /[#&]k=1(&|$)/.test(location.hash));
+  const link = await page.evaluate(() => location.hash);
+  const again = await open(`/${link}`);
+  await settled(again.page);
+  await again.page.waitForSelector('canvas.lattice-tile');
+  assert.equal(await again.page.isChecked('#lattice'), true);
+  assert.deepEqual(again.errors, []);
+  await again.page.close();
   // A stochastic texture has no lattice row.
   await page.selectOption('#texture', 'gravel');
   await page.waitForFunction(() => [...document.querySelectorAll('img.leaflet-tile')].some((i) => i.src.includes('/tiles/gravel/')));
   assert.equal(await page.$eval('#latticerow', (r) => r.hidden), true);
   assert.equal(await page.$$eval('canvas.lattice-tile', (cs) => cs.length), 0);
+  assert.doesNotMatch(await page.evaluate(() => location.hash), /[#&]k=1/);
   assert.deepEqual(errors, []);
   await page.close();
 });
