@@ -16,6 +16,7 @@ pub mod cmd;
 pub mod config;
 pub mod encode;
 pub mod error;
+pub mod etag_memo;
 pub mod export;
 pub mod http;
 pub mod memory;

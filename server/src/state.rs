@@ -29,6 +29,8 @@ pub struct AppState {
     /// place) when an upload adds or a deletion removes a texture, so every request works with
     /// one consistent catalogue.
     registry: RwLock<Option<Arc<Registry>>>,
+    /// The ETags of recent tile requests by URL, valid while the catalogue is the same.
+    pub etags: crate::etag_memo::EtagMemo,
     /// Held while the catalogue is being changed (uploads and deletions, one at a time).
     pub catalogue_writer: tokio::sync::Mutex<()>,
     /// Permits to run analyses of uploaded textures (`max_concurrent_analyses`).
@@ -98,6 +100,7 @@ impl AppState {
                 .unwrap_or_else(|_| axum::http::HeaderValue::from_static("no-cache")),
             config,
             registry: RwLock::new(None),
+            etags: Default::default(),
             catalogue_writer: tokio::sync::Mutex::new(()),
             stopping: Cancel::default(),
             loaded: Default::default(),
@@ -185,6 +188,7 @@ impl AppState {
             tex.limit_caches(each);
         }
         *self.registry.write().unwrap_or_else(|e| e.into_inner()) = Some(reg);
+        self.etags.catalogue_changed();
     }
 
     /// MiB of the memory budget that working memory may reserve (the rest is the textures'

@@ -53,8 +53,18 @@ pub fn image(bytes: Bytes, content_type: &'static str, etag: &str, cache_control
 /// An output's answer: `304` when the client has it, else its bytes (through the tile cache
 /// where it keeps them) with its ETag and content type.
 pub async fn answer(st: &Arc<AppState>, headers: &HeaderMap, out: Output) -> Result<Response, ApiError> {
-    let cc = &st.cache_control;
     let etag = out.etag();
+    answer_tagged(st, headers, out, etag).await
+}
+
+/// [`answer`] of an output whose ETag (its [`Output::etag`]) the caller computed already.
+pub async fn answer_tagged(
+    st: &Arc<AppState>,
+    headers: &HeaderMap,
+    out: Output,
+    etag: String,
+) -> Result<Response, ApiError> {
+    let cc = &st.cache_control;
     if if_none_match(headers, &etag) {
         return Ok(not_modified(&etag, cc));
     }

@@ -12,7 +12,8 @@ use axum::http::HeaderMap;
 use axum::response::Response;
 
 use crate::error::ApiError;
-use crate::http::content::answer;
+use crate::etag_memo::Stamp;
+use crate::http::content::{answer, answer_tagged, if_none_match, image, not_modified};
 use crate::http::extract::{path_error, texture};
 use crate::output::Output;
 use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
@@ -40,21 +41,41 @@ pub async fn tile(
     RawQuery(q): RawQuery,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
+    // Read before the catalogue: a memo made with an older catalogue is never used.
+    let generation = st.etags.generation();
     let reg = st.ready()?;
     let Path((id, z, x, y)) = path.map_err(path_error)?;
-    if let Some(land) = reg.landscape(&id) {
+    // A tile asked for before, whose ETag still holds: answered from the memo and the cache.
+    let url = format!("{id}/{z}/{x}/{y}?{}", q.as_deref().unwrap_or(""));
+    if let Some(m) = st.etags.get(&url, generation) {
+        if if_none_match(&headers, &m.etag) {
+            return Ok(not_modified(&m.etag, &st.cache_control));
+        }
+        if let Some(bytes) = st.cache.peek(&m.etag) {
+            return Ok(image(bytes, m.content_type, &m.etag, &st.cache_control, true));
+        }
+    }
+    let out = if let Some(land) = reg.landscape(&id) {
         let spec = parse_tile_in(land.zooms(), &z, &x, &y)?;
         let mut r = query_reader(q.as_deref())?;
         let map = LandscapeMap::read(land, &mut r, spec.format)?;
-        let job = LandscapeJob::new(land.clone(), Target::Tile(spec), map, r)?;
-        return answer(&st, &headers, Output::Landscape(job)).await;
-    }
-    let tex = texture(&reg, &id)?;
-    let spec = parse_tile(&tex, &z, &x, &y)?;
-    let mut r = query_reader(q.as_deref())?;
-    let (map, dem) = map_and_dem(&tex, &mut r, spec.format)?;
-    let params = params(&tex, r)?;
-    answer(&st, &headers, Output::Image(ImageJob { tex, params, target: Target::Tile(spec), map, dem })).await
+        Output::Landscape(LandscapeJob::new(land.clone(), Target::Tile(spec), map, r)?)
+    } else {
+        let tex = texture(&reg, &id)?;
+        let spec = parse_tile(&tex, &z, &x, &y)?;
+        let mut r = query_reader(q.as_deref())?;
+        let (map, dem) = map_and_dem(&tex, &mut r, spec.format)?;
+        let params = params(&tex, r)?;
+        Output::Image(ImageJob { tex, params, target: Target::Tile(spec), map, dem })
+    };
+    let etag = out.etag();
+    let stamps = match &out {
+        Output::Image(job) => vec![Stamp::new(&job.tex, job.params.name())],
+        Output::Landscape(job) => job.layers.iter().map(|j| Stamp::new(&j.tex, j.params.name())).collect(),
+        _ => Vec::new(),
+    };
+    st.etags.put(&url, generation, &etag, out.content_type(), stamps);
+    answer_tagged(&st, &headers, out, etag).await
 }
 
 /// Any rectangle of the texture at zoom `z`, as one image.
