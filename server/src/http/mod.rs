@@ -36,8 +36,14 @@ use tower_http::cors::{AllowOrigin, CorsLayer};
 use crate::error::ApiError;
 use crate::state::AppState;
 
-/// Count every routed request by route template and status, and time it.
+/// Refuse oversized requests ([`over_limits`]), then count every routed request by route
+/// template and status, and time it.
 async fn track(State(st): State<Arc<AppState>>, req: Request, next: Next) -> Response {
+    // Oversized requests are refused first, untracked (one layer for both: every layer costs a
+    // cached tile its share of instructions).
+    if let Some(refused) = over_limits(&req) {
+        return refused;
+    }
     // The matched route shares its text (no copy per request).
     let matched = req.extensions().get::<MatchedPath>().cloned();
     let route = matched.as_ref().map_or("unmatched", |m| m.as_str());
@@ -55,10 +61,10 @@ pub const MAX_HEADER_BYTES: usize = 64 << 10;
 /// Longest request target (path and query) accepted.
 pub const MAX_URI_BYTES: usize = 16 << 10;
 
-/// Refuse oversized requests with the contract's JSON errors (414, 431) before any route sees
-/// them. What hyper refuses itself — a request line of 64 KiB or more, headers beyond what it
-/// reads at all — it answers with a bare status, which [`bare_errors`] rewrites as JSON too.
-async fn limits(req: Request, next: Next) -> Response {
+/// The contract's JSON error (414, 431) of an oversized request, before any route sees it.
+/// What hyper refuses itself — a request line of 64 KiB or more, headers beyond what it reads
+/// at all — it answers with a bare status, which [`bare_errors`] rewrites as JSON too.
+fn over_limits(req: &Request) -> Option<Response> {
     let uri = req.uri().path_and_query().map_or(0, |pq| pq.as_str().len());
     if uri > MAX_URI_BYTES {
         return ApiError::new(
@@ -66,7 +72,8 @@ async fn limits(req: Request, next: Next) -> Response {
             "uri_too_long",
             format!("the request target is {uri} bytes; at most {MAX_URI_BYTES}"),
         )
-        .into_response();
+        .into_response()
+        .into();
     }
     let h = req.headers();
     let bytes: usize = h.iter().map(|(k, v)| k.as_str().len() + v.len() + 4).sum();
@@ -76,9 +83,10 @@ async fn limits(req: Request, next: Next) -> Response {
             "headers_too_large",
             format!("{} headers of {bytes} bytes; at most {MAX_HEADERS} headers and {MAX_HEADER_BYTES} bytes", h.len()),
         )
-        .into_response();
+        .into_response()
+        .into();
     }
-    next.run(req).await
+    None
 }
 
 /// A route that reads a request body, with the deadline for a body that stops arriving.
@@ -162,7 +170,6 @@ fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Route
     let app = routes
         .fallback(meta::not_found)
         .layer(middleware::from_fn_with_state(state.clone(), track))
-        .layer(middleware::from_fn(limits))
         .with_state(state.clone());
     // 405s get their JSON body outside routing: the router adds a route's `Allow` header after
     // every layer of that route has run.
