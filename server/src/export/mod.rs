@@ -305,71 +305,60 @@ impl Plan {
             self.format.ext(),
             self.query_suffix()
         );
-        let (tex, params) = match &self.what {
-            Exported::Texture { tex, params, .. } => (tex, params),
-            Exported::Landscape(job) => return self.landscape_metadata(job, offset, world, tile_url),
+        let (name, description, attribution, textile) = match &self.what {
+            Exported::Texture { tex, params, .. } => {
+                let c = &tex.config;
+                let description =
+                    format!("textile texture '{}' ({}), exported by {}", c.id, params.name(), engine_version());
+                let textile = json!({
+                    "texture": c.id,
+                    "mode": params.name(),
+                    "parameters": params.canonical(),
+                    "query": self.query,
+                    "world": world,
+                    "zoom_offset": offset,
+                    "engine": engine_version(),
+                    "analysis": tex.file_hash(),
+                    "tile_url": tile_url,
+                });
+                (&c.name, description, &c.attribution, textile)
+            }
+            // A landscape's identity is its id and the hash of its job (configuration, splat
+            // image, seed, period, map, and every layer's analysis, parameters and maps), so that
+            // parts of another version of it are refused by the merge.
+            Exported::Landscape(job) => {
+                let l = &job.land.config;
+                let layers: Vec<&str> = job.land.layers.iter().map(|y| y.tex.config.id.as_str()).collect();
+                let analyses: Vec<Option<&str>> = job.land.layers.iter().map(|y| y.tex.file_hash()).collect();
+                let description =
+                    format!("textile landscape '{}' of {}, exported by {}", l.id, layers.join(", "), engine_version());
+                let textile = json!({
+                    "texture": l.id,
+                    "landscape": l.id,
+                    "mode": "landscape",
+                    "parameters": job.identity(),
+                    "layers": layers,
+                    "query": self.query,
+                    "world": world,
+                    "zoom_offset": offset,
+                    "engine": engine_version(),
+                    "analysis": analyses,
+                    "tile_url": tile_url,
+                });
+                (&l.name, description, &l.attribution, textile)
+            }
         };
-        let c = &tex.config;
         json!({
-            "name": c.name,
-            "description": format!("textile texture '{}' ({}), exported by {}", c.id, params.name(), engine_version()),
-            "attribution": c.attribution,
+            "name": name,
+            "description": description,
+            "attribution": attribution,
             "type": "baselayer",
             "format": self.format.ext(),
             "version": engine_version(),
             "minzoom": self.zooms.0,
             "maxzoom": self.zooms.1,
             "bounds": self.bounds(),
-            "textile": {
-                "texture": c.id,
-                "mode": params.name(),
-                "parameters": params.canonical(),
-                "query": self.query,
-                "world": world,
-                "zoom_offset": offset,
-                "engine": engine_version(),
-                "analysis": tex.file_hash(),
-                "tile_url": tile_url,
-            }
-        })
-    }
-
-    /// A landscape's archive metadata: its identity is the landscape's id and the hash of its
-    /// job (configuration, splat image, seed, period, map, and every layer's analysis, parameters
-    /// and maps), so that parts of another version of it are refused by the merge.
-    fn landscape_metadata(
-        &self,
-        job: &LandscapeJob,
-        offset: i64,
-        world: Option<u64>,
-        tile_url: String,
-    ) -> serde_json::Value {
-        let l = &job.land.config;
-        let layers: Vec<&str> = job.land.layers.iter().map(|y| y.tex.config.id.as_str()).collect();
-        let analyses: Vec<Option<&str>> = job.land.layers.iter().map(|y| y.tex.file_hash()).collect();
-        json!({
-            "name": l.name,
-            "description": format!("textile landscape '{}' of {}, exported by {}", l.id, layers.join(", "), engine_version()),
-            "attribution": l.attribution,
-            "type": "baselayer",
-            "format": self.format.ext(),
-            "version": engine_version(),
-            "minzoom": self.zooms.0,
-            "maxzoom": self.zooms.1,
-            "bounds": self.bounds(),
-            "textile": {
-                "texture": l.id,
-                "landscape": l.id,
-                "mode": "landscape",
-                "parameters": job.identity(),
-                "layers": layers,
-                "query": self.query,
-                "world": world,
-                "zoom_offset": offset,
-                "engine": engine_version(),
-                "analysis": analyses,
-                "tile_url": tile_url,
-            }
+            "textile": textile,
         })
     }
 }
