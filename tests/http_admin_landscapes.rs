@@ -146,6 +146,25 @@ async fn landscapes_added_served_restarted_and_deleted() {
     assert_eq!(r.status().as_u16(), 202);
     let (code, body) = post(&s, &noise("walls", &["bricks", "gravel"]), None, Some(TOKEN)).await;
     assert_eq!(code, 201, "{body}");
+    // A landscape stands where its layers do: analysing while the upload is, then ready.
+    let status = |v: serde_json::Value| v["status"].as_str().unwrap_or("").to_string();
+    let mut seen = Vec::new();
+    for _ in 0..600 {
+        let before = status(s.json("/textures/bricks").await);
+        let walls = s.json("/textures/walls").await;
+        let after = status(s.json("/textures/bricks").await);
+        if before == after {
+            assert_eq!(status(walls.clone()), before, "the landscape says its layer's status: {walls}");
+            seen.push(before.clone());
+        }
+        if after == "ready" {
+            break;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+    }
+    eprintln!("walls' status as its layer was analysed: {:?}", seen.first().zip(seen.last()));
+    assert_eq!(seen.last().map(String::as_str), Some("ready"), "{seen:?}");
+    assert_eq!(s.get_bytes("/tiles/walls/7/0/0.png").await.0, 200);
     let (code, body) = delete(&s, "textures", "bricks").await;
     assert_eq!((code, body["error"].as_str()), (409, Some("texture_in_use")), "{body}");
     assert!(body["message"].as_str().unwrap_or("").contains("walls"), "{body}");
