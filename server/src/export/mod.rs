@@ -7,9 +7,10 @@
 //! show a seamless world. A sub-rectangle (`--bbox`, tile coordinates at the highest zoom) keeps
 //! textile's own zooms and coordinates.
 //!
-//! Tiles are made by the same [`Picture`] as served tiles (an exported tile's bytes equal the
-//! server's answer for the same URL; a landscape's are its [`LandscapeJob`]'s), rendered in parallel in chunks, in ascending Hilbert tile
-//! id (the order PMTiles needs to be clustered), with progress and bounded memory, into a
+//! Tiles are made by the same [`crate::pipeline::Picture`] as served tiles (an exported tile's
+//! bytes equal the server's answer for the same URL; a landscape's are its [`LandscapeJob`]'s),
+//! rendered in parallel in chunks, in ascending Hilbert tile id (the order PMTiles needs to be
+//! clustered), with progress and bounded memory, into a
 //! [`part`] file with a checkpoint after every chunk (an interrupted export resumes); [`merge`]
 //! then lays parts into the archive, written under a temporary name and renamed when complete,
 //! so an interrupted export never leaves a half-written file under the target name. A
@@ -23,21 +24,21 @@ pub mod part;
 pub mod pmtiles_sink;
 
 use std::path::Path;
-use std::sync::Arc;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde_json::json;
 use textile_core::maps::MapChoice;
-use textile_core::{ModeParams, ParamReader, Pyramid};
+use textile_core::{ParamReader, Pyramid};
 
 pub use layout::Layout;
 
 use crate::encode::Format;
 use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
-use crate::pipeline::{engine_version, ImageJob, Picture, Target};
+use crate::pipeline::subject::Subject;
+use crate::pipeline::{engine_version, Target};
 use crate::request::TileSpec;
-use crate::textures::{Served, Texture, Zooms};
+use crate::textures::Served;
 
 /// Tiles rendered per chunk per pool thread: what is held in memory before it is written.
 const CHUNK_PER_THREAD: usize = 32;
@@ -67,58 +68,11 @@ pub enum Area {
     },
 }
 
-/// What an export's tiles show.
-#[derive(Clone)]
-pub enum Exported {
-    /// A texture.
-    Texture {
-        /// The texture.
-        tex: Arc<Texture>,
-        /// The mode and parameters (request parameters only: what a tile URL can carry).
-        params: ModeParams,
-        /// The colour or a material map (`map=` among the pairs).
-        map: MapChoice,
-    },
-    /// A landscape, with its seed, period and map (its job for tile 0/0/0 at zoom 0).
-    Landscape(LandscapeJob),
-}
-
-impl Exported {
-    /// The id of the texture or landscape.
-    pub fn id(&self) -> &str {
-        match self {
-            Exported::Texture { tex, .. } => &tex.config.id,
-            Exported::Landscape(j) => &j.land.config.id,
-        }
-    }
-
-    fn zooms(&self) -> Zooms {
-        match self {
-            Exported::Texture { tex, .. } => tex.zooms(),
-            Exported::Landscape(j) => j.land.zooms(),
-        }
-    }
-
-    /// Its picture of tile `t`: what the server answers for the tile's URL.
-    fn picture(&self, t: TileSpec) -> Picture {
-        match self {
-            Exported::Texture { tex, params, map } => Picture::Texture(ImageJob {
-                tex: tex.clone(),
-                params: params.clone(),
-                target: Target::Tile(t),
-                map: map.clone(),
-                dem: None,
-            }),
-            Exported::Landscape(j) => Picture::Landscape(j.at(Target::Tile(t), j.map.clone())),
-        }
-    }
-}
-
 /// An export, validated.
 #[derive(Clone)]
 pub struct Plan {
-    /// What its tiles show.
-    pub what: Exported,
+    /// What its tiles show (a landscape's job for tile 0/0/0 at zoom 0).
+    pub what: Subject,
     /// The query string that gives the server's tiles the same bytes (`world` included).
     pub query: String,
     /// The area.
@@ -225,7 +179,7 @@ impl Plan {
                     return Err("map 'uv': coordinates are not exported; export albedo or a material map".into());
                 }
                 let params = tex.defaults.request(&tex.source(), r).map_err(|e| e.to_string())?;
-                Exported::Texture { tex, params, map }
+                Subject::Texture { tex, params, map }
             }
             Served::Landscape(land) => {
                 let (map, dem) = LandscapeMap::read(&land, &mut r, format).map_err(|e| e.message)?;
@@ -233,7 +187,7 @@ impl Plan {
                     return Err("raster-dem encodings are served, not exported".into());
                 }
                 let zero = Target::Tile(TileSpec { z: 0, x: 0, y: 0, scale: 1, format });
-                Exported::Landscape(LandscapeJob::new(land, zero, (map, None), r).map_err(|e| e.message)?)
+                Subject::Landscape(LandscapeJob::new(land, zero, (map, None), r).map_err(|e| e.message)?)
             }
         };
         Ok(Plan { what, query, area, zooms: all, format })
@@ -306,7 +260,7 @@ impl Plan {
             self.query_suffix()
         );
         let (name, description, attribution, textile) = match &self.what {
-            Exported::Texture { tex, params, .. } => {
+            Subject::Texture { tex, params, .. } => {
                 let c = &tex.config;
                 let description =
                     format!("textile texture '{}' ({}), exported by {}", c.id, params.name(), engine_version());
@@ -326,7 +280,7 @@ impl Plan {
             // A landscape's identity is its id and the hash of its job (configuration, splat
             // image, seed, period, map, and every layer's analysis, parameters and maps), so that
             // parts of another version of it are refused by the merge.
-            Exported::Landscape(job) => {
+            Subject::Landscape(job) => {
                 let l = &job.land.config;
                 let layers: Vec<&str> = job.land.layers.iter().map(|y| y.tex.config.id.as_str()).collect();
                 let analyses: Vec<Option<&str>> = job.land.layers.iter().map(|y| y.tex.file_hash()).collect();
@@ -458,7 +412,7 @@ pub fn render_part(plan: &Plan, shard: Shard, output: &Path) -> Result<Report, S
         let bytes: Vec<Result<Vec<u8>, String>> = part
             .par_iter()
             .map(|e| {
-                let picture = plan.what.picture(e.tile);
+                let picture = plan.what.picture(Target::Tile(e.tile));
                 picture.bytes(&pyramid, &textile_core::Cancel::default()).map_err(|err| err.message)
             })
             .collect();

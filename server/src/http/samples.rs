@@ -19,19 +19,12 @@ use crate::encode::Format;
 use crate::error::{ApiError, Kind};
 use crate::http::extract::{media_type, path_error, served};
 use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
+use crate::pipeline::subject::Subject;
 use crate::pipeline::Target;
 use crate::request::{params, query_reader, TileSpec};
 use crate::sampling::{self, parse_binary, parse_json, Records, MAX_BODY};
 use crate::state::AppState;
 use crate::textures::Served;
-
-/// What a request samples.
-enum Sampled {
-    /// A texture with a mode's parameters, showing a map.
-    Texture(Arc<crate::textures::Texture>, textile_core::ModeParams, MapChoice),
-    /// A landscape (its seed, period and map).
-    Landscape(LandscapeJob),
-}
 
 /// Colours of scattered samples of the texture, equal to the pixels of the tiles that hold them.
 #[utoipa::path(post, path = "/samples/{id}", tag = "tiles",
@@ -73,7 +66,7 @@ pub async fn samples(
                 ));
             }
             let params = params(&tex, r)?;
-            Sampled::Texture(tex, params, map)
+            Subject::Texture { tex, params, map }
         }
         Served::Landscape(land) => {
             let (map, dem) = LandscapeMap::read(&land, &mut r, Format::Png)?;
@@ -84,7 +77,7 @@ pub async fn samples(
                 ));
             }
             let zero = Target::Tile(TileSpec { z: land.native_zoom, x: 0, y: 0, scale: 1, format: Format::Png });
-            Sampled::Landscape(LandscapeJob::new(land, zero, (map, None), r)?)
+            Subject::Landscape(LandscapeJob::new(land, zero, (map, None), r)?)
         }
     };
     let binary = match media_type(&headers).as_str() {
@@ -122,8 +115,8 @@ pub async fn samples(
         parse_json(zooms, &bytes)?
     };
     let a = match what {
-        Sampled::Texture(tex, params, map) => sampling::run(&st, tex, params, map, points).await?,
-        Sampled::Landscape(job) => sampling::run_landscape(&st, job, points).await?,
+        Subject::Texture { tex, params, map } => sampling::run(&st, tex, params, map, points).await?,
+        Subject::Landscape(job) => sampling::run_landscape(&st, job, points).await?,
     };
     let mut resp = if binary {
         ([(header::CONTENT_TYPE, "application/octet-stream")], a.rgb).into_response()

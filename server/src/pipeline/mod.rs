@@ -7,6 +7,7 @@
 //! landscape's image is a [`landscape::LandscapeJob`]: its layers' jobs, joined.
 
 pub mod landscape;
+pub mod subject;
 
 use std::fmt::Write as _;
 use std::sync::Arc;

@@ -5,17 +5,16 @@
 //! [`crate::output::Output`] turns a [`Model`] into GLB, glTF and X3D bytes; `http/` only
 //! parses requests into one.
 
-use std::collections::BTreeMap;
-use std::sync::Arc;
-
 use base64::Engine;
+use std::collections::BTreeMap;
 use textile_core::maps::MapChoice;
-use textile_core::{ModeParams, ParamReader, TILE_SIZE};
+use textile_core::{ParamReader, TILE_SIZE};
 
 use crate::encode::Format;
 use crate::error::ApiError;
 use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
-use crate::pipeline::{cache_key, engine_version, ImageJob, Picture, Target};
+pub use crate::pipeline::subject::Subject;
+use crate::pipeline::{engine_version, Picture, Target};
 use crate::request::{params, query_string, TileSpec, WindowSpec, COORD_MAX};
 use crate::scene::assets::{image_side, metallic_roughness, Quad, Slot, BORDER, LAYOUT};
 use crate::textures::{Served, Texture};
@@ -32,84 +31,6 @@ pub const SLOT: &str = "slot";
 /// The `generator` of every 3D document.
 pub fn generator() -> String {
     format!("textile {} ({})", env!("CARGO_PKG_VERSION"), engine_version())
-}
-
-/// What a model shows.
-#[derive(Clone)]
-pub enum Subject {
-    /// A texture with a mode's parameters.
-    Texture {
-        /// The texture.
-        tex: Arc<Texture>,
-        /// The mode and its parameters.
-        params: ModeParams,
-    },
-    /// A landscape: its job for the model's (top-left) tile, whose seed and period every image
-    /// of the model keeps.
-    Landscape(LandscapeJob),
-}
-
-impl Subject {
-    /// The id of the texture or landscape.
-    pub fn id(&self) -> &str {
-        match self {
-            Subject::Texture { tex, .. } => &tex.config.id,
-            Subject::Landscape(j) => &j.land.config.id,
-        }
-    }
-
-    /// Zoom at which a tile pixel is a texel (of the finest layer, for a landscape).
-    pub fn native_zoom(&self) -> u32 {
-        match self {
-            Subject::Texture { tex, .. } => tex.native_zoom(),
-            Subject::Landscape(j) => j.land.native_zoom,
-        }
-    }
-
-    /// The names of its maps: a texture's own; a landscape's that every layer has.
-    fn maps(&self) -> Vec<String> {
-        match self {
-            Subject::Texture { tex, .. } => tex.exemplar.maps.iter().map(|m| m.name.clone()).collect(),
-            Subject::Landscape(j) => j.land.maps(),
-        }
-    }
-
-    /// The hashes of map `name`'s images (every layer's, for a landscape), for cache keys.
-    fn map_hashes(&self, name: &str) -> Option<String> {
-        match self {
-            Subject::Texture { tex, .. } => tex.exemplar.map(name).map(|m| m.hash.clone()),
-            Subject::Landscape(j) => {
-                let each: Vec<&str> =
-                    j.land.layers.iter().filter_map(|y| y.tex.exemplar.map(name).map(|m| m.hash.as_str())).collect();
-                (!each.is_empty()).then(|| each.join("+"))
-            }
-        }
-    }
-
-    /// Its picture of `target`: the colour, or map `name`.
-    fn picture(&self, target: Target, map: Option<&str>) -> Picture {
-        match self {
-            Subject::Texture { tex, params } => Picture::Texture(ImageJob {
-                tex: tex.clone(),
-                params: params.clone(),
-                target,
-                map: map.map_or(MapChoice::Albedo, |n| MapChoice::Map(n.to_string())),
-                dem: None,
-            }),
-            Subject::Landscape(j) => {
-                Picture::Landscape(j.at(target, map.map_or(LandscapeMap::Albedo, |n| LandscapeMap::Map(n.to_string()))))
-            }
-        }
-    }
-
-    /// A cache key of something made of it: a texture's as its tiles' keys are made (so
-    /// textures' 3D keys stay as they were); a landscape's after its job's key.
-    pub fn key(&self, what: std::fmt::Arguments) -> String {
-        match self {
-            Subject::Texture { tex, params } => cache_key(tex, params, what),
-            Subject::Landscape(j) => format!("{}|model|{what}", j.key()),
-        }
-    }
 }
 
 /// A model of `tiles × tiles` tiles from `spec` (its top-left tile) of a texture or landscape.
@@ -187,7 +108,7 @@ impl Model {
     /// The ground quad of tile `t`.
     pub fn quad(&self, t: &TileSpec) -> Quad {
         // Native texels per tile side (a fraction of a tile when magnified).
-        let size = TILE_SIZE as f64 * 2f64.powi(self.subject.native_zoom() as i32 - t.z as i32);
+        let size = TILE_SIZE as f64 * 2f64.powi(self.subject.zooms().native as i32 - t.z as i32);
         let origin = (size * t.x as f64, size * t.y as f64);
         if self.span > 0 {
             let name = format!("tiles_0_{}_{}_span_{}", t.x, t.y, self.span);
@@ -223,7 +144,7 @@ impl Model {
             },
             _ => WindowSpec { z: 0, x: 0, y: 0, w: LIFTED_IMAGE, h: LIFTED_IMAGE, format: Format::Png },
         };
-        self.subject.picture(Target::Window(window), map)
+        self.subject.picture_of(Target::Window(window), map)
     }
 
     /// The tile's image of material map `name`.
@@ -330,7 +251,7 @@ pub fn subject_with_relief(
         Served::Texture(tex) => {
             let relief = relief.map(|v| relief_scale(Some(&tex), &v)).transpose()?;
             let params = params(&tex, r)?;
-            Ok((Subject::Texture { tex, params }, relief))
+            Ok((Subject::Texture { tex, params, map: MapChoice::Albedo }, relief))
         }
         Served::Landscape(land) => {
             let relief = relief.map(|v| relief_scale(None, &v)).transpose()?;
