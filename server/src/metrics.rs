@@ -25,6 +25,8 @@ pub struct Metrics {
     pub cache_hits: IntCounter,
     /// Cache lookups that missed.
     pub cache_misses: IntCounter,
+    /// Repeated tile requests answered from their remembered ETag, before routing.
+    pub hot_tiles: IntCounter,
     /// Cache entries evicted to stay within the byte limit.
     pub cache_evictions: IntCounter,
     /// Bytes held by the cache.
@@ -87,6 +89,10 @@ impl Metrics {
                 &["route"],
             )),
             cache_hits: must(IntCounter::new("cache_hits_total", "tile cache hits")),
+            hot_tiles: must(IntCounter::new(
+                "hot_tile_answers_total",
+                "repeated tile requests answered from their remembered ETag, before routing",
+            )),
             cache_misses: must(IntCounter::new("cache_misses_total", "tile cache misses")),
             cache_evictions: must(IntCounter::new("cache_evictions_total", "tile cache evictions")),
             cache_bytes: must(IntGauge::new("cache_bytes", "bytes held by the tile cache")),
@@ -141,6 +147,7 @@ impl Metrics {
             Box::new(m.requests.clone()),
             Box::new(m.latency.clone()),
             Box::new(m.cache_hits.clone()),
+            Box::new(m.hot_tiles.clone()),
             Box::new(m.cache_misses.clone()),
             Box::new(m.cache_evictions.clone()),
             Box::new(m.cache_bytes.clone()),

@@ -106,7 +106,9 @@ async fn serve(cfg: Config) -> CliResult {
             Ok(())
         })
     };
-    let server = tokio::spawn(listen::serve(listener, app, limits, stop.clone()));
+    let hot = crate::http::hot_tiles::Shared::new(state.clone());
+    let service = move |peer| crate::http::hot_tiles::HotTiles::new(hot.clone(), app.clone(), peer);
+    let server = tokio::spawn(listen::serve(listener, service, limits, stop.clone()));
     tokio::spawn(crate::memory::return_freed_memory());
     let mut stopping = stop.clone();
     tokio::select! {

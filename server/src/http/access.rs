@@ -25,6 +25,12 @@ pub async fn record(State(st): State<Arc<AppState>>, req: Request, next: Next) -
     let entry = arrival(&req);
     let head = req.method() == Method::HEAD;
     let resp = next.run(req).await;
+    logged(st, entry, started, head, resp)
+}
+
+/// `resp`, the answer of the request noted as `entry` at `started`, logged when its body has
+/// been sent (a HEAD answer's body never is).
+pub fn logged(st: Arc<AppState>, entry: Entry, started: Instant, head: bool, resp: Response) -> Response {
     let (parts, body) = resp.into_parts();
     let cache = match parts.headers.get("x-cache").map(|v| v.as_bytes()) {
         Some(b"HIT") => "hit",
@@ -37,7 +43,7 @@ pub async fn record(State(st): State<Arc<AppState>>, req: Request, next: Next) -
 }
 
 /// The log entry of a request as it arrives (answer fields to be filled).
-fn arrival(req: &Request) -> Entry {
+pub fn arrival<B>(req: &axum::http::Request<B>) -> Entry {
     let ts_ms = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_millis() as u64);
     let header_text = |h: header::HeaderName| req.headers().get(h).and_then(|v| v.to_str().ok()).map(str::to_owned);
     Entry {

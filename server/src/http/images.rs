@@ -13,7 +13,7 @@ use axum::response::Response;
 
 use crate::error::ApiError;
 use crate::etag_memo::Stamp;
-use crate::http::content::{answer, answer_tagged, if_none_match, image, not_modified};
+use crate::http::content::{answer, answer_tagged};
 use crate::http::extract::{path_error, texture};
 use crate::output::Output;
 use crate::pipeline::landscape::{LandscapeJob, LandscapeMap};
@@ -45,16 +45,8 @@ pub async fn tile(
     let generation = st.etags.generation();
     let reg = st.ready()?;
     let Path((id, z, x, y)) = path.map_err(path_error)?;
-    // A tile asked for before, whose ETag still holds: answered from the memo and the cache.
+    // Remembered with its ETag: asked again, the hot path answers it (`http::hot_tiles`).
     let url = format!("{id}/{z}/{x}/{y}?{}", q.as_deref().unwrap_or(""));
-    if let Some(m) = st.etags.get(&url, generation) {
-        if if_none_match(&headers, &m.etag) {
-            return Ok(not_modified(&m.etag, &st.cache_control));
-        }
-        if let Some(bytes) = st.cache.peek(&m.etag) {
-            return Ok(image(bytes, m.content_type, &m.etag, &st.cache_control, true));
-        }
-    }
     let out = if let Some(land) = reg.landscape(&id) {
         let spec = parse_tile_in(land.zooms(), &z, &x, &y)?;
         let mut r = query_reader(q.as_deref())?;

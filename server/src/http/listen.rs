@@ -8,15 +8,18 @@ use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::Duration;
 
-use axum::extract::ConnectInfo;
-use axum::Router;
+use std::convert::Infallible;
+
+use axum::response::Response;
+use hyper::body::Incoming;
 use hyper::server::conn::http1::Builder;
+use hyper::Request;
 use hyper_util::rt::{TokioIo, TokioTimer};
 use hyper_util::server::graceful::GracefulShutdown;
 use hyper_util::service::TowerToHyperService;
 use tokio::net::TcpListener;
 use tokio::sync::{watch, Semaphore};
-use tower::ServiceExt;
+use tower::Service;
 use tracing::{info, warn};
 
 /// Connection limits.
@@ -31,9 +34,14 @@ pub struct Limits {
     pub shutdown_grace: Duration,
 }
 
-/// Serve `app` on `listener` until `stop` turns true, then drain for at most the grace period.
-/// Returns whether every connection finished within it.
-pub async fn serve(listener: TcpListener, app: Router, limits: Limits, mut stop: watch::Receiver<bool>) -> bool {
+/// Serve on `listener` until `stop` turns true, then drain for at most the grace period; each
+/// connection is served by `service(peer)`. Returns whether every connection finished within it.
+pub async fn serve<F, S>(listener: TcpListener, service: F, limits: Limits, mut stop: watch::Receiver<bool>) -> bool
+where
+    F: Fn(SocketAddr) -> S,
+    S: Service<Request<Incoming>, Response = Response, Error = Infallible> + Clone + Send + 'static,
+    S::Future: Send + 'static,
+{
     let slots = Arc::new(Semaphore::new(limits.max_connections.max(1)));
     let graceful = GracefulShutdown::new();
     // HTTP/1.1 only (browsers speak HTTP/2 only over TLS, which a proxy terminates): protocol
@@ -71,10 +79,7 @@ pub async fn serve(listener: TcpListener, app: Router, limits: Limits, mut stop:
             }
         };
         let _ = stream.set_nodelay(true);
-        let svc = app.clone().map_request(move |mut req: hyper::Request<hyper::body::Incoming>| {
-            req.extensions_mut().insert(ConnectInfo::<SocketAddr>(peer));
-            req
-        });
+        let svc = service(peer);
         let io = TokioIo::new(super::bare_errors::JsonBareErrors::new(stream));
         let conn = builder.serve_connection(io, TowerToHyperService::new(svc));
         let conn = graceful.watch(conn);

@@ -2,7 +2,8 @@
 //! log) and the
 //! modules behind them: errors as HTTP answers, content headers, request extraction, and the
 //! route modules (images, descriptive endpoints, 3D assets, static files, OpenAPI), which import
-//! nothing from each other. Nothing outside this folder names it: the crate root dispatches `textile serve` to [`serve`].
+//! nothing from each other; in front of the router, the hot path of remembered cached tiles
+//! ([`hot_tiles`]). Nothing outside this folder names it: the crate root dispatches `textile serve` to [`serve`].
 
 pub mod access;
 pub mod admin;
@@ -11,6 +12,7 @@ mod bare_errors;
 pub mod content;
 pub mod error;
 pub mod extract;
+pub mod hot_tiles;
 pub mod images;
 pub mod listen;
 pub mod meta;
@@ -32,6 +34,8 @@ use axum::Router;
 use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::compression::CompressionLayer;
 use tower_http::cors::{AllowOrigin, CorsLayer};
+
+use axum::http::{HeaderMap, HeaderName};
 
 use crate::error::ApiError;
 use crate::state::AppState;
@@ -64,7 +68,7 @@ pub const MAX_URI_BYTES: usize = 16 << 10;
 /// The contract's JSON error (414, 431) of an oversized request, before any route sees it.
 /// What hyper refuses itself — a request line of 64 KiB or more, headers beyond what it reads
 /// at all — it answers with a bare status, which [`bare_errors`] rewrites as JSON too.
-fn over_limits(req: &Request) -> Option<Response> {
+fn over_limits<B>(req: &axum::http::Request<B>) -> Option<Response> {
     let uri = req.uri().path_and_query().map_or(0, |pq| pq.as_str().len());
     if uri > MAX_URI_BYTES {
         return ApiError::new(
@@ -87,6 +91,68 @@ fn over_limits(req: &Request) -> Option<Response> {
         .into();
     }
     None
+}
+
+/// The CORS settings (`cors_origins`): the router's CORS layer is built from them, and the
+/// tiles' hot path ([`hot_tiles`]) adds the same headers that layer adds to a GET's answer.
+pub struct Cors {
+    /// Every origin is allowed (`*`), else the listed ones.
+    any: bool,
+    origins: Vec<HeaderValue>,
+    vary: HeaderValue,
+    expose: HeaderValue,
+}
+
+/// The response headers a page's scripts may read.
+fn exposed() -> [HeaderName; 6] {
+    [
+        header::ETAG,
+        HeaderName::from_static("x-cache"),
+        HeaderName::from_static("x-textile-computed"),
+        HeaderName::from_static("x-textile-windows"),
+        header::CONTENT_RANGE,
+        header::LOCATION,
+    ]
+}
+
+impl Cors {
+    /// The settings of the configured origins.
+    pub fn new(origins: &[String]) -> Cors {
+        let joined = |names: &[HeaderName], by: &str| {
+            let text = names.iter().map(HeaderName::as_str).collect::<Vec<_>>().join(by);
+            HeaderValue::from_str(&text).unwrap_or(HeaderValue::from_static(""))
+        };
+        let varies = [header::ORIGIN, header::ACCESS_CONTROL_REQUEST_METHOD, header::ACCESS_CONTROL_REQUEST_HEADERS];
+        Cors {
+            any: origins.iter().any(|o| o == "*"),
+            origins: origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()).collect(),
+            vary: joined(&varies, ", "),
+            expose: joined(&exposed(), ","),
+        }
+    }
+
+    /// The router's CORS layer.
+    pub fn layer(&self) -> CorsLayer {
+        CorsLayer::new()
+            .allow_methods([Method::GET, Method::HEAD, Method::POST, Method::DELETE])
+            .allow_headers([header::IF_NONE_MATCH, header::CONTENT_TYPE, header::RANGE, header::AUTHORIZATION])
+            .expose_headers(exposed())
+            .allow_origin(if self.any { AllowOrigin::any() } else { AllowOrigin::list(self.origins.clone()) })
+    }
+
+    /// Add to `answer` the headers the layer adds to the answer of a GET with `request` headers.
+    pub fn add(&self, request: &HeaderMap, answer: &mut HeaderMap) {
+        answer.append(header::VARY, self.vary.clone());
+        let allowed = if self.any {
+            Some(HeaderValue::from_static("*"))
+        } else {
+            request.get(header::ORIGIN).filter(|o| self.origins.contains(o)).cloned()
+        };
+        if let Some(origin) = allowed {
+            answer.insert(header::ACCESS_CONTROL_ALLOW_ORIGIN, origin);
+        }
+        answer.insert(header::ACCESS_CONTROL_EXPOSE_HEADERS, self.expose.clone());
+    }
 }
 
 /// A route that reads a request body, with the deadline for a body that stops arriving.
@@ -151,22 +217,7 @@ pub fn router(state: Arc<AppState>) -> Router {
 /// The service's fallbacks and middleware around a set of routes: JSON 404/405, request
 /// metrics, JSON compression, CORS, panics turned into a 500 JSON error, and the access log.
 fn with_middleware(routes: Router<Arc<AppState>>, state: Arc<AppState>) -> Router {
-    let cors = CorsLayer::new()
-        .allow_methods([Method::GET, Method::HEAD, Method::POST, Method::DELETE])
-        .allow_headers([header::IF_NONE_MATCH, header::CONTENT_TYPE, header::RANGE, header::AUTHORIZATION])
-        .expose_headers([
-            header::ETAG,
-            header::HeaderName::from_static("x-cache"),
-            header::HeaderName::from_static("x-textile-computed"),
-            header::HeaderName::from_static("x-textile-windows"),
-            header::CONTENT_RANGE,
-            header::LOCATION,
-        ])
-        .allow_origin(if state.config.cors_origins.iter().any(|o| o == "*") {
-            AllowOrigin::any()
-        } else {
-            AllowOrigin::list(state.config.cors_origins.iter().filter_map(|o| HeaderValue::from_str(o).ok()))
-        });
+    let cors = Cors::new(&state.config.cors_origins).layer();
     let app = routes
         .fallback(meta::not_found)
         .layer(middleware::from_fn_with_state(state.clone(), track))
@@ -219,5 +270,27 @@ mod tests {
         assert_eq!(v["error"], "internal");
         let r = app.oneshot(Request::get("/ok").body(Body::empty()).unwrap()).await.unwrap();
         assert_eq!(r.status(), StatusCode::OK);
+    }
+
+    #[tokio::test]
+    async fn the_hot_paths_cors_headers_are_the_layers() {
+        for origins in [vec!["*".to_owned()], vec!["https://a.example".to_owned(), "https://c.example".to_owned()]] {
+            let cors = Cors::new(&origins);
+            let bare = tower::service_fn(|_: Request<Body>| async {
+                Ok::<_, std::convert::Infallible>(Response::new(Body::empty()))
+            });
+            let layered = tower::Layer::layer(&cors.layer(), bare);
+            for origin in [None, Some("https://a.example"), Some("https://b.example")] {
+                let mut req = Request::get("/tiles/gravel/7/1/1.png");
+                if let Some(o) = origin {
+                    req = req.header(header::ORIGIN, o);
+                }
+                let req = req.body(Body::empty()).unwrap();
+                let mut ours = HeaderMap::new();
+                cors.add(req.headers(), &mut ours);
+                let theirs = layered.clone().oneshot(req).await.unwrap();
+                assert_eq!(theirs.headers(), &ours, "{origins:?} {origin:?}");
+            }
+        }
     }
 }
