@@ -173,6 +173,8 @@ async fn render_writes_the_glb_the_server_serves() {
     for (texture, z, x, y, params, query) in [
         ("gravel", "6", "1", "-1", vec!["--seed", "3"], "?seed=3"),
         ("flagstones", "8", "3", "-2", vec!["--param", "relief=4"], "?relief=4"),
+        // A landscape's, raised by its blended heights.
+        ("meadow", "7", "0", "1", vec!["--param", "relief=8", "--seed", "4"], "?relief=8&seed=4"),
     ] {
         let out = dir.path().join(format!("{texture}.glb"));
         let mut args = vec!["render", "--texture", texture, "--data-dir", data.to_str().unwrap()];

@@ -175,26 +175,42 @@ fn target_of(a: &RenderArgs, z: u32, format: Format) -> Result<Target, Box<dyn s
     Ok(Target::Tile(TileSpec { z, x, y, scale: 1, format }))
 }
 
-/// `textile render --texture LANDSCAPE`: a tile or window of a landscape, the bytes the server
-/// serves for it.
+/// `textile render --texture LANDSCAPE`: a tile or window of a landscape, or a tile's model
+/// (`.glb`, with `--param relief=…`), the bytes the server serves for it.
 fn render_landscape(a: &RenderArgs, land: Arc<Landscape>, output: &Path) -> CliResult {
-    if a.sheet || a.camera.is_some() || a.mode.is_some() || !a.params.is_empty() || a.controls.is_some() {
-        return Err("a landscape renders tiles and windows with --seed, --world and --map only (its layers' \
-                    parameters are in its configuration)"
+    let glb = output.extension().is_some_and(|e| e == "glb");
+    let relief_only = a.params.iter().all(|p| glb && p.starts_with("relief="));
+    if a.sheet || a.camera.is_some() || a.mode.is_some() || !relief_only || a.controls.is_some() {
+        return Err("a landscape renders tiles and windows with --seed, --world and --map, and .glb tiles with \
+                    --param relief=… too (its layers' parameters are in its configuration)"
             .into());
     }
-    let format = output_format(output)?;
     let z = a.z.unwrap_or(land.native_zoom);
     if !(land.min_zoom..=land.max_zoom).contains(&z) {
         return Err(format!("--z {z} is outside {}..={}", land.min_zoom, land.max_zoom).into());
     }
+    let mut pairs = param_pairs(&a.params, &None, a.seed, a.world)?;
+    let levels = Pyramid::new(64 << 20);
+    if glb {
+        if a.window.is_some() || a.map != "albedo" {
+            return Err("a .glb output is a tile's model: --x, --y, --z, --seed, --world and relief only".into());
+        }
+        let Target::Tile(spec) = target_of(a, z, Format::Png)? else {
+            return Err("a .glb output is a tile's model".into());
+        };
+        let model = Model::read(Served::Landscape(land), spec, 1, ParamReader::request(pairs)?, Default::default())?;
+        let bytes = Output::Glb(model).bytes(&levels)?;
+        write_atomic(output, &bytes)?;
+        println!("wrote {} (GLB of landscape tile {z}/{}/{}, {} bytes)", output.display(), spec.x, spec.y, bytes.len());
+        return Ok(());
+    }
+    let format = output_format(output)?;
     let target = target_of(a, z, format)?;
-    let mut pairs = param_pairs(&[], &None, a.seed, a.world)?;
     pairs.push(("map".into(), a.map.clone()));
     let mut r = ParamReader::request(pairs)?;
     let map = LandscapeMap::read(&land, &mut r, format)?;
     let job = LandscapeJob::new(land, target, map, r)?;
-    let bytes = Output::Landscape(job).bytes(&Pyramid::new(64 << 20))?;
+    let bytes = Output::Landscape(job).bytes(&levels)?;
     write_atomic(output, &bytes)?;
     println!("wrote {} (landscape, {} bytes)", output.display(), bytes.len());
     Ok(())
