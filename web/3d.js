@@ -345,16 +345,7 @@ async function main() {
   resize();
   catalog = await (await fetch('/catalog')).json();
   const sel = $('texture');
-  const group = (label, items) => {
-    const g = document.createElement('optgroup');
-    g.label = label;
-    for (const t of items) g.append(new Option(t.name, t.id));
-    sel.append(g);
-  };
-  group('Textures', catalog.textures);
-  if ((catalog.landscapes || []).length) group('Landscapes', catalog.landscapes);
-  const all = catalog.textures.concat(catalog.landscapes || []);
-  if (!all.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
+  state.t = window.TextileModes.pick(sel, catalog, state.t);
   sel.value = state.t;
   $('seed').value = state.seed;
   sel.addEventListener('change', () => { state.p = {}; selectTexture(sel.value, false); });

@@ -566,16 +566,7 @@ async function init() {
   readHash();
   catalog = await (await fetch('/catalog')).json();
   const sel = $('texture');
-  const group = (label, list) => {
-    const g = document.createElement('optgroup');
-    g.label = label;
-    for (const t of list) g.append(new Option(t.name, t.id));
-    sel.append(g);
-  };
-  group('Textures', catalog.textures);
-  if ((catalog.landscapes || []).length) group('Landscapes', catalog.landscapes);
-  const known = [...catalog.textures, ...(catalog.landscapes || [])];
-  if (!known.some((t) => t.id === state.t)) state.t = catalog.textures[0].id;
+  state.t = window.TextileModes.pick(sel, catalog, state.t);
   map = L.map('map', { crs: L.CRS.Simple, zoomSnap: 1, keyboard: true, worldCopyJump: false });
   window.textileMap = map;
   map.on('moveend', onMove);
