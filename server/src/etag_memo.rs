@@ -45,6 +45,12 @@ pub struct Memo {
     stamps: Vec<Stamp>,
 }
 
+/// The memo's key of the tile at `path` (`{id}/{z}/{x}/{y}`, after `/tiles/`) with `query`:
+/// the tile route and the hot path (`http::hot_tiles`) must name a request alike.
+pub fn url_key(path: &str, query: Option<&str>) -> String {
+    format!("{path}?{}", query.unwrap_or(""))
+}
+
 /// Recent tile URLs and their ETags.
 pub struct EtagMemo {
     entries: Mutex<lru::LruCache<Box<str>, Arc<Memo>>>,

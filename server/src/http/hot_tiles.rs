@@ -64,15 +64,21 @@ impl Shared {
         let rest = req.uri().path().strip_prefix("/tiles/")?;
         // Exactly the route's four segments, none empty or percent-encoded: then the router's
         // decoded parameters are these segments, and the memo's key is the handler's.
-        if rest.contains('%') || rest.split('/').count() != 4 || rest.split('/').any(str::is_empty) {
+        let mut segments = 0;
+        for s in rest.split('/') {
+            if s.is_empty() {
+                return None;
+            }
+            segments += 1;
+        }
+        if segments != 4 || rest.contains('%') {
             return None;
         }
         let started = Instant::now();
         let st = &self.st;
         let generation = st.etags.generation();
         st.registry()?;
-        let url = format!("{rest}?{}", req.uri().query().unwrap_or(""));
-        let m = st.etags.get(&url, generation)?;
+        let m = st.etags.get(&crate::etag_memo::url_key(rest, req.uri().query()), generation)?;
         let mut resp = if if_none_match(req.headers(), &m.etag) {
             self.not_modified.inc();
             not_modified(&m.etag, &st.cache_control)

@@ -12,7 +12,7 @@ use axum::http::HeaderMap;
 use axum::response::Response;
 
 use crate::error::ApiError;
-use crate::etag_memo::Stamp;
+use crate::etag_memo::{url_key, Stamp};
 use crate::http::content::{answer, answer_tagged};
 use crate::http::extract::{path_error, texture};
 use crate::output::Output;
@@ -45,27 +45,26 @@ pub async fn tile(
     let generation = st.etags.generation();
     let reg = st.ready()?;
     let Path((id, z, x, y)) = path.map_err(path_error)?;
-    // Remembered with its ETag: asked again, the hot path answers it (`http::hot_tiles`).
-    let url = format!("{id}/{z}/{x}/{y}?{}", q.as_deref().unwrap_or(""));
-    let out = if let Some(land) = reg.landscape(&id) {
+    // Remembered with its ETag, and the textures it renders as they stand: asked again, the hot
+    // path answers it (`http::hot_tiles`).
+    let url = url_key(&format!("{id}/{z}/{x}/{y}"), q.as_deref());
+    let (out, stamps) = if let Some(land) = reg.landscape(&id) {
         let spec = parse_tile_in(land.zooms(), &z, &x, &y)?;
         let mut r = query_reader(q.as_deref())?;
         let map = LandscapeMap::read(land, &mut r, spec.format)?;
-        Output::Landscape(LandscapeJob::new(land.clone(), Target::Tile(spec), map, r)?)
+        let job = LandscapeJob::new(land.clone(), Target::Tile(spec), map, r)?;
+        let stamps = job.layers.iter().map(|j| Stamp::new(&j.tex, j.params.name())).collect();
+        (Output::Landscape(job), stamps)
     } else {
         let tex = texture(&reg, &id)?;
         let spec = parse_tile(&tex, &z, &x, &y)?;
         let mut r = query_reader(q.as_deref())?;
         let (map, dem) = map_and_dem(&tex, &mut r, spec.format)?;
         let params = params(&tex, r)?;
-        Output::Image(ImageJob { tex, params, target: Target::Tile(spec), map, dem })
+        let stamps = vec![Stamp::new(&tex, params.name())];
+        (Output::Image(ImageJob { tex, params, target: Target::Tile(spec), map, dem }), stamps)
     };
     let etag = out.etag();
-    let stamps = match &out {
-        Output::Image(job) => vec![Stamp::new(&job.tex, job.params.name())],
-        Output::Landscape(job) => job.layers.iter().map(|j| Stamp::new(&j.tex, j.params.name())).collect(),
-        _ => Vec::new(),
-    };
     st.etags.put(&url, generation, &etag, out.content_type(), stamps);
     answer_tagged(&st, &headers, out, etag).await
 }

@@ -4,11 +4,10 @@
 //! errors (e.g. out of file descriptors) that back off instead of stopping service — and a
 //! graceful shutdown that drains in-flight requests for at most a deadline.
 
+use std::convert::Infallible;
 use std::net::SocketAddr;
 use std::sync::Arc;
 use std::time::Duration;
-
-use std::convert::Infallible;
 
 use axum::response::Response;
 use hyper::body::Incoming;
