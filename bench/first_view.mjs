@@ -8,18 +8,9 @@
 // e.g. node bench/first_view.mjs http://127.0.0.1:8080 /tmp/access.log 't=gravel' 't=flagstones'
 // A HASH opens a page of its own; `>TEXTURE` picks that texture in the page before it, as a user
 // switching textures does (e.g. 't=gravel' '>flagstones').
-import { createRequire } from 'node:module';
 import { readFileSync, statSync } from 'node:fs';
 
-const require = createRequire(new URL('../tests/browser/package.json', import.meta.url));
-// The libraries are tests/browser's: installed by `npm ci` there (what .ci/run does).
-let chromium;
-try {
-  ({ chromium } = require('playwright-core'));
-} catch {
-  console.error('bench: the browser libraries are missing; install them first: (cd tests/browser && npm ci)');
-  process.exit(2);
-}
+import { chromium } from './browser_libs.mjs';
 
 const [base, log, ...hashes] = process.argv.slice(2);
 const views = hashes.length ? hashes : ['t=gravel', 't=flagstones'];

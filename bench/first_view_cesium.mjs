@@ -10,19 +10,10 @@
 // (CESIUM_OPTIONS='{…}' replaces the recipe's options to Cesium3DTileset.fromUrl, by default
 // {"skipLevelOfDetail": true, "foveatedScreenSpaceError": false}; SCENE='statements' runs them with `viewer` set up, before the
 // tileset, e.g. SCENE='viewer.resolutionScale = 0.2'; SHOTS=DIR saves each settled view there)
-import { createRequire } from 'node:module';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 
-const require = createRequire(new URL('../tests/browser/package.json', import.meta.url));
-// The libraries are tests/browser's: installed by `npm ci` there (what .ci/run does).
-let chromium;
-try {
-  ({ chromium } = require('playwright-core'));
-} catch {
-  console.error('bench: the browser libraries are missing; install them first: (cd tests/browser && npm ci)');
-  process.exit(2);
-}
+import { chromium } from './browser_libs.mjs';
 const MODULES = new URL('../tests/browser/node_modules/', import.meta.url).pathname;
 const TYPES = { js: 'text/javascript', css: 'text/css', json: 'application/json', wasm: 'application/wasm', png: 'image/png', jpg: 'image/jpeg', glb: 'model/gltf-binary' };
 

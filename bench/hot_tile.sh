@@ -14,20 +14,13 @@ WORK=$(mktemp -d)
 PIDS=()
 trap 'kill "${PIDS[@]}" 2>/dev/null; rm -rf "$WORK"' EXIT
 
-start() { # NAME BINARY -> sets URL_NAME
-  local name=$1 bin=$2
-  mkdir -p "$WORK/$name"
-  "$bin" serve --bind 127.0.0.1:0 --data-dir "$WORK/$name" > "$WORK/$name.out" 2>&1 &
-  PIDS+=($!)
-  until grep -q "textile ready" "$WORK/$name.out" 2>/dev/null; do
-    kill -0 "${PIDS[-1]}" 2>/dev/null || { cat "$WORK/$name.out" >&2; exit 1; }
-    sleep 0.2
-  done
-  sed -n 's/^textile ready: viewer at \(http[^ ]*\)\/ .*/\1/p' "$WORK/$name.out"
-}
-
-URL_OLD=$(start old "$OLD")
-URL_NEW=$(start new "$NEW")
+. "$(dirname "$0")/server.sh"
+serve_binary "$OLD" "$WORK/old"
+PIDS+=("$PID")
+URL_OLD=$URL
+serve_binary "$NEW" "$WORK/new"
+PIDS+=("$PID")
+URL_NEW=$URL
 for u in "$URL_OLD" "$URL_NEW"; do
   curl -s -o /dev/null "$u$TILE"
 done

@@ -20,14 +20,10 @@ command -v wrk >/dev/null || { echo "bench: needs wrk (apt-get install wrk)" >&2
 NGINX=$(command -v nginx || echo /usr/sbin/nginx)
 [ -x "$NGINX" ] || { echo "bench: needs nginx (apt-get install nginx)" >&2; exit 2; }
 
-mkdir -p "$WORK/data"
-"$BIN" serve --bind 127.0.0.1:0 --data-dir "$WORK/data" > "$WORK/textile.out" 2>&1 &
-PIDS+=($!)
-until grep -q "textile ready" "$WORK/textile.out" 2>/dev/null; do
-  kill -0 "${PIDS[-1]}" 2>/dev/null || { cat "$WORK/textile.out" >&2; exit 1; }
-  sleep 0.2
-done
-T=$(sed -n 's/^textile ready: viewer at \(http[^ ]*\)\/ .*/\1/p' "$WORK/textile.out")
+. "$(dirname "$0")/server.sh"
+serve_binary "$BIN" "$WORK/data"
+PIDS+=("$PID")
+T=$URL
 mkdir -p "$WORK/www$(dirname "$TILE")"
 curl -s -o "$WORK/www$TILE" "$T$TILE"
 ETAG=$(curl -s -D - -o /dev/null "$T$TILE" | awk 'tolower($1) == "etag:" {print $2}' | tr -d '\r')
